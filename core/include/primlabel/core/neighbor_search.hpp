@@ -1,0 +1,63 @@
+#pragma once
+// Fixed-radius, k-nearest and hybrid neighbour queries over a cloud's finite points (nanoflann
+// k-d tree). Results are sorted by ascending squared distance, ties by ascending index, so the
+// same query always returns the same list.
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "primlabel/core/point_cloud.hpp"
+
+namespace primlabel {
+
+// What a "neighbourhood" is. Radius search when radius > 0 and max_neighbors == 0; k-nearest when
+// radius == 0 and k > 0; hybrid (the nearest max_neighbors within radius) when both are set.
+struct Neighborhood {
+  float radius = 0.0f;
+  int k = 0;              // k-nearest (radius == 0)
+  int max_neighbors = 0;  // cap for radius search; 0 = unlimited
+
+  static Neighborhood Radius(float r) { return {r, 0, 0}; }
+  static Neighborhood Knn(int k) { return {0.0f, k, 0}; }
+  static Neighborhood Hybrid(float r, int max_nn) { return {r, 0, max_nn}; }
+
+  bool valid() const { return (radius > 0.0f && k == 0) || (radius == 0.0f && k > 0); }
+  std::string describe() const;
+};
+
+struct NeighborList {
+  std::vector<std::uint32_t> indices;  // indices into the cloud the search was built on
+  std::vector<float> sq_dists;
+  std::size_t size() const { return indices.size(); }
+  void clear() {
+    indices.clear();
+    sq_dists.clear();
+  }
+};
+
+class NeighborSearch {
+ public:
+  // Indexes the finite points of `points`; the vector must outlive the search object.
+  explicit NeighborSearch(const std::vector<Vec3f>& points);
+  ~NeighborSearch();
+  NeighborSearch(const NeighborSearch&) = delete;
+  NeighborSearch& operator=(const NeighborSearch&) = delete;
+
+  // Neighbours of an arbitrary query position (the query point itself is included when it is in
+  // the cloud, at distance 0). k-nearest results are always sorted; radius results are sorted
+  // unless `sorted` is false, in which case their order is still deterministic (tree order) and
+  // the O(n log n) sort is saved. A non-finite query has no neighbours.
+  // Thread-safe: the tree is read-only after construction.
+  void find(const Vec3f& query, const Neighborhood& hood, NeighborList& out,
+            bool sorted = true) const;
+
+  std::size_t indexed_points() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace primlabel

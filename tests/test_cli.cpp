@@ -1,0 +1,96 @@
+// End-to-end checks of the command-line tools as a user runs them: exit codes, one-line errors,
+// and output files that read back.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/core/features.hpp"
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+struct Result {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+Result run(const std::string& command) {
+  Result result{-1, {}};
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::string features_tool() { return test::binary("primlabel-features"); }
+
+class FeaturesCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    bunny_ = test::shared_data("pcl/bun0.pcd");
+    if (!std::filesystem::exists(bunny_)) GTEST_SKIP() << bunny_ << " not present";
+  }
+  std::string bunny_;
+  test::TempDir dir_;
+};
+
+TEST_F(FeaturesCli, WritesNormalsCurvatureAndFpfh) {
+  const std::string out = dir_.file("bunny_fpfh.pcd");
+  const Result r = run(features_tool() + " " + bunny_ + " -o " + out +
+                       " --normal-k 10 --feature-radius 0.02 --threads 2");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const PointCloud cloud = read_pcd(out);
+  EXPECT_EQ(cloud.size(), 397u);
+  EXPECT_TRUE(cloud.has_normals());
+  EXPECT_TRUE(cloud.has_curvature());
+  const FloatField* fpfh = cloud.find_field("fpfh");
+  ASSERT_NE(fpfh, nullptr);
+  EXPECT_EQ(fpfh->count, kFpfhSize);
+  EXPECT_NE(r.output.find("fpfh: 397 computed"), std::string::npos) << r.output;
+}
+
+TEST_F(FeaturesCli, PfhToPlyWithInputNormals) {
+  const std::string out = dir_.file("bunny_pfh.ply");
+  const Result r = run(features_tool() + " " + bunny_ + " -o " + out +
+                       " --use-input-normals --feature-k 10 --descriptor pfh -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output, "");  // quiet
+  const PointCloud cloud = read_ply(out);
+  const FloatField* pfh = cloud.find_field("pfh");
+  ASSERT_NE(pfh, nullptr);
+  EXPECT_EQ(pfh->count, kPfhSize);
+}
+
+TEST_F(FeaturesCli, UsageErrorsExitWith2AndOneLine) {
+  for (const std::string args : {" -o x.pcd --normal-k 10 --normal-radius 0.1", " -o x.pcd --descriptor shot",
+                                 " -o x.pcd --feature-radius -1", "", " -o x.pcd --viewpoint 1,2"}) {
+    const Result r = run(features_tool() + " " + bunny_ + args);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.output;
+    EXPECT_NE(r.output.find("usage error"), std::string::npos) << r.output;
+  }
+}
+
+TEST_F(FeaturesCli, RuntimeErrorsExitWith1AndNameTheFile) {
+  Result r = run(features_tool() + " /nonexistent/scan.pcd -o " + dir_.file("o.pcd"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("/nonexistent/scan.pcd"), std::string::npos) << r.output;
+
+  PointCloud no_normals = test::random_box(50, 1.0f, 3);
+  write_pcd(dir_.file("plain.pcd"), no_normals);
+  r = run(features_tool() + " " + dir_.file("plain.pcd") + " -o " + dir_.file("o.pcd") +
+          " --use-input-normals");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("has no normal"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_.file("o.pcd")));
+}
+
+}  // namespace
+}  // namespace primlabel

@@ -1,0 +1,233 @@
+#include "primlabel/core/features.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <numeric>
+
+#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/core/normals.hpp"
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+// ---- pair features -----------------------------------------------------------------------------
+
+TEST(PairFeatures, ParallelNormalsOnAPlane) {
+  float f1, f2, f3, f4;
+  ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {2, 0, 0}, {0, 0, 1}, f1, f2, f3, f4));
+  EXPECT_FLOAT_EQ(f4, 2.0f);
+  EXPECT_FLOAT_EQ(f1, 0.0f);
+  EXPECT_FLOAT_EQ(f2, 0.0f);
+  EXPECT_FLOAT_EQ(f3, 0.0f);
+}
+
+TEST(PairFeatures, AlphaIsTheNormalsAngleInTheDarbouxFrame) {
+  const float a = 0.3f;
+  float f1, f2, f3, f4;
+  // u = n1 = z, v = (p2 - p1) x u = -y, w = u x v = x: n2 = (sin a, 0, cos a) makes angle a.
+  ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0},
+                                    {std::sin(a), 0, std::cos(a)}, f1, f2, f3, f4));
+  EXPECT_NEAR(f1, a, 1e-6f);
+  EXPECT_NEAR(f2, 0.0f, 1e-7f);
+  EXPECT_NEAR(f3, 0.0f, 1e-7f);
+}
+
+TEST(PairFeatures, SourceIsThePointWhoseNormalIsCloserToTheLine) {
+  float f1, f2, f3, f4;
+  // n2 lies along the connecting line, n1 is perpendicular: the pair is swapped, theta = -1.
+  ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {1, 0, 0}, f1, f2, f3, f4));
+  EXPECT_FLOAT_EQ(f3, -1.0f);
+  float g1, g2, g3, g4;  // and the features do not depend on the order of the points
+  ASSERT_TRUE(compute_pair_features({1, 0, 0}, {1, 0, 0}, {0, 0, 0}, {0, 0, 1}, g1, g2, g3, g4));
+  EXPECT_FLOAT_EQ(f1, g1);
+  EXPECT_FLOAT_EQ(f2, g2);
+  EXPECT_FLOAT_EQ(f3, g3);
+}
+
+TEST(PairFeatures, DegeneratePairsAreZero) {
+  float f1 = 1, f2 = 1, f3 = 1, f4 = 1;
+  EXPECT_FALSE(compute_pair_features({1, 1, 1}, {0, 0, 1}, {1, 1, 1}, {0, 1, 0}, f1, f2, f3, f4));
+  EXPECT_EQ(f1 + f2 + f3 + f4, 0.0f);
+  // Normal parallel to the connecting line: no Darboux frame.
+  EXPECT_FALSE(compute_pair_features({0, 0, 0}, {1, 0, 0}, {1, 0, 0}, {1, 0, 0}, f1, f2, f3, f4));
+}
+
+// ---- conformance with PCL 1.13 on the Stanford bunny (reference fixtures made by PCL) ----------
+
+class BunnyConformance : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const std::string path = test::shared_data("pcl/bun0.pcd");
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
+    cloud_ = read_pcd(path);
+    ASSERT_TRUE(cloud_.has_normals());
+    ASSERT_EQ(cloud_.size(), 397u);
+  }
+
+  // Largest |ours - PCL| over every bin of every point; NaN must match NaN.
+  float max_difference(const std::vector<float>& ours, int bins, const std::string& fixture) {
+    const auto reference = test::read_csv(test::test_data("reference/" + fixture));
+    EXPECT_EQ(reference.size(), cloud_.size());
+    float worst = 0.0f;
+    for (std::size_t i = 0; i < reference.size(); ++i) {
+      EXPECT_EQ(reference[i].size(), static_cast<std::size_t>(bins));
+      for (int b = 0; b < bins; ++b) {
+        const float mine = ours[i * bins + b], theirs = reference[i][b];
+        if (std::isnan(mine) || std::isnan(theirs)) {
+          EXPECT_EQ(std::isnan(mine), std::isnan(theirs)) << "point " << i << " bin " << b;
+          continue;
+        }
+        worst = std::max(worst, std::abs(mine - theirs));
+      }
+    }
+    return worst;
+  }
+
+  PointCloud cloud_;
+};
+
+TEST_F(BunnyConformance, FpfhK10) {
+  FeatureOptions options;
+  options.neighborhood = Neighborhood::Knn(10);
+  EXPECT_LE(max_difference(compute_fpfh(cloud_, options), kFpfhSize, "bun0_fpfh_k10.csv"), 1e-4f);
+}
+
+TEST_F(BunnyConformance, FpfhRadius001) {
+  FeatureOptions options;
+  options.neighborhood = Neighborhood::Radius(0.01f);
+  EXPECT_LE(max_difference(compute_fpfh(cloud_, options), kFpfhSize, "bun0_fpfh_r0.01.csv"), 1e-4f);
+}
+
+TEST_F(BunnyConformance, FpfhRadius002) {
+  FeatureOptions options;
+  options.neighborhood = Neighborhood::Radius(0.02f);
+  EXPECT_LE(max_difference(compute_fpfh(cloud_, options), kFpfhSize, "bun0_fpfh_r0.02.csv"), 1e-4f);
+}
+
+TEST_F(BunnyConformance, PfhK10) {
+  FeatureOptions options;
+  options.neighborhood = Neighborhood::Knn(10);
+  EXPECT_LE(max_difference(compute_pfh(cloud_, options), kPfhSize, "bun0_pfh_k10.csv"), 1e-4f);
+}
+
+// ---- histogram properties ----------------------------------------------------------------------
+
+PointCloud sphere_with_normals(int n, unsigned seed) {
+  PointCloud cloud = test::sphere(Vec3f(0, 0, 1), 0.1f, n, 0.0005f, seed);
+  NormalOptions options;
+  options.neighborhood = Neighborhood::Knn(10);
+  estimate_normals(cloud, options);
+  return cloud;
+}
+
+float sub_sum(const std::vector<float>& h, std::size_t point, int sub) {
+  const float* row = h.data() + point * kFpfhSize + sub * kFpfhBinsPerFeature;
+  return std::accumulate(row, row + kFpfhBinsPerFeature, 0.0f);
+}
+
+TEST(Fpfh, SubHistogramsSumTo100AndThePaperVariantAddsTheOwnSpfh) {
+  PointCloud cloud = sphere_with_normals(3000, 5);
+  FeatureOptions options;
+  options.neighborhood = Neighborhood::Radius(0.02f);
+  FeatureStats stats;
+  const auto pcl = compute_fpfh(cloud, options, &stats);
+  EXPECT_EQ(stats.computed, cloud.size());
+  EXPECT_EQ(stats.nan, 0u);
+  options.fpfh_variant = FpfhVariant::kWithOwnSpfh;
+  const auto paper = compute_fpfh(cloud, options);
+  for (std::size_t i = 0; i < cloud.size(); i += 37)
+    for (int s = 0; s < 3; ++s) {
+      ASSERT_NEAR(sub_sum(pcl, i, s), 100.0f, 1e-3f);
+      ASSERT_NEAR(sub_sum(paper, i, s), 200.0f, 2e-3f);  // own SPFH also sums to 100
+    }
+}
+
+TEST(Fpfh, PlaneAndSphereDiffer) {
+  // The descriptor must tell a plane from a curved surface: plane pairs all land in the
+  // middle bins (alpha = phi = theta = 0), sphere pairs spread out.
+  PointCloud plane = test::plane_grid(0, 0, 0.1f, 0.005f);
+  plane.viewpoint.origin = Vec3f(0, 0, 1);
+  NormalOptions normal_options;
+  normal_options.neighborhood = Neighborhood::Radius(0.012f);
+  estimate_normals(plane, normal_options);
+  FeatureOptions options;
+  options.neighborhood = Neighborhood::Radius(0.02f);
+  const auto h = compute_fpfh(plane, options);
+  const std::size_t center = plane.size() / 2;
+  EXPECT_NEAR(h[center * kFpfhSize + 5], 100.0f, 1e-3f);
+  EXPECT_NEAR(h[center * kFpfhSize + 11 + 5], 100.0f, 1e-3f);
+  EXPECT_NEAR(h[center * kFpfhSize + 22 + 5], 100.0f, 1e-3f);
+
+  PointCloud ball = sphere_with_normals(3000, 9);
+  const auto hb = compute_fpfh(ball, options);
+  EXPECT_LT(hb[0 * kFpfhSize + 22 + 5], 95.0f);
+}
+
+TEST(Features, InvalidPointsAndNormalsAreNaNAndLeftOutOfNeighbourhoods) {
+  PointCloud cloud = sphere_with_normals(2000, 11);
+  const std::size_t broken_normal = 100, broken_point = 200;
+  cloud.normals[broken_normal] = Vec3f::Constant(NAN);
+  cloud.xyz[broken_point] = Vec3f::Constant(NAN);
+  cloud.xyz.push_back(Vec3f(9, 9, 9));  // isolated: no neighbour but itself
+  cloud.normals.push_back(Vec3f(0, 0, 1));
+  FeatureOptions options;
+  options.neighborhood = Neighborhood::Radius(0.02f);
+  FeatureStats stats;
+  const auto with_gaps = compute_fpfh(cloud, options, &stats);
+  EXPECT_EQ(stats.nan, 3u);
+  for (std::size_t p : {broken_normal, broken_point, cloud.size() - 1})
+    EXPECT_TRUE(std::isnan(with_gaps[p * kFpfhSize])) << p;
+
+  // A neighbour without a normal counts as absent: same descriptors as with it removed.
+  PointCloud without = cloud;
+  without.xyz[broken_normal] = Vec3f::Constant(NAN);
+  const auto removed = compute_fpfh(without, options);
+  for (std::size_t i = 0; i < cloud.size() - 1; ++i) {
+    if (i == broken_normal || i == broken_point) continue;
+    for (int b = 0; b < kFpfhSize; ++b)
+      ASSERT_NEAR(with_gaps[i * kFpfhSize + b], removed[i * kFpfhSize + b], 1e-4f);
+  }
+  FeatureStats pfh_stats;
+  const auto pfh = compute_pfh(cloud, options, &pfh_stats);
+  EXPECT_EQ(pfh_stats.nan, 3u);
+  EXPECT_TRUE(std::isnan(pfh[broken_normal * kPfhSize]));
+}
+
+TEST(Features, RejectCloudsWithoutNormalsAndBadNeighbourhoods) {
+  PointCloud cloud = test::random_box(10, 1.0f, 1);
+  FeatureOptions options;
+  EXPECT_THROW(compute_fpfh(cloud, options), std::invalid_argument);
+  EXPECT_THROW(compute_pfh(cloud, options), std::invalid_argument);
+  cloud.normals.assign(cloud.size(), Vec3f(0, 0, 1));
+  options.neighborhood = Neighborhood::Knn(0);
+  EXPECT_THROW(compute_fpfh(cloud, options), std::invalid_argument);
+  PointCloud empty;
+  options.neighborhood = Neighborhood::Knn(5);
+  EXPECT_TRUE(compute_fpfh(empty, options).empty());
+}
+
+TEST(Features, IdenticalForAnyThreadCount) {
+  PointCloud cloud = sphere_with_normals(20000, 13);
+  std::vector<float> fpfh_reference, pfh_reference;
+  for (int threads : {1, 2, 3}) {
+    FeatureOptions options;
+    options.neighborhood = Neighborhood::Radius(0.012f);
+    options.threads = threads;
+    const auto fpfh = compute_fpfh(cloud, options);
+    options.neighborhood = Neighborhood::Knn(8);
+    const auto pfh = compute_pfh(cloud, options);
+    if (fpfh_reference.empty()) {
+      fpfh_reference = fpfh;
+      pfh_reference = pfh;
+      continue;
+    }
+    ASSERT_EQ(0, std::memcmp(fpfh.data(), fpfh_reference.data(), fpfh.size() * sizeof(float)));
+    ASSERT_EQ(0, std::memcmp(pfh.data(), pfh_reference.data(), pfh.size() * sizeof(float)));
+  }
+}
+
+}  // namespace
+}  // namespace primlabel

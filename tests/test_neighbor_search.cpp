@@ -1,0 +1,126 @@
+#include "primlabel/core/neighbor_search.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <limits>
+
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+// Brute force reference: (sq_dist, index) pairs sorted like the search promises.
+std::vector<std::pair<float, std::uint32_t>> brute_force(const std::vector<Vec3f>& pts,
+                                                         const Vec3f& q) {
+  std::vector<std::pair<float, std::uint32_t>> all;
+  for (std::uint32_t i = 0; i < pts.size(); ++i)
+    if (is_finite(pts[i])) all.emplace_back((pts[i] - q).squaredNorm(), i);
+  std::sort(all.begin(), all.end());
+  return all;
+}
+
+class NeighborSearchTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    cloud_ = test::random_box(3000, 1.0f, 42);
+    // Invalid points must never be returned.
+    for (int i = 0; i < 3000; i += 97) cloud_.xyz[i] = Vec3f::Constant(NAN);
+  }
+  PointCloud cloud_;
+};
+
+TEST_F(NeighborSearchTest, RadiusMatchesBruteForce) {
+  NeighborSearch search(cloud_.xyz);
+  NeighborList found;
+  const float r = 0.2f;
+  for (int qi = 1; qi < 3000; qi += 151) {
+    const Vec3f q = cloud_.xyz[qi];
+    if (!is_finite(q)) continue;
+    search.find(q, Neighborhood::Radius(r), found);
+    auto expected = brute_force(cloud_.xyz, q);
+    expected.erase(std::remove_if(expected.begin(), expected.end(),
+                                  [&](auto& e) { return !(e.first < r * r); }),
+                   expected.end());
+    ASSERT_EQ(found.size(), expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      EXPECT_EQ(found.indices[i], expected[i].second);
+      EXPECT_FLOAT_EQ(found.sq_dists[i], expected[i].first);
+    }
+    EXPECT_EQ(found.indices[0], static_cast<std::uint32_t>(qi));  // the query point itself
+  }
+}
+
+TEST_F(NeighborSearchTest, UnsortedRadiusHasTheSameSetAndIsRepeatable) {
+  NeighborSearch search(cloud_.xyz);
+  NeighborList sorted, unsorted, again;
+  const Vec3f q = cloud_.xyz[5];
+  search.find(q, Neighborhood::Radius(0.3f), sorted, true);
+  search.find(q, Neighborhood::Radius(0.3f), unsorted, false);
+  search.find(q, Neighborhood::Radius(0.3f), again, false);
+  EXPECT_EQ(unsorted.indices, again.indices);
+  auto a = sorted.indices, b = unsorted.indices;
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  EXPECT_EQ(a, b);
+}
+
+TEST_F(NeighborSearchTest, KnnMatchesBruteForce) {
+  NeighborSearch search(cloud_.xyz);
+  NeighborList found;
+  for (int qi = 2; qi < 3000; qi += 211) {
+    const Vec3f q = cloud_.xyz[qi] + Vec3f(0.001f, 0, 0);
+    search.find(q, Neighborhood::Knn(15), found);
+    const auto expected = brute_force(cloud_.xyz, q);
+    ASSERT_EQ(found.size(), 15u);
+    for (std::size_t i = 0; i < 15; ++i) EXPECT_EQ(found.indices[i], expected[i].second);
+  }
+}
+
+TEST_F(NeighborSearchTest, HybridIsNearestWithinRadius) {
+  NeighborSearch search(cloud_.xyz);
+  NeighborList found;
+  const Vec3f q = cloud_.xyz[10];
+  const auto expected = brute_force(cloud_.xyz, q);
+  // Radius holds more than the cap: exactly the cap, nearest first.
+  search.find(q, Neighborhood::Hybrid(0.5f, 20), found);
+  ASSERT_EQ(found.size(), 20u);
+  for (std::size_t i = 0; i < 20; ++i) EXPECT_EQ(found.indices[i], expected[i].second);
+  // Radius holds fewer than the cap: everything inside the radius.
+  const float r = 0.08f;
+  const auto inside = std::count_if(expected.begin(), expected.end(),
+                                    [&](auto& e) { return e.first < r * r; });
+  search.find(q, Neighborhood::Hybrid(r, 1000), found);
+  EXPECT_EQ(found.size(), static_cast<std::size_t>(inside));
+}
+
+TEST(NeighborSearch, TiesAreReportedLowestIndexFirst) {
+  std::vector<Vec3f> pts = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {5, 5, 5}};
+  NeighborSearch search(pts);
+  NeighborList found;
+  search.find(Vec3f::Zero(), Neighborhood::Knn(3), found);
+  EXPECT_EQ(found.indices, (std::vector<std::uint32_t>{0, 1, 2}));
+  search.find(Vec3f::Zero(), Neighborhood::Radius(1.5f), found);
+  EXPECT_EQ(found.indices, (std::vector<std::uint32_t>{0, 1, 2, 3, 4}));
+}
+
+TEST(NeighborSearch, NonFiniteQueryEmptyCloudAndBadParameters) {
+  std::vector<Vec3f> none;
+  NeighborSearch empty(none);
+  NeighborList found;
+  empty.find(Vec3f::Zero(), Neighborhood::Knn(3), found);
+  EXPECT_EQ(found.size(), 0u);
+
+  std::vector<Vec3f> pts = {{0, 0, 0}, {1, 0, 0}, {Vec3f::Constant(NAN)}};
+  NeighborSearch search(pts);
+  EXPECT_EQ(search.indexed_points(), 2u);
+  search.find(Vec3f::Constant(std::numeric_limits<float>::infinity()), Neighborhood::Knn(1), found);
+  EXPECT_EQ(found.size(), 0u);
+  search.find(Vec3f::Zero(), Neighborhood::Knn(10), found);  // more asked than indexed
+  EXPECT_EQ(found.size(), 2u);
+  EXPECT_THROW(search.find(Vec3f::Zero(), Neighborhood{-1.0f, 0, 0}, found), std::invalid_argument);
+  EXPECT_THROW(search.find(Vec3f::Zero(), Neighborhood{}, found), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace primlabel
