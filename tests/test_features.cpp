@@ -27,21 +27,23 @@ TEST(PairFeatures, ParallelNormalsOnAPlane) {
 TEST(PairFeatures, AlphaIsTheNormalsAngleInTheDarbouxFrame) {
   const float a = 0.3f;
   float f1, f2, f3, f4;
-  // u = n1 = z, v = (p2 - p1) x u = -y, w = u x v = x: n2 = (sin a, 0, cos a) makes angle a.
+  // n2 = (sin a, 0, cos a) is closer to the line than n1 = z, so p2 is the source: u = n2,
+  // delta = -x, v = delta x u / |..| = y, w = u x v = (-cos a, 0, sin a); alpha = atan2(w.n1, u.n1).
   ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0},
                                     {std::sin(a), 0, std::cos(a)}, f1, f2, f3, f4));
   EXPECT_NEAR(f1, a, 1e-6f);
   EXPECT_NEAR(f2, 0.0f, 1e-7f);
-  EXPECT_NEAR(f3, 0.0f, 1e-7f);
+  EXPECT_NEAR(f3, -std::sin(a), 1e-7f);
 }
 
 TEST(PairFeatures, SourceIsThePointWhoseNormalIsCloserToTheLine) {
   float f1, f2, f3, f4;
-  // n2 lies along the connecting line, n1 is perpendicular: the pair is swapped, theta = -1.
-  ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {1, 0, 0}, f1, f2, f3, f4));
-  EXPECT_FLOAT_EQ(f3, -1.0f);
+  // n2 is nearly along the connecting line, n1 perpendicular to it: swapped, theta = -n2.x.
+  const Vec3f n2 = Vec3f(1, 0, 0.5f).normalized();
+  ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, n2, f1, f2, f3, f4));
+  EXPECT_FLOAT_EQ(f3, -n2.x());
   float g1, g2, g3, g4;  // and the features do not depend on the order of the points
-  ASSERT_TRUE(compute_pair_features({1, 0, 0}, {1, 0, 0}, {0, 0, 0}, {0, 0, 1}, g1, g2, g3, g4));
+  ASSERT_TRUE(compute_pair_features({1, 0, 0}, n2, {0, 0, 0}, {0, 0, 1}, g1, g2, g3, g4));
   EXPECT_FLOAT_EQ(f1, g1);
   EXPECT_FLOAT_EQ(f2, g2);
   EXPECT_FLOAT_EQ(f3, g3);
@@ -177,9 +179,13 @@ TEST(Features, InvalidPointsAndNormalsAreNaNAndLeftOutOfNeighbourhoods) {
   options.neighborhood = Neighborhood::Radius(0.02f);
   FeatureStats stats;
   const auto with_gaps = compute_fpfh(cloud, options, &stats);
-  EXPECT_EQ(stats.nan, 3u);
-  for (std::size_t p : {broken_normal, broken_point, cloud.size() - 1})
-    EXPECT_TRUE(std::isnan(with_gaps[p * kFpfhSize])) << p;
+  EXPECT_EQ(stats.nan, 2u);
+  EXPECT_EQ(stats.isolated, 1u);
+  EXPECT_EQ(stats.computed, cloud.size() - 3);
+  for (std::size_t p : {broken_normal, broken_point})
+    for (int b = 0; b < kFpfhSize; ++b) EXPECT_TRUE(std::isnan(with_gaps[p * kFpfhSize + b])) << p;
+  const std::size_t lonely = cloud.size() - 1;  // like PCL: all zero
+  for (int b = 0; b < kFpfhSize; ++b) EXPECT_EQ(with_gaps[lonely * kFpfhSize + b], 0.0f);
 
   // A neighbour without a normal counts as absent: same descriptors as with it removed.
   PointCloud without = cloud;
@@ -192,8 +198,10 @@ TEST(Features, InvalidPointsAndNormalsAreNaNAndLeftOutOfNeighbourhoods) {
   }
   FeatureStats pfh_stats;
   const auto pfh = compute_pfh(cloud, options, &pfh_stats);
-  EXPECT_EQ(pfh_stats.nan, 3u);
+  EXPECT_EQ(pfh_stats.nan, 2u);
+  EXPECT_EQ(pfh_stats.isolated, 1u);
   EXPECT_TRUE(std::isnan(pfh[broken_normal * kPfhSize]));
+  for (int b = 0; b < kPfhSize; ++b) EXPECT_EQ(pfh[(cloud.size() - 1) * kPfhSize + b], 0.0f);
 }
 
 TEST(Features, RejectCloudsWithoutNormalsAndBadNeighbourhoods) {

@@ -25,20 +25,25 @@ inline std::string binary(const std::string& name) {
   return std::string(PRIMLABEL_BIN_DIR) + "/" + name;
 }
 
-// A CSV of floats, one row per point ("nan" allowed); lines starting with '#' or a letter other
-// than 'n' (a header) are skipped.
+// A CSV of floats, one row per point ("nan" allowed). Lines starting with '#' and header lines
+// (any cell that is not a number) are skipped.
 inline std::vector<std::vector<float>> read_csv(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot open fixture " + path);
   std::vector<std::vector<float>> rows;
   std::string line;
   while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#' || (std::isalpha(line[0]) && line[0] != 'n')) continue;
+    if (line.empty() || line[0] == '#') continue;
     std::vector<float> row;
     std::stringstream s(line);
     std::string cell;
-    while (std::getline(s, cell, ',')) row.push_back(std::strtof(cell.c_str(), nullptr));
-    rows.push_back(std::move(row));
+    bool numeric = true;
+    while (std::getline(s, cell, ',')) {
+      char* end = nullptr;
+      row.push_back(std::strtof(cell.c_str(), &end));
+      numeric = numeric && end != cell.c_str() && *end == '\0';
+    }
+    if (numeric) rows.push_back(std::move(row));
   }
   return rows;
 }

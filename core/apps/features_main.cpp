@@ -86,8 +86,10 @@ int run(const Arguments& args) {
 
   write_cloud(args.output, cloud);
   if (!args.quiet)
-    std::fprintf(stderr, "%s: %zu computed, %zu NaN, %.2f s (%.0f points/s); wrote %s\n",
-                 args.descriptor.c_str(), stats.computed, stats.nan, feature_seconds,
+    std::fprintf(stderr,
+                 "%s: %zu computed, %zu isolated (all zero), %zu invalid (NaN), %.2f s "
+                 "(%.0f points/s); wrote %s\n",
+                 args.descriptor.c_str(), stats.computed, stats.isolated, stats.nan, feature_seconds,
                  double(cloud.size()) / std::max(feature_seconds, 1e-9), args.output.c_str());
   return cli::kExitOk;
 }

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "feature_neighborhood.hpp"
-#include "pair_features_inline.hpp"
+#include "pair_bins_batch.hpp"
 #include "parallel.hpp"
 #include "primlabel/core/features.hpp"
 
@@ -16,21 +16,30 @@ namespace {
 
 constexpr int kSplit = kPfhBinsPerFeature;
 
-void compute_point_pfh(const PointCloud& cloud, const NeighborList& neighbors, float* pfh) {
+struct PfhScratch {
+  detail::PairTargets targets;
+  std::vector<std::uint8_t> alpha, phi, theta;
+};
+
+void compute_point_pfh(const PointCloud& cloud, const NeighborList& neighbors,
+                       PfhScratch& scratch, float* pfh) {
   const std::size_t k = neighbors.size();
-  const float increment = 100.0f / static_cast<float>(k * (k - 1) / 2);
-  for (std::size_t i = 0; i < k; ++i) {
+  scratch.targets.clear();
+  for (std::uint32_t q : neighbors.indices) scratch.targets.push(cloud.xyz[q], cloud.normals[q]);
+  scratch.alpha.resize(k), scratch.phi.resize(k), scratch.theta.resize(k);
+  std::vector<std::uint32_t> counts(kPfhSize, 0);
+  // Pairs (i, j < i) with point i first, in PCL's order.
+  for (std::size_t i = 1; i < k; ++i) {
     const std::uint32_t a = neighbors.indices[i];
-    for (std::size_t j = 0; j < i; ++j) {
-      const std::uint32_t b = neighbors.indices[j];
-      detail::PairFeatures f;
-      detail::pair_features(cloud.xyz[a], cloud.normals[a], cloud.xyz[b], cloud.normals[b], f);
-      const int bin = detail::angle_bin(f.alpha, kSplit) +
-                      kSplit * detail::cosine_bin(f.phi, kSplit) +
-                      kSplit * kSplit * detail::cosine_bin(f.theta, kSplit);
-      pfh[bin] += increment;
-    }
+    detail::pair_bins_batch(cloud.xyz[a], cloud.normals[a], scratch.targets, i, kSplit,
+                            scratch.alpha.data(), scratch.phi.data(), scratch.theta.data());
+    for (std::size_t j = 0; j < i; ++j)
+      ++counts[scratch.alpha[j] + kSplit * scratch.phi[j] + kSplit * kSplit * scratch.theta[j]];
   }
+  // Repeated float additions, not count * increment: the rounding then matches PCL's.
+  const float increment = 100.0f / static_cast<float>(k * (k - 1) / 2);
+  for (int b = 0; b < kPfhSize; ++b)
+    for (std::uint32_t c = 0; c < counts[b]; ++c) pfh[b] += increment;
 }
 
 }  // namespace
@@ -46,32 +55,33 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
   const std::size_t n = cloud.size();
   const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(n);
   std::vector<float> pfh(n * kPfhSize, 0.0f);
-  std::size_t computed = 0;
+  std::size_t computed = 0, isolated = 0;
   detail::ProgressCounter progress(options.progress, n);
-#pragma omp parallel num_threads(detail::resolve_threads(options.threads)) reduction(+ : computed)
+#pragma omp parallel num_threads(detail::resolve_threads(options.threads)) \
+    reduction(+ : computed, isolated)
   {
     NeighborList neighbors;
+    PfhScratch scratch;
 #pragma omp for schedule(dynamic, 64)
     for (std::ptrdiff_t p = 0; p < count; ++p) {
       float* out = &pfh[p * kPfhSize];
-      bool ok = false;
-      if (usable[p]) {
+      if (!usable[p]) {
+        std::fill(out, out + kPfhSize, std::numeric_limits<float>::quiet_NaN());
+      } else {
         // Pair order decides which point is "first" only in exact ties; sorted lists match PCL's.
         detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, true, neighbors);
         if (neighbors.size() >= 2) {
-          compute_point_pfh(cloud, neighbors, out);
-          ok = true;
+          compute_point_pfh(cloud, neighbors, scratch, out);
+          ++computed;
+        } else {
+          ++isolated;  // stays all zero
         }
       }
-      if (ok)
-        ++computed;
-      else
-        std::fill(out, out + kPfhSize, std::numeric_limits<float>::quiet_NaN());
       if ((p & 63) == 63) progress.add(64);
     }
   }
   progress.finish();
-  if (stats) *stats = FeatureStats{computed, n - computed};
+  if (stats) *stats = FeatureStats{computed, isolated, n - computed - isolated};
   return pfh;
 }
 

@@ -2,9 +2,11 @@
 // Point Feature Histograms (Rusu et al.): FPFH (33 bins) and PFH (125 bins), computed exactly as
 // PCL 1.13 computes them so descriptors are interchangeable with PCL's.
 //
-// Defined behaviour for bad input: a point with non-finite coordinates or normal, or with no
-// neighbour other than itself, gets an all-NaN descriptor. Neighbours with non-finite normals are
-// left out of every histogram (PCL would bin their NaN angles into bin 0).
+// Defined behaviour for bad input: a point with non-finite coordinates or normal gets an all-NaN
+// descriptor. A point with no usable neighbour but itself gets an all-zero descriptor, as in PCL
+// (every sub-histogram of a valid descriptor sums to 100, so it is easy to tell apart). Neighbours
+// with non-finite normals are left out of every histogram (PCL would bin their NaN angles into
+// bin 0).
 
 #include <cstddef>
 #include <vector>
@@ -29,12 +31,16 @@ struct FeatureOptions {
   Neighborhood neighborhood = Neighborhood::Knn(10);
   FpfhVariant fpfh_variant = FpfhVariant::kPcl;
   int threads = 0;  // 0 = OpenMP default
+  // FPFH keeps each point's neighbour list between its two passes up to this many bytes (4 per
+  // neighbour); points beyond it are searched twice. Results do not depend on it.
+  std::size_t neighbor_cache_bytes = std::size_t(1) << 30;
   ProgressFn progress;
 };
 
 struct FeatureStats {
-  std::size_t computed = 0;  // points with a finite descriptor
-  std::size_t nan = 0;       // points whose descriptor is NaN (see above)
+  std::size_t computed = 0;  // points with a histogram from at least one neighbour
+  std::size_t isolated = 0;  // valid points with no neighbour: all-zero descriptor
+  std::size_t nan = 0;       // invalid points or normals: NaN descriptor
 };
 
 // Row-major size() x 33. Requires cloud.normals.
