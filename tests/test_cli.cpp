@@ -54,7 +54,7 @@ TEST_F(FeaturesCli, WritesNormalsCurvatureAndFpfh) {
   const FloatField* fpfh = cloud.find_field("fpfh");
   ASSERT_NE(fpfh, nullptr);
   EXPECT_EQ(fpfh->count, kFpfhSize);
-  EXPECT_NE(r.output.find("fpfh: 397 computed"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("fpfh: 397 computed, 0 isolated"), std::string::npos) << r.output;
 }
 
 TEST_F(FeaturesCli, PfhToPlyWithInputNormals) {
