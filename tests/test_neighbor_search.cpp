@@ -51,6 +51,30 @@ TEST_F(NeighborSearchTest, RadiusMatchesBruteForce) {
   }
 }
 
+TEST(NeighborSearch, SparseAndDenseCloudsAgreeWithBruteForce) {
+  // A sparse cloud (cells far outnumber points) is answered by the k-d tree, a dense one by the
+  // radius grid; both must return exactly the brute-force set, in distance order.
+  for (const bool sparse : {true, false}) {
+    PointCloud cloud = test::random_box(2000, 1.0f, 17);
+    if (sparse)  // two dense blobs 100 apart: a grid over the bounding box would be mostly empty
+      for (int i = 0; i < 2000; ++i) cloud.xyz[i].x() += i % 2 ? 50.0f : -50.0f;
+    NeighborSearch search(cloud.xyz);
+    NeighborList found;
+    const float r = 0.15f;
+    for (int qi = 0; qi < 2000; qi += 97) {
+      const Vec3f q = cloud.xyz[qi];
+      search.find(q, Neighborhood::Radius(r), found);
+      auto expected = brute_force(cloud.xyz, q);
+      expected.erase(std::remove_if(expected.begin(), expected.end(),
+                                    [&](auto& e) { return !(e.first < r * r); }),
+                     expected.end());
+      ASSERT_EQ(found.size(), expected.size()) << (sparse ? "sparse" : "dense");
+      for (std::size_t i = 0; i < expected.size(); ++i)
+        EXPECT_EQ(found.indices[i], expected[i].second);
+    }
+  }
+}
+
 TEST_F(NeighborSearchTest, UnsortedRadiusHasTheSameSetAndIsRepeatable) {
   NeighborSearch search(cloud_.xyz);
   NeighborList sorted, unsorted, again;

@@ -74,10 +74,10 @@ struct SpfhScratch {
 
 void compute_spfh(const PointCloud& cloud, std::size_t p, const NeighborList& neighbors,
                   SpfhScratch& scratch, float* spfh) {
-  scratch.targets.clear();
+  scratch.targets.resize(neighbors.size());
+  std::size_t pairs = 0;
   for (std::uint32_t q : neighbors.indices)
-    if (q != p) scratch.targets.push(cloud.xyz[q], cloud.normals[q]);
-  const std::size_t pairs = scratch.targets.size();
+    if (q != p) scratch.targets.set(pairs++, cloud.xyz[q], cloud.normals[q]);
   scratch.alpha.resize(pairs), scratch.phi.resize(pairs), scratch.theta.resize(pairs);
   // A degenerate pair (coincident points) still counts, with zero features: PCL does the same.
   detail::pair_bins_batch(cloud.xyz[p], cloud.normals[p], scratch.targets, pairs, kBins,

@@ -5,7 +5,10 @@
 #include <nanoflann.hpp>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <limits>
+#include <mutex>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -83,10 +86,117 @@ void sort_by_distance(NeighborList& list) {
 
 }  // namespace
 
+// Fixed-radius queries on dense scans return hundreds of points; walking the k-d tree for them
+// costs more than scanning the few grid cells that can hold them. Cells are as wide as the
+// radius and stored x-fastest, so the <= 3 cells along x of each (y, z) row are one contiguous
+// run: at most 9 runs per query. Distances are computed in nanoflann's order, so a grid query
+// returns exactly the set the tree would.
+class RadiusGrid {
+ public:
+  // Returns nullptr when the cloud is too sparse for a grid of this cell size to pay off.
+  static std::unique_ptr<RadiusGrid> build(const std::vector<Vec3f>& points,
+                                           const std::vector<std::uint32_t>& to_cloud,
+                                           float radius) {
+    if (points.empty() || !(radius > 0.0f)) return nullptr;
+    Vec3f lo = points[0], hi = points[0];
+    for (const Vec3f& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    std::int64_t dims[3];
+    double cells = 1;
+    for (int d = 0; d < 3; ++d) {
+      dims[d] = static_cast<std::int64_t>(std::floor((hi[d] - lo[d]) / radius)) + 1;
+      cells *= double(dims[d]);
+    }
+    if (cells > 4.0 * double(points.size()) + 4096 || cells > double(1 << 28)) return nullptr;
+
+    auto grid = std::unique_ptr<RadiusGrid>(new RadiusGrid);
+    grid->origin_ = lo;
+    grid->inv_cell_ = 1.0f / radius;
+    for (int d = 0; d < 3; ++d) grid->dims_[d] = dims[d];
+    const std::size_t n = points.size();
+    std::vector<std::uint32_t> cell_of(n);
+    grid->starts_.assign(static_cast<std::size_t>(cells) + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      cell_of[i] = static_cast<std::uint32_t>(grid->cell_index(grid->cell_coords(points[i])));
+      ++grid->starts_[cell_of[i] + 1];
+    }
+    std::partial_sum(grid->starts_.begin(), grid->starts_.end(), grid->starts_.begin());
+    grid->x_.resize(n), grid->y_.resize(n), grid->z_.resize(n), grid->index_.resize(n);
+    std::vector<std::uint32_t> fill(grid->starts_.begin(), grid->starts_.end() - 1);
+    for (std::size_t i = 0; i < n; ++i) {  // stable: points keep their order within a cell
+      const std::uint32_t slot = fill[cell_of[i]]++;
+      grid->x_[slot] = points[i].x(), grid->y_[slot] = points[i].y(), grid->z_[slot] = points[i].z();
+      grid->index_[slot] = to_cloud[i];
+    }
+    return grid;
+  }
+
+  void find(const Vec3f& q, float sq_radius, float radius, NeighborList& out) const {
+    std::int64_t lo[3], hi[3];
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::max<std::int64_t>(0, cell_coord(q[d] - radius, d));
+      hi[d] = std::min<std::int64_t>(dims_[d] - 1, cell_coord(q[d] + radius, d));
+      if (lo[d] > hi[d]) return;
+    }
+    for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+      for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
+        const std::size_t first = starts_[cell_index({lo[0], y, z})];
+        const std::size_t last = starts_[cell_index({hi[0], y, z}) + 1];
+        std::size_t count = out.indices.size();
+        out.indices.resize(count + (last - first));
+        out.sq_dists.resize(count + (last - first));
+        for (std::size_t i = first; i < last; ++i) {
+          // nanoflann's L2_Simple_Adaptor: ((0 + dx^2) + dy^2) + dz^2.
+          const float dx = q.x() - x_[i], dy = q.y() - y_[i], dz = q.z() - z_[i];
+          const float sq = (dx * dx + dy * dy) + dz * dz;
+          out.indices[count] = index_[i];
+          out.sq_dists[count] = sq;
+          count += sq < sq_radius;  // branch-free: write always, keep if inside
+        }
+        out.indices.resize(count);
+        out.sq_dists.resize(count);
+      }
+  }
+
+  float radius() const { return 1.0f / inv_cell_; }
+
+ private:
+  RadiusGrid() = default;
+  std::int64_t cell_coord(float v, int d) const {
+    return static_cast<std::int64_t>(std::floor((v - origin_[d]) * inv_cell_));
+  }
+  std::array<std::int64_t, 3> cell_coords(const Vec3f& p) const {
+    return {std::min(cell_coord(p.x(), 0), dims_[0] - 1), std::min(cell_coord(p.y(), 1), dims_[1] - 1),
+            std::min(cell_coord(p.z(), 2), dims_[2] - 1)};
+  }
+  std::size_t cell_index(const std::array<std::int64_t, 3>& c) const {
+    return static_cast<std::size_t>((c[2] * dims_[1] + c[1]) * dims_[0] + c[0]);
+  }
+
+  Vec3f origin_;
+  float inv_cell_ = 1.0f;
+  std::int64_t dims_[3] = {1, 1, 1};
+  std::vector<std::size_t> starts_;  // per cell, into the arrays below; one extra at the end
+  std::vector<float> x_, y_, z_;
+  std::vector<std::uint32_t> index_;  // cloud index of each grid slot
+};
+
 struct NeighborSearch::Impl {
   CompactPoints compact;
   std::vector<std::uint32_t> to_cloud;  // compact index -> cloud index
   std::unique_ptr<KdTree> tree;
+
+  // Radius grids are built on first use for a radius and kept; a radius that does not suit a
+  // grid is remembered as such (nullptr) so the tree answers it.
+  std::mutex grids_mutex;
+  std::vector<std::pair<float, std::unique_ptr<RadiusGrid>>> grids;
+
+  const RadiusGrid* grid_for(float radius) {
+    std::lock_guard<std::mutex> lock(grids_mutex);
+    for (const auto& [r, grid] : grids)
+      if (r == radius) return grid.get();
+    grids.emplace_back(radius, RadiusGrid::build(compact.points, to_cloud, radius));
+    return grids.back().second.get();
+  }
 };
 
 NeighborSearch::NeighborSearch(const std::vector<Vec3f>& points) : impl_(std::make_unique<Impl>()) {
@@ -115,6 +225,11 @@ void NeighborSearch::find(const Vec3f& query, const Neighborhood& hood, Neighbor
 
   const bool knn_like = hood.k > 0 || hood.max_neighbors > 0;
   if (!knn_like) {
+    if (const RadiusGrid* grid = impl_->grid_for(hood.radius)) {
+      grid->find(query, hood.radius * hood.radius, hood.radius, out);
+      if (sorted) sort_by_distance(out);
+      return;
+    }
     RadiusCollector collector(hood.radius * hood.radius, impl_->to_cloud, out);
     impl_->tree->findNeighbors(collector, query.data(), nanoflann::SearchParams(32, 0.0f, false));
     if (sorted) sort_by_distance(out);

@@ -16,6 +16,12 @@ struct PairTargets {
   void clear() {
     x.clear(), y.clear(), z.clear(), nx.clear(), ny.clear(), nz.clear();
   }
+  void resize(std::size_t n) {
+    x.resize(n), y.resize(n), z.resize(n), nx.resize(n), ny.resize(n), nz.resize(n);
+  }
+  void set(std::size_t j, const Vec3f& p, const Vec3f& n) {
+    x[j] = p.x(), y[j] = p.y(), z[j] = p.z(), nx[j] = n.x(), ny[j] = n.y(), nz[j] = n.z();
+  }
   void push(const Vec3f& p, const Vec3f& n) {
     x.push_back(p.x()), y.push_back(p.y()), z.push_back(p.z());
     nx.push_back(n.x()), ny.push_back(n.y()), nz.push_back(n.z());
