@@ -1,7 +1,15 @@
 #pragma once
 // Reading and writing point clouds: PCD v0.7 (ascii, binary, binary_compressed) and PLY (ascii,
-// binary_little_endian). Errors are reported as IoError whose message names the file and says
-// what is wrong with it.
+// binary_little_endian; binary_big_endian is read too). Errors are reported as IoError whose
+// message starts with the file path and says what is wrong with it. Writes are atomic (a
+// temporary file in the same directory renamed over the target).
+//
+// Field mapping (PCD field / PLY vertex property -> PointCloud):
+//   x y z -> xyz (required); normal_x normal_y normal_z (PLY: nx ny nz) -> normals;
+//   curvature -> curvature; label -> labels (must be integers in 0..2^32-1);
+//   PCD rgb/rgba (4 bytes, bit pattern kept) or PLY red green blue [alpha] uchar -> rgba;
+//   anything else -> a FloatField (PCD keeps COUNT; PLY name_0..name_k runs form one field).
+//   PCD "_" padding fields are skipped. PLY clouds are read as one row (height 1).
 
 #include <stdexcept>
 #include <string>

@@ -1,0 +1,778 @@
+// PCD reading/writing: round trips of every encoding, PCL-written files, field layouts and types,
+// and malformed input (each must raise an IoError naming the file and the problem).
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "primlabel/core/cloud_io.hpp"
+#include "test_util.hpp"
+
+// Records the largest single allocation, so tests can prove that absurd header values are
+// rejected before anything of that size is allocated.
+namespace {
+std::atomic<std::size_t> g_largest_allocation{0};
+
+void* guarded_allocate(std::size_t size) {
+  std::size_t seen = g_largest_allocation.load(std::memory_order_relaxed);
+  while (size > seen && !g_largest_allocation.compare_exchange_weak(seen, size)) {
+  }
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+}  // namespace
+
+void* operator new(std::size_t size) { return guarded_allocate(size); }
+void* operator new[](std::size_t size) { return guarded_allocate(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace primlabel {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_TRUE(out.good()) << path;
+}
+
+template <typename T>
+void put(std::string& out, T value) {
+  out.append(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+// A valid LZF stream made only of literal runs (control byte n < 32 copies n + 1 bytes), so the
+// tests can build binary_compressed files without linking liblzf.
+std::string lzf_literals(const std::string& bytes) {
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 32) {
+    const std::size_t run = std::min<std::size_t>(32, bytes.size() - i);
+    out += static_cast<char>(run - 1);
+    out += bytes.substr(i, run);
+  }
+  return out;
+}
+
+std::string compressed_payload(const std::string& planes) {
+  std::string out;
+  const std::string lzf = lzf_literals(planes);
+  put<std::uint32_t>(out, static_cast<std::uint32_t>(lzf.size()));
+  put<std::uint32_t>(out, static_cast<std::uint32_t>(planes.size()));
+  return out + lzf;
+}
+
+bool same_float(float a, float b) {
+  return (std::isnan(a) && std::isnan(b)) ||
+         std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b);
+}
+
+void expect_same_floats(const float* a, const float* b, std::size_t n, const std::string& what) {
+  for (std::size_t i = 0; i < n; ++i)
+    ASSERT_TRUE(same_float(a[i], b[i])) << what << "[" << i << "]: " << a[i] << " vs " << b[i];
+}
+
+// An organised 4x3 cloud with invalid (NaN) pixels and awkward float values in every attribute.
+PointCloud awkward_cloud() {
+  const float specials[] = {0.1f,          -0.0f, 1e-40f /* subnormal */,
+                            3.4028235e38f, -kInf, 1.17549435e-38f,
+                            123456.789f,   1e-7f, 3.14159265f};
+  PointCloud cloud;
+  cloud.width = 4;
+  cloud.height = 3;
+  for (int i = 0; i < 12; ++i) {
+    const float s = specials[i % 9];
+    const bool invalid = i == 1 || i == 6 || i == 11;
+    cloud.xyz.push_back(invalid ? Vec3f(kNaN, kNaN, kNaN) : Vec3f(s, -s * 0.5f, 1.0f + i));
+    cloud.normals.push_back(invalid ? Vec3f(kNaN, kNaN, kNaN) : Vec3f(0.6f, -0.8f, s));
+    cloud.curvature.push_back(invalid ? kNaN : s);
+    cloud.labels.push_back(i == 0 ? 0u : i == 5 ? 0xffffffffu : static_cast<std::uint32_t>(i * 7));
+    cloud.rgba.push_back(i == 3 ? 0xffffffffu : 0xff102030u + static_cast<std::uint32_t>(i));
+  }
+  FloatField& fpfh = cloud.set_field("fpfh", 33);
+  for (std::size_t v = 0; v < fpfh.values.size(); ++v)
+    fpfh.values[v] = v % 17 == 0 ? kNaN : static_cast<float>(v) / 7.0f;
+  FloatField& intensity = cloud.set_field("intensity", 1);
+  for (std::size_t v = 0; v < intensity.values.size(); ++v) intensity.values[v] = specials[v % 9];
+  cloud.viewpoint.origin = Vec3f(0.25f, -1.5f, 3.0f);
+  cloud.viewpoint.orientation = Eigen::Quaternionf(0.5f, 0.5f, -0.5f, 0.5f);
+  return cloud;
+}
+
+void expect_same_attributes(const PointCloud& a, const PointCloud& b) {
+  ASSERT_EQ(a.size(), b.size());
+  expect_same_floats(a.xyz.data()->data(), b.xyz.data()->data(), 3 * a.size(), "xyz");
+  ASSERT_EQ(a.normals.size(), b.normals.size());
+  if (a.has_normals())
+    expect_same_floats(a.normals.data()->data(), b.normals.data()->data(), 3 * a.size(), "normal");
+  ASSERT_EQ(a.curvature.size(), b.curvature.size());
+  expect_same_floats(a.curvature.data(), b.curvature.data(), a.curvature.size(), "curvature");
+  EXPECT_EQ(a.labels, b.labels);
+  EXPECT_EQ(a.rgba, b.rgba);
+  ASSERT_EQ(a.fields.size(), b.fields.size());
+  for (std::size_t f = 0; f < a.fields.size(); ++f) {
+    EXPECT_EQ(a.fields[f].name, b.fields[f].name);
+    EXPECT_EQ(a.fields[f].count, b.fields[f].count);
+    ASSERT_EQ(a.fields[f].values.size(), b.fields[f].values.size());
+    expect_same_floats(a.fields[f].values.data(), b.fields[f].values.data(),
+                       a.fields[f].values.size(), a.fields[f].name);
+  }
+}
+
+void expect_same_cloud(const PointCloud& a, const PointCloud& b) {
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  EXPECT_TRUE(a.viewpoint.origin == b.viewpoint.origin);
+  EXPECT_TRUE(a.viewpoint.orientation.coeffs() == b.viewpoint.orientation.coeffs());
+  expect_same_attributes(a, b);
+}
+
+// Asserts that reading `path` throws an IoError that starts with the path and mentions `needle`.
+void expect_read_error(const std::string& path, const std::string& needle) {
+  try {
+    read_pcd(path);
+    ADD_FAILURE() << "no IoError for " << path << " (expected '" << needle << "')";
+  } catch (const IoError& error) {
+    const std::string message = error.what();
+    EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
+    EXPECT_NE(message.find(needle), std::string::npos)
+        << "message: " << message << "\nexpected to contain: " << needle;
+  }
+}
+
+std::string header(const std::string& fields, const std::string& sizes, const std::string& types,
+                   const std::string& counts, std::uint64_t points, const std::string& data) {
+  return "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS " + fields + "\nSIZE " +
+         sizes + "\nTYPE " + types + "\nCOUNT " + counts + "\nWIDTH " + std::to_string(points) +
+         "\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(points) + "\nDATA " +
+         data + "\n";
+}
+
+std::string xyz_header(std::uint64_t points, const std::string& data) {
+  return header("x y z", "4 4 4", "F F F", "1 1 1", points, data);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Round trips
+
+class PcdRoundTrip : public ::testing::TestWithParam<PcdEncoding> {};
+
+TEST_P(PcdRoundTrip, EveryAttributeSurvivesBitForBit) {
+  test::TempDir dir;
+  const std::string path = dir.file("cloud.pcd");
+  const PointCloud original = awkward_cloud();
+  write_pcd(path, original, GetParam());
+  const PointCloud loaded = read_pcd(path);
+  expect_same_cloud(original, loaded);
+  EXPECT_EQ(loaded.fields[0].name, "fpfh");
+  EXPECT_EQ(loaded.fields[0].count, 33);
+}
+
+TEST_P(PcdRoundTrip, EmptyCloud) {
+  test::TempDir dir;
+  const std::string path = dir.file("empty.pcd");
+  PointCloud empty;
+  empty.set_field("fpfh", 33);
+  write_pcd(path, empty, GetParam());
+  const PointCloud loaded = read_pcd(path);
+  EXPECT_EQ(loaded.size(), 0u);
+  ASSERT_EQ(loaded.fields.size(), 1u);
+  EXPECT_EQ(loaded.fields[0].count, 33);
+}
+
+TEST_P(PcdRoundTrip, XyzOnlyCloudHasNoOptionalAttributes) {
+  test::TempDir dir;
+  const std::string path = dir.file("xyz.pcd");
+  PointCloud cloud;
+  cloud.resize_unorganized(5);
+  for (int i = 0; i < 5; ++i) cloud.xyz[i] = Vec3f(i, 2.0f * i, -i);
+  write_pcd(path, cloud, GetParam());
+  const PointCloud loaded = read_pcd(path);
+  expect_same_cloud(cloud, loaded);
+  EXPECT_FALSE(loaded.has_normals() || loaded.has_curvature() || loaded.has_labels() ||
+               loaded.has_rgba());
+  EXPECT_TRUE(loaded.fields.empty());
+}
+
+std::string encoding_name(const ::testing::TestParamInfo<PcdEncoding>& info) {
+  switch (info.param) {
+    case PcdEncoding::kAscii:
+      return "Ascii";
+    case PcdEncoding::kBinary:
+      return "Binary";
+    default:
+      return "BinaryCompressed";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdRoundTrip,
+                         ::testing::Values(PcdEncoding::kAscii, PcdEncoding::kBinary,
+                                           PcdEncoding::kBinaryCompressed),
+                         encoding_name);
+
+TEST(PcdWrite, HeaderListsFieldsLikePcl) {
+  test::TempDir dir;
+  const std::string path = dir.file("cloud.pcd");
+  write_pcd(path, awkward_cloud(), PcdEncoding::kBinaryCompressed);
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  std::vector<std::string> lines;
+  while (std::getline(in, line) && lines.size() < 11) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 11u);
+  EXPECT_EQ(lines[1], "VERSION 0.7");
+  EXPECT_EQ(lines[2],
+            "FIELDS x y z normal_x normal_y normal_z curvature label rgba fpfh intensity");
+  EXPECT_EQ(lines[3], "SIZE 4 4 4 4 4 4 4 4 4 4 4");
+  EXPECT_EQ(lines[4], "TYPE F F F F F F F U U F F");
+  EXPECT_EQ(lines[5], "COUNT 1 1 1 1 1 1 1 1 1 33 1");
+  EXPECT_EQ(lines[6], "WIDTH 4");
+  EXPECT_EQ(lines[7], "HEIGHT 3");
+  EXPECT_EQ(lines[8], "VIEWPOINT 0.25 -1.5 3 0.5 0.5 -0.5 0.5");
+  EXPECT_EQ(lines[9], "POINTS 12");
+  EXPECT_EQ(lines[10], "DATA binary_compressed");
+}
+
+TEST(PcdWrite, AsciiWritesNanAsNan) {
+  test::TempDir dir;
+  const std::string path = dir.file("nan.pcd");
+  PointCloud cloud;
+  cloud.resize_unorganized(1);
+  cloud.xyz[0] = Vec3f(kNaN, -kNaN, 0.1f);
+  write_pcd(path, cloud, PcdEncoding::kAscii);
+  std::ifstream in(path);
+  std::string line, last;
+  while (std::getline(in, line)) last = line;
+  EXPECT_EQ(last, "nan nan 0.1");
+}
+
+TEST(PcdWrite, ReplacesAnExistingFileAndLeavesNoTemporaryFiles) {
+  test::TempDir dir;
+  const std::string path = dir.file("cloud.pcd");
+  write_bytes(path, "old contents");
+  write_pcd(path, awkward_cloud());
+  EXPECT_EQ(read_pcd(path).size(), 12u);
+  int files = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::filesystem::path(path).parent_path())) {
+    (void)entry;
+    ++files;
+  }
+  EXPECT_EQ(files, 1);
+}
+
+TEST(PcdWrite, InvalidCloudIsRejectedAndLeavesTheOldFileAlone) {
+  test::TempDir dir;
+  const std::string path = dir.file("cloud.pcd");
+  write_bytes(path, "old contents");
+  PointCloud cloud = awkward_cloud();
+  cloud.normals.pop_back();
+  try {
+    write_pcd(path, cloud);
+    ADD_FAILURE() << "no IoError";
+  } catch (const IoError& error) {
+    EXPECT_NE(std::string(error.what()).find("normals has 11 entries for 12 points"),
+              std::string::npos)
+        << error.what();
+  }
+  std::ifstream in(path);
+  std::string contents;
+  std::getline(in, contents);
+  EXPECT_EQ(contents, "old contents");
+}
+
+TEST(PcdWrite, RejectsBadFieldsAndShapes) {
+  test::TempDir dir;
+  const std::string path = dir.file("bad.pcd");
+  {
+    PointCloud cloud = awkward_cloud();
+    cloud.fields[0].values.pop_back();
+    EXPECT_THROW(write_pcd(path, cloud), IoError);
+  }
+  {
+    PointCloud cloud = awkward_cloud();
+    cloud.set_field("x", 1);  // would duplicate the coordinate field
+    EXPECT_THROW(write_pcd(path, cloud), IoError);
+  }
+  {
+    PointCloud cloud = awkward_cloud();
+    cloud.set_field("has space", 1);
+    EXPECT_THROW(write_pcd(path, cloud), IoError);
+  }
+  {
+    PointCloud cloud = awkward_cloud();
+    cloud.width = 5;  // 5 x 3 != 12
+    EXPECT_THROW(write_pcd(path, cloud), IoError);
+  }
+  EXPECT_FALSE(std::filesystem::exists(path));
+  EXPECT_THROW(write_pcd(dir.file("missing_dir/cloud.pcd"), awkward_cloud()), IoError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Files written by PCL
+
+TEST(PcdSharedData, BunnyAsciiWithNormalsAndCurvature) {
+  const std::string path = test::shared_data("pcl/bun0.pcd");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
+  const PointCloud cloud = read_pcd(path);
+  ASSERT_EQ(cloud.size(), 397u);
+  EXPECT_EQ(cloud.width, 397u);
+  EXPECT_EQ(cloud.height, 1u);
+  ASSERT_TRUE(cloud.has_normals());
+  ASSERT_TRUE(cloud.has_curvature());
+  EXPECT_FALSE(cloud.has_labels() || cloud.has_rgba());
+  EXPECT_TRUE(cloud.fields.empty());
+  EXPECT_EQ(cloud.xyz[0], Vec3f(0.0054215998f, 0.11349f, 0.040748999f));
+  EXPECT_EQ(cloud.normals[0], Vec3f(-0.16884723f, -0.45159745f, -0.87609947f));
+  EXPECT_EQ(cloud.curvature[0], 0.0030943851f);
+  EXPECT_EQ(count_finite(cloud), 397u);
+}
+
+TEST(PcdSharedData, TableSceneBinaryCompressedOrganised) {
+  const std::string path = test::shared_data("pcl/table_scene_mug_stereo_textured.pcd");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
+  const PointCloud cloud = read_pcd(path);
+  EXPECT_EQ(cloud.width, 640u);
+  EXPECT_EQ(cloud.height, 480u);
+  ASSERT_EQ(cloud.size(), 640u * 480u);
+  EXPECT_TRUE(cloud.organized());
+  ASSERT_TRUE(cloud.has_rgba());
+  EXPECT_FALSE(cloud.has_normals() || cloud.has_labels());
+  EXPECT_TRUE(cloud.fields.empty());
+  EXPECT_EQ(cloud.viewpoint.origin, Vec3f::Zero());
+  // VIEWPOINT 0 0 0 0 1 0 0: qw = 0, qx = 1.
+  EXPECT_EQ(cloud.viewpoint.orientation.w(), 0.0f);
+  EXPECT_EQ(cloud.viewpoint.orientation.x(), 1.0f);
+  const std::size_t finite = count_finite(cloud);
+  EXPECT_GT(finite, 100000u);
+  EXPECT_LT(finite, cloud.size());  // a stereo scan has holes, kept as NaN pixels
+  // Valid points are in front of a camera a metre or so away.
+  for (const Vec3f& p : cloud.xyz) {
+    if (!is_finite(p)) continue;
+    ASSERT_TRUE(p.z() > 0.1f && p.z() < 10.0f) << p.transpose();
+  }
+}
+
+TEST(PcdSharedData, MosdLabelsZeroExactlyOnInvalidPoints) {
+  const std::string path = test::shared_data("mosd/learn0.pcd");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
+  const PointCloud cloud = read_pcd(path);
+  EXPECT_EQ(cloud.width, 640u);
+  EXPECT_EQ(cloud.height, 480u);
+  ASSERT_EQ(cloud.size(), 307200u);
+  ASSERT_TRUE(cloud.has_labels());
+  ASSERT_TRUE(cloud.has_rgba());
+  EXPECT_TRUE(cloud.fields.empty());
+  std::size_t invalid = 0, table = 0, objects = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const std::uint32_t label = cloud.labels[i];
+    ASSERT_EQ(label == 0, !is_finite(cloud.xyz[i])) << "point " << i << " label " << label;
+    invalid += label == 0;
+    table += label >= 1 && label <= 9;
+    objects += label >= 20;
+    ASSERT_TRUE(label == 0 || (label >= 1 && label <= 9) || label >= 20) << label;
+  }
+  const std::size_t finite = count_finite(cloud);
+  EXPECT_EQ(finite + invalid, cloud.size());
+  EXPECT_GT(finite, 170000u);
+  EXPECT_LT(finite, 195000u);
+  EXPECT_GT(table, 0u);
+  EXPECT_GT(objects, 0u);
+}
+
+TEST(PcdSharedData, PclFileSurvivesOurRoundTrip) {
+  const std::string path = test::shared_data("mosd/learn0.pcd");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
+  const PointCloud cloud = read_pcd(path);
+  test::TempDir dir;
+  for (PcdEncoding encoding :
+       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+    const std::string copy = dir.file("copy.pcd");
+    write_pcd(copy, cloud, encoding);
+    expect_same_cloud(cloud, read_pcd(copy));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Layouts and types
+
+// Fields in an unusual order, with padding, in all three encodings.
+class PcdFieldOrder : public ::testing::TestWithParam<PcdEncoding> {};
+
+TEST_P(PcdFieldOrder, AnyOrderWithPaddingMapsByName) {
+  test::TempDir dir;
+  const std::string path = dir.file("order.pcd");
+  const std::uint32_t rgb[2] = {0xff0a0b0cu, 0x00fffefdu};
+  const float z[2] = {3.5f, kNaN};
+  const std::uint16_t label[2] = {7, 65535};
+  const float y[2] = {-2.25f, 1e-3f};
+  const double x[2] = {0.1, -1e300};
+  // Padding ("_") both between fields and at the end.
+  const std::string fields = "rgb z _ label y x _";
+  const std::string sizes = "4 4 4 2 4 8 1";
+  const std::string types = "U F U U F F U";
+  const std::string counts = "1 1 2 1 1 1 3";
+  std::string file;
+  if (GetParam() == PcdEncoding::kAscii) {
+    file = header(fields, sizes, types, counts, 2, "ascii");
+    file += "4278848268 3.5 99 98 7 -2.25 0.1 1 2 3\n";
+    file += "16776957 nan 0 0 65535 0.001 -1e300 4 5 6\n";
+  } else if (GetParam() == PcdEncoding::kBinary) {
+    file = header(fields, sizes, types, counts, 2, "binary");
+    for (int i = 0; i < 2; ++i) {
+      put(file, rgb[i]);
+      put(file, z[i]);
+      put<std::uint64_t>(file, 0xdeadbeefdeadbeefull);  // padding
+      put(file, label[i]);
+      put(file, y[i]);
+      put(file, x[i]);
+      file += "pad";
+    }
+  } else {
+    // binary_compressed planes leave out "_" fields, as PCL writes them.
+    file = header(fields, sizes, types, counts, 2, "binary_compressed");
+    std::string planes;
+    for (int i = 0; i < 2; ++i) put(planes, rgb[i]);
+    for (int i = 0; i < 2; ++i) put(planes, z[i]);
+    for (int i = 0; i < 2; ++i) put(planes, label[i]);
+    for (int i = 0; i < 2; ++i) put(planes, y[i]);
+    for (int i = 0; i < 2; ++i) put(planes, x[i]);
+    file += compressed_payload(planes);
+  }
+  write_bytes(path, file);
+
+  const PointCloud cloud = read_pcd(path);
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_EQ(cloud.xyz[0], Vec3f(0.1f, -2.25f, 3.5f));
+  EXPECT_EQ(cloud.xyz[1].x(), -kInf);  // a double beyond float range saturates
+  EXPECT_EQ(cloud.xyz[1].y(), 1e-3f);
+  EXPECT_TRUE(std::isnan(cloud.xyz[1].z()));
+  EXPECT_EQ(cloud.labels, (std::vector<std::uint32_t>{7, 65535}));
+  EXPECT_EQ(cloud.rgba, (std::vector<std::uint32_t>{rgb[0], rgb[1]}));
+  EXPECT_TRUE(cloud.fields.empty()) << "padding must not become a field";
+}
+
+INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdFieldOrder,
+                         ::testing::Values(PcdEncoding::kAscii, PcdEncoding::kBinary,
+                                           PcdEncoding::kBinaryCompressed),
+                         encoding_name);
+
+TEST(PcdRead, IntegerTypesOfEverySizeAndMultiValueFields) {
+  test::TempDir dir;
+  const std::string path = dir.file("types.pcd");
+  const std::string fields = "x y z a b c d e f hist label";
+  const std::string sizes = "4 4 4 1 1 2 2 8 8 4 1";
+  const std::string types = "F F F I U I U I U F I";
+  const std::string counts = "1 1 1 1 1 1 1 1 1 3 1";
+  std::string ascii = header(fields, sizes, types, counts, 1, "ascii");
+  ascii += "1 2 3 -128 255 -32768 65535 -1099511627776 1099511627776 0.5 nan -inf 100\n";
+  write_bytes(path, ascii);
+  const PointCloud from_ascii = read_pcd(path);
+
+  std::string binary = header(fields, sizes, types, counts, 1, "binary");
+  for (float v : {1.0f, 2.0f, 3.0f}) put(binary, v);
+  put<std::int8_t>(binary, -128);
+  put<std::uint8_t>(binary, 255);
+  put<std::int16_t>(binary, -32768);
+  put<std::uint16_t>(binary, 65535);
+  put<std::int64_t>(binary, -1099511627776);
+  put<std::uint64_t>(binary, 1099511627776);
+  for (float v : {0.5f, kNaN, -kInf}) put(binary, v);
+  put<std::int8_t>(binary, 100);
+  write_bytes(path, binary);
+  const PointCloud from_binary = read_pcd(path);
+
+  for (const PointCloud* cloud : {&from_ascii, &from_binary}) {
+    ASSERT_EQ(cloud->size(), 1u);
+    EXPECT_EQ(cloud->xyz[0], Vec3f(1, 2, 3));
+    EXPECT_EQ(cloud->labels, std::vector<std::uint32_t>{100});
+    ASSERT_EQ(cloud->fields.size(), 7u);
+    const float expected[] = {-128.0f,           255.0f,          -32768.0f, 65535.0f,
+                              -1099511627776.0f, 1099511627776.0f};
+    for (int f = 0; f < 6; ++f) {
+      EXPECT_EQ(cloud->fields[f].count, 1);
+      EXPECT_EQ(cloud->fields[f].values[0], expected[f]) << cloud->fields[f].name;
+    }
+    const FloatField* hist = cloud->find_field("hist");
+    ASSERT_NE(hist, nullptr);
+    EXPECT_EQ(hist->count, 3);
+    EXPECT_EQ(hist->values[0], 0.5f);
+    EXPECT_TRUE(std::isnan(hist->values[1]));
+    EXPECT_EQ(hist->values[2], -kInf);
+  }
+}
+
+TEST(PcdRead, FloatLabelsAndRgbTypedF) {
+  test::TempDir dir;
+  const std::string path = dir.file("flabel.pcd");
+  std::string file = header("x y z label rgb", "4 4 4 4 4", "F F F F F", "1 1 1 1 1", 1, "binary");
+  for (float v : {1.0f, 2.0f, 3.0f, 42.0f}) put(file, v);
+  put<std::uint32_t>(file, 0x7fc0ffeeu);  // a packed colour whose float reading is a NaN
+  write_bytes(path, file);
+  const PointCloud cloud = read_pcd(path);
+  EXPECT_EQ(cloud.labels, std::vector<std::uint32_t>{42});
+  EXPECT_EQ(cloud.rgba, std::vector<std::uint32_t>{0x7fc0ffeeu});
+}
+
+TEST(PcdRead, OldHeaderWithoutCountOrViewpoint) {
+  test::TempDir dir;
+  const std::string path = dir.file("old.pcd");
+  write_bytes(path,
+              "# .PCD v.6\nVERSION .6\r\nFIELDS x y z\r\nSIZE 4 4 4\r\nTYPE F F F\r\n"
+              "WIDTH 2\r\nHEIGHT 1\r\nPOINTS 2\r\nDATA ascii\r\n1 2 3\r\n\r\n4 5 6\r\n");
+  const PointCloud cloud = read_pcd(path);
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_EQ(cloud.xyz[1], Vec3f(4, 5, 6));
+  EXPECT_TRUE(cloud.viewpoint.orientation.coeffs() == Eigen::Quaternionf::Identity().coeffs());
+}
+
+TEST(PcdRead, PartialNormalsBecomeOrdinaryFields) {
+  test::TempDir dir;
+  const std::string path = dir.file("partial.pcd");
+  write_bytes(
+      path, header("x y z normal_x", "4 4 4 4", "F F F F", "1 1 1 1", 1, "ascii") + "1 2 3 0.5\n");
+  const PointCloud cloud = read_pcd(path);
+  EXPECT_FALSE(cloud.has_normals());
+  ASSERT_NE(cloud.find_field("normal_x"), nullptr);
+  EXPECT_EQ(cloud.find_field("normal_x")->values[0], 0.5f);
+}
+
+TEST(CloudIo, DispatchesOnExtensionCaseInsensitively) {
+  test::TempDir dir;
+  const PointCloud cloud = awkward_cloud();
+  write_cloud(dir.file("a.PCD"), cloud);
+  expect_same_cloud(cloud, read_cloud(dir.file("a.PCD")));
+  write_cloud(dir.file("b.Ply"), cloud);
+  const PointCloud from_ply = read_cloud(dir.file("b.Ply"));
+  EXPECT_EQ(from_ply.height, 1u);
+  expect_same_attributes(cloud, from_ply);
+  EXPECT_THROW(write_cloud(dir.file("c.xyz"), cloud), IoError);
+  try {
+    read_cloud(dir.file("noext"));
+    ADD_FAILURE();
+  } catch (const IoError& error) {
+    EXPECT_NE(std::string(error.what()).find("unknown point cloud format"), std::string::npos);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Malformed input
+
+struct MalformedPcd {
+  const char* name;
+  std::string contents;
+  const char* expected;
+};
+
+// Names the case in gtest output instead of dumping its bytes.
+void PrintTo(const MalformedPcd& c, std::ostream* out) { *out << c.name; }
+
+std::string binary_points(int points) {
+  std::string out;
+  for (int i = 0; i < 3 * points; ++i) put(out, static_cast<float>(i));
+  return out;
+}
+
+std::vector<MalformedPcd> malformed_cases() {
+  const std::string v7 = "# .PCD v0.7\nVERSION 0.7\n";
+  std::string three_planes;
+  for (int i = 0; i < 9; ++i) put(three_planes, static_cast<float>(i));
+  std::string bad_lzf;  // a back-reference before the start of the output
+  put<std::uint32_t>(bad_lzf, 3);
+  put<std::uint32_t>(bad_lzf, 36);
+  bad_lzf += std::string("\xe0\x10\x40", 3);
+  std::string overlong_lzf;  // valid literals, but more of them than declared
+  const std::string literals = lzf_literals(three_planes + three_planes);
+  put<std::uint32_t>(overlong_lzf, static_cast<std::uint32_t>(literals.size()));
+  put<std::uint32_t>(overlong_lzf, 36);
+  overlong_lzf += literals;
+  std::string big_compressed_size;
+  put<std::uint32_t>(big_compressed_size, 1000);
+  put<std::uint32_t>(big_compressed_size, 36);
+  big_compressed_size += "abc";
+  std::string wrong_uncompressed;
+  put<std::uint32_t>(wrong_uncompressed, 10);
+  put<std::uint32_t>(wrong_uncompressed, 40);
+  wrong_uncompressed += std::string(10, '\0');
+
+  return {
+      {"SizeEntries",
+       v7 + "FIELDS x y z w rgb\nSIZE 4 4 4 4\nTYPE F F F F F\nCOUNT 1 1 1 1 1\n"
+            "WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3 4 5\n",
+       "header line 4: SIZE has 4 entries but FIELDS has 5"},
+      {"TypeEntries", v7 + "FIELDS x y z\nSIZE 4 4 4\nTYPE F F\nWIDTH 1\nPOINTS 1\nDATA ascii\n",
+       "header line 5: TYPE has 2 entries but FIELDS has 3"},
+      {"CountEntries", v7 + "FIELDS x y z\nCOUNT 1\nPOINTS 1\nDATA ascii\n",
+       "COUNT has 1 entries but FIELDS has 3"},
+      {"FloatOfSizeTwo", header("x y z", "4 2 4", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n",
+       "field 'y' has TYPE F with SIZE 2 (F needs SIZE 4 or 8)"},
+      {"SizeZero", header("x y z", "4 4 0", "F F F", "1 1 1", 1, "ascii"),
+       "SIZE of field 'z' is '0', expected 1, 2, 4 or 8"},
+      {"SizeNegative", header("x y z", "4 4 -4", "F F F", "1 1 1", 1, "ascii"),
+       "SIZE of field 'z' is '-4'"},
+      {"UnknownType", header("x y z", "4 4 4", "F D F", "1 1 1", 1, "ascii"),
+       "TYPE of field 'y' is 'D', expected F, I or U"},
+      {"CountZero", header("x y z", "4 4 4", "F F F", "1 0 1", 1, "ascii"),
+       "COUNT of field 'y' is '0', expected a positive integer"},
+      {"CountOnCoordinate", header("x y z", "4 4 4", "F F F", "1 1 2", 1, "ascii"),
+       "field 'z' must have COUNT 1, got 2"},
+      {"RgbOfSizeTwo", header("x y z rgb", "4 4 4 2", "F F F U", "1 1 1 1", 1, "ascii"),
+       "field 'rgb' is a packed colour and needs SIZE 4"},
+      {"DuplicateField", header("x y z y", "4 4 4 4", "F F F F", "1 1 1 1", 1, "ascii"),
+       "field 'y' is listed twice"},
+      {"MissingY", header("x z", "4 4", "F F", "1 1", 1, "ascii") + "1 2\n",
+       "missing field 'y' (x, y and z are required)"},
+      {"MissingFields", v7 + "WIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n", "missing FIELDS line"},
+      {"UnknownDataKind", xyz_header(1, "binary_lzma") + "...", "unknown DATA kind 'binary_lzma'"},
+      {"MissingDataLine",
+       v7 + "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\n"
+            "POINTS 1\n",
+       "missing DATA line"},
+      {"DataWithoutDataLine",
+       v7 + "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\n"
+            "POINTS 1\n1 2 3\n",
+       "header line 9: data value '1' before any DATA line (missing DATA line?)"},
+      {"UnknownKeyword", v7 + "FIELDS x y z\nCOLOUR red\nDATA ascii\n",
+       "header line 4: unknown header keyword 'COLOUR'"},
+      {"UnsupportedVersion", "VERSION 2.0\nFIELDS x y z\nPOINTS 0\nDATA ascii\n",
+       "header line 1: unsupported VERSION '2.0'"},
+      {"DuplicateWidth", v7 + "FIELDS x y z\nWIDTH 1\nWIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n",
+       "header line 5: duplicate WIDTH line (first on line 4)"},
+      {"WidthTimesHeight", v7 + "FIELDS x y z\nWIDTH 640\nHEIGHT 480\nPOINTS 1000\nDATA ascii\n",
+       "WIDTH 640 x HEIGHT 480 = 307200 does not match POINTS 1000"},
+      {"HeightZero", v7 + "FIELDS x y z\nWIDTH 3\nHEIGHT 0\nPOINTS 3\nDATA ascii\n",
+       "WIDTH 3 x HEIGHT 0 = 0 does not match POINTS 3"},
+      {"NegativeWidth", v7 + "FIELDS x y z\nWIDTH -3\nPOINTS 3\nDATA ascii\n",
+       "header line 4: WIDTH must be a non-negative integer, got '-3'"},
+      {"NonNumericPoints", v7 + "FIELDS x y z\nPOINTS many\nDATA ascii\n",
+       "POINTS must be a non-negative integer, got 'many'"},
+      {"WidthTooLarge", v7 + "FIELDS x y z\nWIDTH 5000000000\nPOINTS 5000000000\nDATA ascii\n",
+       "WIDTH 5000000000 exceeds 4294967295"},
+      {"ShortViewpoint", v7 + "FIELDS x y z\nVIEWPOINT 0 0 0 1\nPOINTS 0\nDATA ascii\n",
+       "VIEWPOINT needs 7 values"},
+      {"AsciiTooFewValues", xyz_header(2, "ascii") + "1 2 3\n4 5\n",
+       "line 13: expected 3 values for point 1, found 2"},
+      {"AsciiTooManyValues", xyz_header(1, "ascii") + "1 2 3 4\n",
+       "line 12: expected 3 values for point 0, found 4"},
+      {"AsciiNonNumeric", xyz_header(2, "ascii") + "1 2 3\n4 abc 6\n",
+       "line 13: value 'abc' of field 'y' is not a valid F 4 number"},
+      {"AsciiTrailingGarbage", xyz_header(1, "ascii") + "1 2 3x\n",
+       "value '3x' of field 'z' is not a valid F 4 number"},
+      {"AsciiIntegerOutOfRange",
+       header("x y z label", "4 4 4 1", "F F F U", "1 1 1 1", 1, "ascii") + "1 2 3 256\n",
+       "value '256' of field 'label' is not a valid U 1 number"},
+      {"AsciiNegativeUnsigned",
+       header("x y z label", "4 4 4 4", "F F F U", "1 1 1 1", 1, "ascii") + "1 2 3 -1\n",
+       "value '-1' of field 'label' is not a valid U 4 number"},
+      {"AsciiTooFewLines", xyz_header(3, "ascii") + "1 2 3\n4 5 6\n\n",
+       "ascii data ends after 2 points, POINTS declares 3"},
+      {"AsciiTooManyLines", xyz_header(1, "ascii") + "1 2 3\n4 5 6\n",
+       "line 13: more data lines than POINTS (1)"},
+      {"NegativeLabel",
+       header("x y z label", "4 4 4 4", "F F F I", "1 1 1 1", 2, "ascii") + "1 2 3 5\n1 2 3 -1\n",
+       "field 'label' of point 1: value -1 is not a label"},
+      {"FractionalLabel",
+       header("x y z label", "4 4 4 4", "F F F F", "1 1 1 1", 1, "ascii") + "1 2 3 1.5\n",
+       "value 1.5 is not a label"},
+      {"TruncatedBinary", xyz_header(3, "binary") + binary_points(1) + "abcdefgh",
+       "truncated binary data: expected 36 bytes for 3 points, found 20"},
+      {"HugePointsBinary",
+       header("x y z", "4 4 4", "F F F", "1 1 1", 4000000000ull, "binary") + std::string(100, 'x'),
+       "truncated binary data: expected 48000000000 bytes for 4000000000 points, found 100"},
+      {"CompressedMissingSizes", xyz_header(3, "binary_compressed") + "abc",
+       "truncated binary_compressed data: expected an 8-byte size header, found 3 bytes"},
+      {"CompressedSizeBeyondFile", xyz_header(3, "binary_compressed") + big_compressed_size,
+       "compressed size 1000 is larger than the 3 bytes remaining in the file"},
+      {"UncompressedSizeMismatch", xyz_header(3, "binary_compressed") + wrong_uncompressed,
+       "binary_compressed header says 40 uncompressed bytes, but 3 points x 12 bytes need 36"},
+      {"CorruptLzf", xyz_header(3, "binary_compressed") + bad_lzf, "LZF decompression failed"},
+      {"OverlongLzf", xyz_header(3, "binary_compressed") + overlong_lzf,
+       "LZF decompression failed"},
+      {"EmptyFile", "", "empty file, not a PCD file"},
+  };
+}
+
+class PcdMalformed : public ::testing::TestWithParam<MalformedPcd> {};
+
+TEST_P(PcdMalformed, ThrowsIoErrorNamingFileAndProblem) {
+  test::TempDir dir;
+  const std::string path = dir.file(std::string(GetParam().name) + ".pcd");
+  write_bytes(path, GetParam().contents);
+  expect_read_error(path, GetParam().expected);
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, PcdMalformed, ::testing::ValuesIn(malformed_cases()),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+TEST(PcdMalformedFiles, MissingFileReportsErrno) {
+  test::TempDir dir;
+  expect_read_error(dir.file("nope.pcd"), "cannot open: No such file or directory");
+}
+
+TEST(PcdMalformedFiles, DirectoryIsNotARegularFile) {
+  test::TempDir dir;
+  const std::string path = dir.file("folder.pcd");
+  std::filesystem::create_directory(path);
+  expect_read_error(path, "not a regular file");
+}
+
+// Absurd sizes in tiny files must fail on the size check, before allocating anything like them.
+class PcdHugeHeader : public ::testing::TestWithParam<MalformedPcd> {};
+
+TEST_P(PcdHugeHeader, FailsWithoutAllocatingTheDeclaredSize) {
+  test::TempDir dir;
+  const std::string path = dir.file(std::string(GetParam().name) + ".pcd");
+  write_bytes(path, GetParam().contents);
+  g_largest_allocation = 0;
+  expect_read_error(path, GetParam().expected);
+  EXPECT_LT(g_largest_allocation.load(), std::size_t{1} << 20)
+      << "largest allocation while reading a " << GetParam().contents.size() << "-byte file";
+}
+
+std::vector<MalformedPcd> huge_cases() {
+  const std::string huge = "4000000000";
+  std::string consistent_sizes;  // 300M points x 12 bytes fit the uint32 size field
+  put<std::uint32_t>(consistent_sizes, 4);
+  put<std::uint32_t>(consistent_sizes, 3600000000u);
+  consistent_sizes += "\x03xyzw";
+  std::string tiny_sizes;
+  put<std::uint32_t>(tiny_sizes, 4);
+  put<std::uint32_t>(tiny_sizes, 4);
+  tiny_sizes += "abcd";
+  return {
+      {"Binary", xyz_header(4000000000ull, "binary") + std::string(100, 'x'),
+       "truncated binary data"},
+      {"BinaryOverflowingProduct",
+       header("x y z h", "4 4 4 8", "F F F F", "1 1 1 4000000000", 4000000000ull, "binary") +
+           std::string(100, 'x'),
+       "truncated binary data"},
+      {"CompressedSizeMismatch", xyz_header(4000000000ull, "binary_compressed") + tiny_sizes,
+       "binary_compressed header says 4 uncompressed bytes"},
+      {"CompressedImpossibleRatio", xyz_header(300000000, "binary_compressed") + consistent_sizes,
+       "LZF data of 4 bytes cannot expand to 3600000000 bytes"},
+      {"Ascii", xyz_header(4000000000ull, "ascii") + "1 2 3\n4 5 6\n",
+       "ascii data ends after 2 points, POINTS declares 4000000000"},
+      {"AsciiHugeCount",
+       header("x y z h", "4 4 4 4", "F F F F", "1 1 1 4000000000", 1, "ascii") + "1 2 3 4\n",
+       "expected 4000000003 values for point 0, found 4"},
+  };
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, PcdHugeHeader, ::testing::ValuesIn(huge_cases()),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace primlabel
