@@ -70,8 +70,9 @@ TEST_F(FeaturesCli, PfhToPlyWithInputNormals) {
 }
 
 TEST_F(FeaturesCli, UsageErrorsExitWith2AndOneLine) {
-  for (const std::string args : {" -o x.pcd --normal-k 10 --normal-radius 0.1", " -o x.pcd --descriptor shot",
-                                 " -o x.pcd --feature-radius -1", "", " -o x.pcd --viewpoint 1,2"}) {
+  for (const std::string args :
+       {" -o x.pcd --normal-k 10 --normal-radius 0.1", " -o x.pcd --descriptor shot",
+        " -o x.pcd --feature-radius -1", "", " -o x.pcd --viewpoint 1,2"}) {
     const Result r = run(features_tool() + " " + bunny_ + args);
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.output;
     EXPECT_NE(r.output.find("usage error"), std::string::npos) << r.output;

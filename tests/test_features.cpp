@@ -1,5 +1,3 @@
-#include "primlabel/core/features.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -7,6 +5,7 @@
 #include <numeric>
 
 #include "primlabel/core/cloud_io.hpp"
+#include "primlabel/core/features.hpp"
 #include "primlabel/core/normals.hpp"
 #include "test_util.hpp"
 
@@ -28,9 +27,10 @@ TEST(PairFeatures, AlphaIsTheNormalsAngleInTheDarbouxFrame) {
   const float a = 0.3f;
   float f1, f2, f3, f4;
   // n2 = (sin a, 0, cos a) is closer to the line than n1 = z, so p2 is the source: u = n2,
-  // delta = -x, v = delta x u / |..| = y, w = u x v = (-cos a, 0, sin a); alpha = atan2(w.n1, u.n1).
-  ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0},
-                                    {std::sin(a), 0, std::cos(a)}, f1, f2, f3, f4));
+  // delta = -x, v = delta x u / |..| = y, w = u x v = (-cos a, 0, sin a); alpha = atan2(w.n1,
+  // u.n1).
+  ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {std::sin(a), 0, std::cos(a)},
+                                    f1, f2, f3, f4));
   EXPECT_NEAR(f1, a, 1e-6f);
   EXPECT_NEAR(f2, 0.0f, 1e-7f);
   EXPECT_NEAR(f3, -std::sin(a), 1e-7f);

@@ -1,10 +1,9 @@
-#include "primlabel/core/neighbor_search.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <limits>
 
+#include "primlabel/core/neighbor_search.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -112,8 +111,8 @@ TEST_F(NeighborSearchTest, HybridIsNearestWithinRadius) {
   for (std::size_t i = 0; i < 20; ++i) EXPECT_EQ(found.indices[i], expected[i].second);
   // Radius holds fewer than the cap: everything inside the radius.
   const float r = 0.08f;
-  const auto inside = std::count_if(expected.begin(), expected.end(),
-                                    [&](auto& e) { return e.first < r * r; });
+  const auto inside =
+      std::count_if(expected.begin(), expected.end(), [&](auto& e) { return e.first < r * r; });
   search.find(q, Neighborhood::Hybrid(r, 1000), found);
   EXPECT_EQ(found.size(), static_cast<std::size_t>(inside));
 }

@@ -1,11 +1,10 @@
-#include "primlabel/core/normals.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <filesystem>
 
 #include "primlabel/core/cloud_io.hpp"
+#include "primlabel/core/normals.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -55,8 +54,12 @@ TEST(Normals, DefaultViewpointIsTheCloudsSensorOrigin) {
 
 TEST(Normals, TooFewNeighboursAndInvalidPointsGiveNaNAndAreCounted) {
   PointCloud cloud;
-  cloud.xyz = {{0, 0, 0}, {0.01f, 0, 0}, {0, 0.01f, 0}, {0.01f, 0.01f, 0.001f},  // a patch
-               {5, 5, 5}, {5.01f, 5, 5},                                            // a pair
+  cloud.xyz = {{0, 0, 0},
+               {0.01f, 0, 0},
+               {0, 0.01f, 0},
+               {0.01f, 0.01f, 0.001f},  // a patch
+               {5, 5, 5},
+               {5.01f, 5, 5},  // a pair
                {Vec3f::Constant(NAN)}};
   cloud.width = 7;
   NormalOptions options;
@@ -95,8 +98,8 @@ TEST(Normals, IdenticalForAnyThreadCount) {
       reference = cloud.normals;
       continue;
     }
-    ASSERT_EQ(0, std::memcmp(reference.data(), cloud.normals.data(),
-                             reference.size() * sizeof(Vec3f)))
+    ASSERT_EQ(0,
+              std::memcmp(reference.data(), cloud.normals.data(), reference.size() * sizeof(Vec3f)))
         << threads << " threads";
   }
 }
@@ -113,7 +116,8 @@ TEST(Normals, MatchPclOnTheBunny) {
   estimate_normals(cloud, options);
   float worst = 0.0f;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    for (int d = 0; d < 3; ++d) worst = std::max(worst, std::abs(cloud.normals[i][d] - reference[i][d]));
+    for (int d = 0; d < 3; ++d)
+      worst = std::max(worst, std::abs(cloud.normals[i][d] - reference[i][d]));
     worst = std::max(worst, std::abs(cloud.curvature[i] - reference[i][3]));
   }
   EXPECT_LE(worst, 1e-4f);

@@ -47,8 +47,8 @@ TEST(PairBinsBatch, RandomPairsMatchTheExactPath) {
   std::uniform_real_distribution<float> u(-0.05f, 0.05f);
   std::vector<Pair> pairs;
   for (int i = 0; i < 400000; ++i)
-    pairs.push_back({Vec3f(u(rng), u(rng), u(rng)), random_unit(rng),
-                     Vec3f(u(rng), u(rng), u(rng)), random_unit(rng)});
+    pairs.push_back({Vec3f(u(rng), u(rng), u(rng)), random_unit(rng), Vec3f(u(rng), u(rng), u(rng)),
+                     random_unit(rng)});
   EXPECT_EQ(count_mismatches(pairs, 11), 0u);
   EXPECT_EQ(count_mismatches(pairs, 5), 0u);
 }
@@ -77,8 +77,9 @@ TEST(PairBinsBatch, AdversarialPairsMatchTheExactPath) {
   for (int bins : {5, 11})
     for (int b = 0; b <= bins; ++b) {
       const double angle = -M_PI + 2.0 * M_PI * b / bins;
-      pairs.push_back({Vec3f::Zero(), Vec3f(0, 0, 1), Vec3f(1, 0, 0),
-                       Vec3f(float(std::sin(angle)) * 0.1f, 0, float(std::cos(angle))).normalized()});
+      pairs.push_back(
+          {Vec3f::Zero(), Vec3f(0, 0, 1), Vec3f(1, 0, 0),
+           Vec3f(float(std::sin(angle)) * 0.1f, 0, float(std::cos(angle))).normalized()});
       pairs.push_back({Vec3f::Zero(), Vec3f(0, 0, 1), Vec3f(1, 0, 0),
                        Vec3f(0, float(std::sin(angle)), float(std::cos(angle)))});
     }

@@ -71,7 +71,8 @@ class TempDir {
 inline PointCloud plane_grid(float a, float b, float extent, float spacing) {
   PointCloud cloud;
   for (float x = -extent; x <= extent + 1e-6f; x += spacing)
-    for (float y = -extent; y <= extent + 1e-6f; y += spacing) cloud.xyz.emplace_back(x, y, a * x + b * y);
+    for (float y = -extent; y <= extent + 1e-6f; y += spacing)
+      cloud.xyz.emplace_back(x, y, a * x + b * y);
   cloud.width = static_cast<std::uint32_t>(cloud.xyz.size());
   return cloud;
 }

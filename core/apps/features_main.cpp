@@ -26,8 +26,9 @@ struct Arguments {
 };
 
 Neighborhood neighborhood_of(int k, float radius, int max_neighbors, int default_k) {
-  if (radius > 0) return max_neighbors > 0 ? Neighborhood::Hybrid(radius, max_neighbors)
-                                           : Neighborhood::Radius(radius);
+  if (radius > 0)
+    return max_neighbors > 0 ? Neighborhood::Hybrid(radius, max_neighbors)
+                             : Neighborhood::Radius(radius);
   return Neighborhood::Knn(k > 0 ? k : default_k);
 }
 
@@ -57,7 +58,8 @@ int run(const Arguments& args) {
     }
   } else {
     NormalOptions options;
-    options.neighborhood = neighborhood_of(args.normal_k, args.normal_radius, args.max_neighbors, 10);
+    options.neighborhood =
+        neighborhood_of(args.normal_k, args.normal_radius, args.max_neighbors, 10);
     if (!args.viewpoint.empty()) options.viewpoint = cli::parse_vec3(args.viewpoint);
     options.threads = args.threads;
     options.progress = progress.stage("normals");
@@ -89,8 +91,9 @@ int run(const Arguments& args) {
     std::fprintf(stderr,
                  "%s: %zu computed, %zu isolated (all zero), %zu invalid (NaN), %.2f s "
                  "(%.0f points/s); wrote %s\n",
-                 args.descriptor.c_str(), stats.computed, stats.isolated, stats.nan, feature_seconds,
-                 double(cloud.size()) / std::max(feature_seconds, 1e-9), args.output.c_str());
+                 args.descriptor.c_str(), stats.computed, stats.isolated, stats.nan,
+                 feature_seconds, double(cloud.size()) / std::max(feature_seconds, 1e-9),
+                 args.output.c_str());
   return cli::kExitOk;
 }
 

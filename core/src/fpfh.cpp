@@ -102,8 +102,7 @@ inline float squared_distance(const Vec3f& a, const Vec3f& b) {
 }
 
 void weight_spfh(const PointCloud& cloud, std::size_t p, const std::vector<float>& spfh,
-                 const std::vector<double>& spfh_sums, const NeighborList& neighbors,
-                 float* fpfh) {
+                 const std::vector<double>& spfh_sums, const NeighborList& neighbors, float* fpfh) {
   alignas(16) float accumulated[kFpfhSize] = {};
   double sum[3] = {0.0, 0.0, 0.0};
   for (std::uint32_t q : neighbors.indices) {

@@ -2,13 +2,12 @@
 
 // Equal distances are reported lowest index first, so k-nearest lists are reproducible.
 #define NANOFLANN_FIRST_MATCH
-#include <nanoflann.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <nanoflann.hpp>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -39,8 +38,9 @@ struct CompactPoints {
   }
 };
 
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, CompactPoints>,
-                                                   CompactPoints, 3, std::uint32_t>;
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, CompactPoints>,
+                                        CompactPoints, 3, std::uint32_t>;
 
 // Collects every point strictly inside the radius straight into the caller's NeighborList,
 // translating compact indices back to cloud indices.
@@ -124,7 +124,8 @@ class RadiusGrid {
     std::vector<std::uint32_t> fill(grid->starts_.begin(), grid->starts_.end() - 1);
     for (std::size_t i = 0; i < n; ++i) {  // stable: points keep their order within a cell
       const std::uint32_t slot = fill[cell_of[i]]++;
-      grid->x_[slot] = points[i].x(), grid->y_[slot] = points[i].y(), grid->z_[slot] = points[i].z();
+      grid->x_[slot] = points[i].x(), grid->y_[slot] = points[i].y(),
+      grid->z_[slot] = points[i].z();
       grid->index_[slot] = to_cloud[i];
     }
     return grid;
@@ -165,7 +166,8 @@ class RadiusGrid {
     return static_cast<std::int64_t>(std::floor((v - origin_[d]) * inv_cell_));
   }
   std::array<std::int64_t, 3> cell_coords(const Vec3f& p) const {
-    return {std::min(cell_coord(p.x(), 0), dims_[0] - 1), std::min(cell_coord(p.y(), 1), dims_[1] - 1),
+    return {std::min(cell_coord(p.x(), 0), dims_[0] - 1),
+            std::min(cell_coord(p.y(), 1), dims_[1] - 1),
             std::min(cell_coord(p.z(), 2), dims_[2] - 1)};
   }
   std::size_t cell_index(const std::array<std::int64_t, 3>& c) const {
@@ -209,8 +211,8 @@ NeighborSearch::NeighborSearch(const std::vector<Vec3f>& points) : impl_(std::ma
     impl_->compact.points.push_back(points[i]);
     impl_->to_cloud.push_back(static_cast<std::uint32_t>(i));
   }
-  impl_->tree = std::make_unique<KdTree>(3, impl_->compact,
-                                         nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  impl_->tree =
+      std::make_unique<KdTree>(3, impl_->compact, nanoflann::KDTreeSingleIndexAdaptorParams(16));
 }
 
 NeighborSearch::~NeighborSearch() = default;

@@ -80,8 +80,8 @@ void pair_bins_batch(const Vec3f& p1, const Vec3f& n1, const PairTargets& t, std
     const __m128 abs1 = abs_ps(angle1), abs2 = abs_ps(angle2);
     const __m128 swap = _mm_cmplt_ps(abs1, abs2);
     const __m128 gap = abs_ps(_mm_sub_ps(abs1, abs2));
-    exact = _mm_or_ps(exact, _mm_and_ps(_mm_cmple_ps(gap, _mm_set1_ps(2e-6f)),
-                                        _mm_cmpneq_ps(abs1, abs2)));
+    exact = _mm_or_ps(exact,
+                      _mm_and_ps(_mm_cmple_ps(gap, _mm_set1_ps(2e-6f)), _mm_cmpneq_ps(abs1, abs2)));
     const __m128 ux = select(swap, m2x, n1x), uy = select(swap, m2y, n1y),
                  uz = select(swap, m2z, n1z);
     const __m128 tx = select(swap, n1x, m2x), ty = select(swap, n1y, m2y),

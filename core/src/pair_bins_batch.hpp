@@ -13,9 +13,7 @@ namespace primlabel::detail {
 // Structure-of-arrays copy of the second points of a batch of pairs.
 struct PairTargets {
   std::vector<float> x, y, z, nx, ny, nz;
-  void clear() {
-    x.clear(), y.clear(), z.clear(), nx.clear(), ny.clear(), nz.clear();
-  }
+  void clear() { x.clear(), y.clear(), z.clear(), nx.clear(), ny.clear(), nz.clear(); }
   void resize(std::size_t n) {
     x.resize(n), y.resize(n), z.resize(n), nx.resize(n), ny.resize(n), nz.resize(n);
   }

@@ -21,8 +21,8 @@ struct PfhScratch {
   std::vector<std::uint8_t> alpha, phi, theta;
 };
 
-void compute_point_pfh(const PointCloud& cloud, const NeighborList& neighbors,
-                       PfhScratch& scratch, float* pfh) {
+void compute_point_pfh(const PointCloud& cloud, const NeighborList& neighbors, PfhScratch& scratch,
+                       float* pfh) {
   const std::size_t k = neighbors.size();
   scratch.targets.clear();
   for (std::uint32_t q : neighbors.indices) scratch.targets.push(cloud.xyz[q], cloud.normals[q]);

@@ -20,7 +20,7 @@ namespace primlabel {
 inline constexpr int kFpfhBinsPerFeature = 11;
 inline constexpr int kFpfhSize = 3 * kFpfhBinsPerFeature;  // 33
 inline constexpr int kPfhBinsPerFeature = 5;
-inline constexpr int kPfhSize = 125;                        // 5^3
+inline constexpr int kPfhSize = 125;  // 5^3
 
 enum class FpfhVariant {
   kPcl,          // PCL: weighted sum of the neighbours' SPFHs only

@@ -20,9 +20,9 @@ struct NormalOptions {
 };
 
 struct NormalStats {
-  std::size_t estimated = 0;     // points that got a finite normal
-  std::size_t too_few = 0;       // fewer than 3 neighbours, or all coincident: NaN normal
-  std::size_t invalid_input = 0; // points with non-finite coordinates: NaN normal
+  std::size_t estimated = 0;      // points that got a finite normal
+  std::size_t too_few = 0;        // fewer than 3 neighbours, or all coincident: NaN normal
+  std::size_t invalid_input = 0;  // points with non-finite coordinates: NaN normal
 };
 
 // Fills cloud.normals and cloud.curvature (one per point). Points that cannot get a normal get NaN

@@ -37,11 +37,11 @@ struct FloatField {
 
 struct PointCloud {
   std::vector<Vec3f> xyz;
-  std::vector<Vec3f> normals;          // NaN where a normal could not be estimated
-  std::vector<float> curvature;        // surface variation lambda0 / (lambda0 + lambda1 + lambda2)
-  std::vector<std::uint32_t> labels;   // integer class / segment labels
-  std::vector<std::uint32_t> rgba;     // packed 0xAARRGGBB as PCL stores rgb/rgba
-  std::vector<FloatField> fields;      // descriptors and any other float attributes
+  std::vector<Vec3f> normals;         // NaN where a normal could not be estimated
+  std::vector<float> curvature;       // surface variation lambda0 / (lambda0 + lambda1 + lambda2)
+  std::vector<std::uint32_t> labels;  // integer class / segment labels
+  std::vector<std::uint32_t> rgba;    // packed 0xAARRGGBB as PCL stores rgb/rgba
+  std::vector<FloatField> fields;     // descriptors and any other float attributes
 
   std::uint32_t width = 0;   // points per row; equals size() when height == 1
   std::uint32_t height = 1;  // rows; > 1 means organised

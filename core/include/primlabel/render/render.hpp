@@ -25,11 +25,11 @@ struct RenderOptions {
   int width = 1024;
   int height = 768;
   RenderView view = RenderView::kOblique;
-  Vec3f up = Vec3f(0, 0, 1);         // world up, for kTop and kOblique
-  int point_radius_px = 1;           // splat size; 0 = single pixels
+  Vec3f up = Vec3f(0, 0, 1);  // world up, for kTop and kOblique
+  int point_radius_px = 1;    // splat size; 0 = single pixels
   std::uint32_t background = 0xFFFFFF;
-  std::string title;                 // drawn top-left when not empty
-  std::vector<LegendEntry> legend;   // drawn bottom-left when not empty
+  std::string title;                // drawn top-left when not empty
+  std::vector<LegendEntry> legend;  // drawn bottom-left when not empty
 };
 
 // Renders the finite points of `cloud` with colours `point_rgb` (0xRRGGBB, one per point) to a
