@@ -19,7 +19,8 @@ JOBS=${JOBS:-$(nproc)}
 # Debian 12 packages the build and the tests need.
 PACKAGES=(
   build-essential cmake pkg-config
-  libeigen3-dev libnanoflann-dev liblzf-dev libcli11-dev libpng-dev
+  libeigen3-dev libnanoflann-dev liblzf-dev libcli11-dev libpng-dev zlib1g-dev
+  libprotobuf-dev protobuf-compiler liblbfgspp-dev libsvm-dev
   libgtest-dev
 )
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev)
