@@ -1,0 +1,64 @@
+#pragma once
+// A synthetic table scene: a table slab whose top face is the plane z = 0 of the world frame,
+// and objects standing on it, each a shape with a pose (a position on the table and a yaw).
+// Generation is deterministic for a seed.
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "primlabel/synth/shapes.hpp"
+
+namespace primlabel::synth {
+
+struct SceneObject {
+  std::shared_ptr<const Shape> shape;
+  Eigen::Isometry3d world_from_local = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d local_from_world = Eigen::Isometry3d::Identity();
+  std::uint32_t rgb = 0x808080;        // base colour for the cloud's rgb field
+  bool on_support = true;              // stands on the table (false for the table itself)
+  Vec3d bound_center = Vec3d::Zero();  // world frame
+  double bound_radius = 0;
+
+  SceneObject(std::shared_ptr<const Shape> shape, const Eigen::Isometry3d& pose, std::uint32_t rgb,
+              bool on_support);
+};
+
+struct SceneHit {
+  double t = 0;
+  int object = -1;  // index into Scene::objects; 0 is the table
+  int part = -1;
+  Vec3d normal = Vec3d::Zero();  // world frame, out of the material
+};
+
+struct Scene {
+  std::vector<SceneObject> objects;  // objects[0] is the table (the support)
+  Vec3d table_size = Vec3d::Zero();  // x, y extent and thickness of the slab
+
+  // Nearest hit of a world-frame ray with t in (t_min, t_max).
+  std::optional<SceneHit> cast(const Ray& ray, double t_min, double t_max) const;
+  // True when something blocks the segment from `from` to `to` (shadow rays).
+  bool occluded(const Vec3d& from, const Vec3d& to) const;
+};
+
+enum class SceneKind {
+  kTable,       // a table with 4-8 randomly chosen, posed and sized kitchen objects
+  kPrimitives,  // one of each shape in a row on a table, for tests and demos
+  kEmptyTable,  // the bare table (noise statistics)
+};
+
+struct TableSceneOptions {
+  int min_objects = 7;
+  int max_objects = 10;
+  double min_gap = 0.035;  // between object footprints: labels never mix two objects
+};
+
+Scene make_scene(SceneKind kind, std::uint64_t seed, const TableSceneOptions& options = {});
+
+// The objects' kinds, e.g. "box,can,mug" (table excluded).
+std::string describe_objects(const Scene& scene);
+
+}  // namespace primlabel::synth

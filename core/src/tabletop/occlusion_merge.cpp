@@ -1,0 +1,191 @@
+#include "primlabel/tabletop/occlusion_merge.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include "primlabel/tabletop/convex_hull.hpp"
+
+namespace primlabel::tabletop {
+
+void OcclusionMergeOptions::validate() const {
+  const auto fail = [](const std::string& what) { throw std::invalid_argument(what); };
+  const auto non_negative = [](float v) { return v >= 0.0f && std::isfinite(v); };
+  if (!non_negative(depth_margin)) fail("occlusion merge depth margin must be >= 0");
+  if (max_scan_pixels < 1) fail("occlusion merge max scan pixels must be at least 1");
+  if (min_scanlines < 1) fail("occlusion merge min scanlines must be at least 1");
+  if (!non_negative(top_tolerance)) fail("occlusion merge top tolerance must be >= 0");
+  if (!non_negative(max_gap)) fail("occlusion merge max gap must be >= 0");
+  if (!non_negative(footprint_margin)) fail("occlusion merge footprint margin must be >= 0");
+  if (!non_negative(max_table_fraction)) fail("occlusion merge max table fraction must be >= 0");
+}
+
+namespace {
+
+struct Link {
+  int scanlines = 0;
+  float gap = std::numeric_limits<float>::infinity();  // smallest 3D distance of linked ends
+};
+
+// Finds, along image rows and columns, pairs of clusters separated only by occluding pixels.
+class LinkScanner {
+ public:
+  LinkScanner(const PointCloud& cloud, const std::vector<std::vector<std::uint32_t>>& clusters,
+              const OcclusionMergeOptions& options)
+      : cloud_(cloud), options_(options), label_(cloud.size(), -1), range_(cloud.size()) {
+    for (std::size_t k = 0; k < clusters.size(); ++k)
+      for (std::uint32_t i : clusters[k]) label_[i] = static_cast<std::int32_t>(k);
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+      range_[i] = is_finite(cloud.xyz[i]) ? (cloud.xyz[i] - cloud.viewpoint.origin).norm()
+                                          : std::numeric_limits<float>::quiet_NaN();
+  }
+
+  std::map<std::pair<std::int32_t, std::int32_t>, Link> scan() {
+    const std::size_t w = cloud_.width, h = cloud_.height;
+    for (std::size_t row = 0; row < h; ++row) scan_line(row * w, 1, w);
+    for (std::size_t col = 0; col < w; ++col) scan_line(col, w, h);
+    return std::move(links_);
+  }
+
+ private:
+  std::size_t pixel(std::size_t start, std::size_t step, std::size_t t) const {
+    return start + t * step;
+  }
+
+  void scan_line(std::size_t start, std::size_t step, std::size_t length) {
+    std::vector<std::int32_t> found;
+    for (std::size_t t = 1; t < length; ++t) {
+      const std::size_t p = pixel(start, step, t);
+      const std::int32_t x = label_[p];
+      if (x < 0 || label_[pixel(start, step, t - 1)] == x) continue;  // only where a run starts
+      // Walk back over invalid pixels and pixels nearer than p; every other cluster met there is
+      // a candidate.
+      found.clear();
+      const std::size_t reach = std::min<std::size_t>(t, std::size_t(options_.max_scan_pixels) + 1);
+      for (std::size_t back = 1; back <= reach; ++back) {
+        const std::size_t s = t - back;
+        const std::size_t q = pixel(start, step, s);
+        const std::int32_t y = label_[q];
+        if (y == x) break;
+        if (y >= 0 && std::find(found.begin(), found.end(), y) == found.end()) {
+          found.push_back(y);
+          if (occluded_between(start, step, s, t)) add_link(y, x, q, p);
+        }
+        if (!std::isnan(range_[q]) && !(range_[q] < range_[p] - options_.depth_margin)) break;
+      }
+    }
+  }
+
+  // True when every valid pixel strictly between s and t is nearer than the straight line
+  // between the ranges at s and t, by depth_margin.
+  bool occluded_between(std::size_t start, std::size_t step, std::size_t s, std::size_t t) const {
+    const float rs = range_[pixel(start, step, s)], rt = range_[pixel(start, step, t)];
+    for (std::size_t k = s + 1; k < t; ++k) {
+      const float r = range_[pixel(start, step, k)];
+      if (std::isnan(r)) continue;
+      const float line = rs + (rt - rs) * float(k - s) / float(t - s);
+      if (!(r < line - options_.depth_margin)) return false;
+    }
+    return true;
+  }
+
+  void add_link(std::int32_t a, std::int32_t b, std::size_t pa, std::size_t pb) {
+    Link& link = links_[{std::min(a, b), std::max(a, b)}];
+    ++link.scanlines;
+    link.gap = std::min(link.gap, (cloud_.xyz[pa] - cloud_.xyz[pb]).norm());
+  }
+
+  const PointCloud& cloud_;
+  const OcclusionMergeOptions& options_;
+  std::vector<std::int32_t> label_;
+  std::vector<float> range_;
+  std::map<std::pair<std::int32_t, std::int32_t>, Link> links_;
+};
+
+// The height below which 99% of the cluster's points lie: the top, robust to flying pixels.
+float top_height(const std::vector<std::uint32_t>& cluster, const std::vector<float>& height) {
+  std::vector<float> h;
+  h.reserve(cluster.size());
+  for (std::uint32_t i : cluster) h.push_back(height[i]);
+  const std::size_t k = h.size() - 1 - h.size() / 100;
+  std::nth_element(h.begin(), h.begin() + k, h.end());
+  return h[k];
+}
+
+}  // namespace
+
+std::vector<std::vector<std::uint32_t>> merge_occluded(
+    const PointCloud& cloud, const std::vector<float>& height, const PlaneGrid& table,
+    std::vector<std::vector<std::uint32_t>> clusters, const OcclusionMergeOptions& options) {
+  options.validate();
+  const auto by_size = [](const auto& a, const auto& b) {
+    return a.size() != b.size() ? a.size() > b.size() : a.front() < b.front();
+  };
+  if (!options.enabled || !cloud.organized() ||
+      std::size_t(cloud.width) * cloud.height != cloud.size() || clusters.size() < 2) {
+    std::sort(clusters.begin(), clusters.end(), by_size);
+    return clusters;
+  }
+
+  std::vector<std::pair<std::pair<std::int32_t, std::int32_t>, Link>> links;
+  for (const auto& entry : LinkScanner(cloud, clusters, options).scan())
+    if (entry.second.scanlines >= options.min_scanlines) links.push_back(entry);
+  std::stable_sort(links.begin(), links.end(), [](const auto& a, const auto& b) {
+    return a.second.scanlines > b.second.scanlines;
+  });
+
+  // Groups of joined clusters: root, top height, footprint hull and point count.
+  const std::size_t n = clusters.size();
+  std::vector<std::uint32_t> root(n);
+  std::vector<float> top(n);
+  std::vector<std::vector<Vec2f>> hull(n);
+  std::vector<std::size_t> count(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    root[k] = static_cast<std::uint32_t>(k);
+    top[k] = top_height(clusters[k], height);
+    std::vector<Vec2f> footprint;
+    footprint.reserve(clusters[k].size());
+    for (std::uint32_t i : clusters[k]) footprint.push_back(table.project(cloud.xyz[i]));
+    hull[k] = convex_hull(std::move(footprint));
+    count[k] = clusters[k].size();
+  }
+  const auto find = [&](std::uint32_t k) {
+    while (root[k] != k) k = root[k] = root[root[k]];
+    return k;
+  };
+  for (const auto& [pair, link] : links) {
+    const std::uint32_t a = find(pair.first), b = find(pair.second);
+    if (a == b || std::abs(top[a] - top[b]) > options.top_tolerance || link.gap > options.max_gap)
+      continue;
+    std::vector<Vec2f> joint = hull[a];
+    joint.insert(joint.end(), hull[b].begin(), hull[b].end());
+    joint = convex_hull(std::move(joint));
+    const std::size_t table_inside = table.count_inside(joint, options.footprint_margin);
+    if (double(table_inside) > options.max_table_fraction * double(count[a] + count[b])) continue;
+    const std::uint32_t kept = std::min(a, b), gone = std::max(a, b);
+    root[gone] = kept;
+    top[kept] = std::max(top[a], top[b]);
+    hull[kept] = std::move(joint);
+    count[kept] += count[gone];
+  }
+
+  std::vector<std::vector<std::uint32_t>> merged;
+  std::vector<std::int64_t> slot(n, -1);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t r = find(static_cast<std::uint32_t>(k));
+    if (slot[r] < 0) {
+      slot[r] = static_cast<std::int64_t>(merged.size());
+      merged.emplace_back();
+    }
+    auto& members = merged[slot[r]];
+    members.insert(members.end(), clusters[k].begin(), clusters[k].end());
+  }
+  for (auto& members : merged) std::sort(members.begin(), members.end());
+  std::sort(merged.begin(), merged.end(), by_size);
+  return merged;
+}
+
+}  // namespace primlabel::tabletop

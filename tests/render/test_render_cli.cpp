@@ -1,0 +1,128 @@
+// primlabel-render as a user runs it: pictures of synthetic and real scans, exit codes, errors.
+
+#include <gtest/gtest.h>
+#include <png.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+struct Result {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+Result run(const std::string& command) {
+  Result result{-1, {}};
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::string render_tool() { return test::binary("primlabel-render"); }
+int lines(const std::string& text) { return int(std::count(text.begin(), text.end(), '\n')); }
+
+bool png_size(const std::string& path, int& width, int& height) {
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, path.c_str())) return false;
+  width = int(image.width);
+  height = int(image.height);
+  png_image_free(&image);
+  return true;
+}
+
+class RenderCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir;
+    const Result r =
+        run(test::binary("primlabel-synth") +
+            " --scene primitives --sensor lms400 --seed 2 -q -o " + dir_->file("prims.pcd"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static std::string scene() { return dir_->file("prims.pcd"); }
+  static test::TempDir* dir_;
+};
+test::TempDir* RenderCli::dir_ = nullptr;
+
+TEST_F(RenderCli, RendersLabelsRgbAndFieldsInEveryView) {
+  const std::vector<std::string> variants = {
+      "",
+      "--field label --view top",
+      "--field rgb --view sensor",
+      "--field z --view oblique",
+      "--field object --palette segments",
+      "--field label --palette segments --no-legend --no-title"};
+  for (std::size_t i = 0; i < variants.size(); ++i) {
+    const std::string out = dir_->file(std::string("v").append(std::to_string(i)).append(".png"));
+    const Result r = run(render_tool() + " " + scene() + " -o " + out +
+                         " --width 320 --height 240 " + variants[i]);
+    ASSERT_EQ(r.exit_code, 0) << variants[i] << ": " << r.output;
+    EXPECT_EQ(r.output, "");
+    int width = 0, height = 0;
+    ASSERT_TRUE(png_size(out, width, height)) << variants[i];
+    EXPECT_EQ(width, 320);
+    EXPECT_EQ(height, 240);
+  }
+}
+
+TEST_F(RenderCli, ClassMapNamesTheLegend) {
+  const std::string map = dir_->file("map.txt");
+  FILE* f = std::fopen(map.c_str(), "w");
+  std::fputs("0 unknown\n1 plane\n", f);  // deliberately incomplete: the rest show as "label N"
+  std::fclose(f);
+  const Result r =
+      run(render_tool() + " " + scene() + " -o " + dir_->file("m.png") + " --classes " + map);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+}
+
+TEST_F(RenderCli, UsageErrorsExitWith2AndOneLine) {
+  for (const std::string args :
+       {" -o x.png --view side", "", " -o x.png --width 10", " -o x.png --palette rainbow"}) {
+    const Result r = run(render_tool() + " " + scene() + args);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("primlabel-render: usage error"), std::string::npos) << r.output;
+  }
+}
+
+TEST_F(RenderCli, RuntimeErrorsExitWith1AndNameTheFile) {
+  Result r = run(render_tool() + " /nonexistent/scan.pcd -o " + dir_->file("x.png"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("/nonexistent/scan.pcd"), std::string::npos) << r.output;
+  r = run(render_tool() + " " + scene() + " -o /nonexistent/dir/x.png");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/dir/x.png"), std::string::npos) << r.output;
+  r = run(render_tool() + " " + scene() + " -o " + dir_->file("x.png") + " --field fpfh");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("has no field 'fpfh' (fields: x y z label rgb object)"),
+            std::string::npos)
+      << r.output;
+}
+
+TEST(RenderCliShared, MosdSegmentsFromTheSensor) {
+  const std::string scan = test::shared_data("mosd/learn36.pcd");
+  if (!std::filesystem::exists(scan)) GTEST_SKIP() << scan << " not present";
+  test::TempDir dir;
+  const Result r = run(render_tool() + " " + scan + " -o " + dir.file("learn36.png") +
+                       " --field label --palette segments --view sensor --width 640 --height 480");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  int width = 0, height = 0;
+  EXPECT_TRUE(png_size(dir.file("learn36.png"), width, height));
+}
+
+}  // namespace
+}  // namespace primlabel

@@ -1,0 +1,112 @@
+// primlabel-synth as a user runs it: outputs, scene sets, exit codes and one-line errors.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/core/taxonomy.hpp"
+#include "primlabel/synth/labeled_cloud.hpp"
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+struct Result {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+Result run(const std::string& arguments) {
+  Result result{-1, {}};
+  FILE* pipe = popen((test::binary("primlabel-synth") + " " + arguments + " 2>&1").c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+int lines(const std::string& text) { return int(std::count(text.begin(), text.end(), '\n')); }
+
+TEST(SynthCli, ListsTheClassesAsAClassMap) {
+  const Result r = run("--list-classes");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output, ClassMap::taxonomy().to_text());
+  EXPECT_NE(r.output.find("6 corner\n"), std::string::npos);
+}
+
+TEST(SynthCli, WritesALabeledScene) {
+  test::TempDir dir;
+  const std::string out = dir.file("scene.pcd");
+  const Result r = run("--scene table --sensor lms400 --seed 7 -o " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("wrote " + out), std::string::npos);
+  const PointCloud cloud = read_pcd(out);
+  ASSERT_TRUE(cloud.has_labels());
+  EXPECT_GT(cloud.size(), 50000u);
+  const CloudTags tags = read_cloud_tags(out);
+  EXPECT_EQ(tags.at("label_radius"), "0.025");
+  EXPECT_EQ(tags.at("sensor"), "lms400");
+  EXPECT_EQ(tags.at("seed"), "7");
+  for (std::uint32_t label : cloud.labels) ASSERT_LT(label, kPrimitiveClassCount);
+}
+
+TEST(SynthCli, KinectPrimitivesWithRadiusToPly) {
+  test::TempDir dir;
+  const std::string out = dir.file("prims.ply");
+  const Result r = run("--scene primitives --sensor kinect --seed 3 --radius 0.03 -q -o " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output, "");
+  const CloudTags tags = read_cloud_tags(out);
+  EXPECT_EQ(tags.at("label_radius"), "0.03");
+  EXPECT_EQ(tags.at("objects"), "box,can,mug,bowl,ball,torus");
+  const PointCloud cloud = load_labeled_cloud(out);
+  EXPECT_EQ(cloud.size(), 640u * 480u);
+}
+
+TEST(SynthCli, WritesASceneSetWithManifest) {
+  test::TempDir dir;
+  const std::string set_dir = dir.file("val");
+  const Result r = run("--set val --count 2 --out-dir " + set_dir + " -q");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const std::string file :
+       {"val_0000.pcd", "val_0001.pcd", "val_manifest.json", "classes.txt"})
+    EXPECT_TRUE(std::filesystem::exists(set_dir + "/" + file)) << file;
+  EXPECT_EQ(read_cloud_tags(set_dir + "/val_0001.pcd").at("seed"), "2001");
+  std::ifstream in(set_dir + "/val_manifest.json");
+  std::stringstream manifest;
+  manifest << in.rdbuf();
+  EXPECT_NE(manifest.str().find("\"seed\": 2000"), std::string::npos) << manifest.str();
+  EXPECT_NE(manifest.str().find("\"label_radius\": 0.025"), std::string::npos);
+  EXPECT_EQ(read_class_map(set_dir + "/classes.txt").to_text(), ClassMap::taxonomy().to_text());
+}
+
+TEST(SynthCli, UsageErrorsExitWith2AndOneLine) {
+  for (const std::string args :
+       {"--scene table", "--sensor lidar -o x.pcd", "--radius -1 -o x.pcd", "--set train -o x.pcd",
+        "--set train --out-dir d", "--count 3 -o x.pcd", "--scene kitchen -o x.pcd",
+        "--seed x -o x.pcd"}) {
+    const Result r = run(args);
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.output;
+    EXPECT_EQ(lines(r.output), 1) << args << ": " << r.output;
+    EXPECT_NE(r.output.find("primlabel-synth: usage error"), std::string::npos) << r.output;
+  }
+}
+
+TEST(SynthCli, UnwritableOutputExitsWith1NamingThePath) {
+  const Result r = run("--scene primitives --seed 1 -o /nonexistent/dir/out.pcd");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/dir/out.pcd"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace primlabel

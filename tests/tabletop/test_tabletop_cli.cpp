@@ -1,0 +1,91 @@
+// primlabel-tabletop as a user runs it: exit codes, one-line errors, the final JSON line.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+
+#include "../test_util.hpp"
+#include "primlabel/core/cloud_io.hpp"
+
+namespace primlabel {
+namespace {
+
+struct Result {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+Result run(const std::string& arguments) {
+  Result result{-1, {}};
+  FILE* pipe = popen((test::binary("primlabel-tabletop") + " " + arguments + " 2>&1").c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::string last_line(const std::string& text) {
+  std::string trimmed = text;
+  while (!trimmed.empty() && trimmed.back() == '\n') trimmed.pop_back();
+  return trimmed.substr(trimmed.rfind('\n') + 1);
+}
+
+TEST(TabletopCli, UsageErrorsExitTwo) {
+  EXPECT_EQ(run("").exit_code, 2);
+  EXPECT_EQ(run("x.pcd --cluster-tolerance -1").exit_code, 2);
+  const Result r = run("x.pcd --up 0,0,0");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find("usage error"), std::string::npos) << r.output;
+}
+
+TEST(TabletopCli, UnreadableFileExitsOne) {
+  const Result r = run("/nonexistent/scan.pcd");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("primlabel-tabletop: error:"), std::string::npos) << r.output;
+}
+
+TEST(TabletopCli, AllNanCloudGivesAClearResult) {
+  test::TempDir dir;
+  PointCloud cloud;
+  cloud.xyz.assign(64 * 48, Vec3f::Constant(std::numeric_limits<float>::quiet_NaN()));
+  cloud.width = 64;
+  cloud.height = 48;
+  const std::string path = dir.file("nan.pcd");
+  write_pcd(path, cloud);
+  const Result r = run(path + " --json");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("\"status\":\"no_valid_points\""), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no point has finite coordinates"), std::string::npos) << r.output;
+}
+
+TEST(TabletopCli, EvalWithoutLabelsFails) {
+  test::TempDir dir;
+  const std::string path = dir.file("plane.pcd");
+  write_pcd(path, test::plane_grid(0, 0, 0.5f, 0.01f));
+  const Result r = run(path + " --eval");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("no 'label' field"), std::string::npos) << r.output;
+}
+
+TEST(TabletopCli, EvalJsonOnAnMosdScene) {
+  const std::string scene = test::shared_data("mosd/learn0.pcd");
+  if (!std::filesystem::exists(scene)) GTEST_SKIP() << scene << " not present";
+  test::TempDir dir;
+  const std::string png = dir.file("learn0.png");
+  const Result r = run(scene + " --eval --json --threads 2 --png " + png);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string json = last_line(r.output);
+  ASSERT_EQ(json.front(), '{') << r.output;
+  for (const char* key : {"table_precision", "table_recall", "table_f1", "mean_object_iou",
+                          "objects_found", "objects_true", "ms"})
+    EXPECT_NE(json.find("\"" + std::string(key) + "\":"), std::string::npos) << key << ": " << json;
+  EXPECT_GT(std::filesystem::file_size(png), 1000u);
+}
+
+}  // namespace
+}  // namespace primlabel

