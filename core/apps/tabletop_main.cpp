@@ -127,7 +127,7 @@ int run(const Arguments& args) {
   const TabletopTimings& t = result.timings;
   json << ",\"ms\":" << t.total_ms << ",\"ms_prepare\":" << t.prepare_ms
        << ",\"ms_plane\":" << t.plane_ms << ",\"ms_table\":" << t.table_ms
-       << ",\"ms_objects\":" << t.objects_ms << "}";
+       << ",\"ms_objects\":" << t.objects_ms << ",\"ms_refine\":" << t.refine_ms << "}";
 
   if (!args.png.empty()) {
     render(cloud, result, args, title);
@@ -179,6 +179,9 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--min-cluster-size", min_size, "smallest object (points)");
   app.add_option("--max-cluster-size", max_size, "largest object (points)");
+  bool no_split = false, no_merge = false;
+  app.add_flag("--no-split", no_split, "keep objects standing on objects in one cluster");
+  app.add_flag("--no-merge", no_merge, "do not join parts of objects cut apart by occlusion");
   app.add_option("--voxel-leaf", o.voxel_leaf, "fit and cluster on voxel centroids (m; 0 = off)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--seed", o.seed, "RANSAC seed");
@@ -194,6 +197,8 @@ int main(int argc, char** argv) {
     return cli::kExitUsage;
   }
   try {
+    o.split.enabled = !no_split;
+    o.merge.enabled = !no_merge;
     o.clusters.min_size = min_size;
     o.clusters.max_size = max_size;
     if (!args.up.empty()) {

@@ -1,8 +1,9 @@
 // Building blocks of the table-top filter on synthetic data: voxel grid, plane fit, convex hull,
-// Euclidean clustering.
+// Euclidean clustering, the table-plane grid.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -10,6 +11,7 @@
 #include "primlabel/tabletop/convex_hull.hpp"
 #include "primlabel/tabletop/euclidean_clusters.hpp"
 #include "primlabel/tabletop/plane_fit.hpp"
+#include "primlabel/tabletop/plane_grid.hpp"
 #include "primlabel/tabletop/voxel_grid.hpp"
 
 namespace primlabel::tabletop {
@@ -211,6 +213,68 @@ TEST(TabletopClusters, ToleranceIsExact) {
   for (int i = 0; i < 50; ++i) chain.emplace_back(0.0099f * i, 0.0005f * (i % 3), 0.0f);
   EXPECT_EQ(euclidean_clusters(chain, all_indices(50), {0.010f, 1, SIZE_MAX}).size(), 1u);
   EXPECT_EQ(euclidean_clusters(chain, all_indices(50), {0.0098f, 1, SIZE_MAX}).size(), 50u);
+}
+
+TEST(TabletopPlaneGrid, PartsAreConnectedThroughNeighbouringCells) {
+  // Two 20 cm patches of the plane z = 0, 5 mm apart, and a third 3 cm away; cells of 1 cm.
+  std::vector<Vec3f> points;
+  for (float x = 0; x < 0.2f; x += 0.004f)
+    for (float y = 0; y < 0.2f; y += 0.004f) {
+      points.emplace_back(x, y, 0.0f);
+      points.emplace_back(x + 0.205f, y, 0.001f);
+      points.emplace_back(x + 0.44f, y, -0.001f);
+    }
+  const PlaneGrid grid(points, all_indices(points.size()), Eigen::Vector4f(0, 0, 1, 0), 0.01f);
+  const auto parts = grid.connected_parts();
+  ASSERT_EQ(parts.size(), 2u);
+  EXPECT_EQ(parts[0].size(), 2 * parts[1].size());
+  EXPECT_TRUE(std::is_sorted(parts[0].begin(), parts[0].end()));
+  EXPECT_EQ(parts[1].front(), 2u);  // the far patch's first point
+  EXPECT_THROW(PlaneGrid(points, {}, Eigen::Vector4f(0, 0, 1, 0), 0.0f), std::invalid_argument);
+}
+
+TEST(TabletopPlaneGrid, LocalNormalsTellASurfaceFromASlice) {
+  std::mt19937 rng(5);
+  std::vector<Vec3f> points;
+  add_patch(points, Vec3f(0, 0, 0), Vec3f::UnitX(), Vec3f::UnitY(), 0.3f, 0.003f, 0.001f, rng);
+  const std::size_t floor_points = points.size();
+  // A wall x = 0.5 cut by the band |z| <= 1 cm: a strip whose points face sideways.
+  for (float y = 0; y < 0.3f; y += 0.003f)
+    for (float z = -0.01f; z <= 0.01f; z += 0.002f) points.emplace_back(0.5f, y, z);
+  const PlaneGrid grid(points, all_indices(points.size()), Eigen::Vector4f(0, 0, 1, 0), 0.01f);
+  std::vector<std::uint32_t> floor(floor_points), wall;
+  for (std::uint32_t i = 0; i < floor_points; ++i) floor[i] = i;
+  for (std::uint32_t i = floor_points; i < points.size(); ++i) wall.push_back(i);
+  EXPECT_GT(grid.fraction_parallel(floor, 20.0f), 0.99);
+  EXPECT_LT(grid.fraction_parallel(wall, 20.0f), 0.01);
+  EXPECT_EQ(grid.fraction_parallel({}, 20.0f), 0.0);
+}
+
+TEST(TabletopPlaneGrid, HullCandidatesKeepTheHullAndCountInsideSkipsFootprints) {
+  std::mt19937 rng(6);
+  std::vector<Vec3f> points;
+  add_patch(points, Vec3f(0, 0, 0), Vec3f::UnitX(), Vec3f::UnitY(), 0.5f, 0.004f, 0.001f, rng);
+  const auto all = all_indices(points.size());
+  const PlaneGrid grid(points, all, Eigen::Vector4f(0, 0, 1, 0), 0.01f);
+  std::vector<Vec2f> projected;
+  for (const Vec3f& p : points) projected.push_back(grid.project(p));
+  const std::vector<Vec2f> candidates = grid.hull_candidates(all);
+  EXPECT_LT(candidates.size(), points.size() / 5);
+  EXPECT_EQ(convex_hull(candidates), convex_hull(projected));
+
+  // A 10 cm square over the patch's middle, in plane coordinates.
+  const Vec2f centre = grid.project(Vec3f(0.25f, 0.25f, 0));
+  const std::vector<Vec2f> square =
+      convex_hull({centre + Vec2f(-0.05f, -0.05f), centre + Vec2f(0.05f, -0.05f),
+                   centre + Vec2f(0.05f, 0.05f), centre + Vec2f(-0.05f, 0.05f)});
+  const std::size_t inside = grid.count_inside(square, 0.0f);
+  EXPECT_NEAR(double(inside), 0.01 / (0.004 * 0.004), 0.15 * 0.01 / (0.004 * 0.004));
+  EXPECT_LT(grid.count_inside(square, 0.02f), inside / 2);  // shrunk to 6 x 6 cm
+  // Cells under an object standing on the middle are not counted.
+  std::vector<std::uint32_t> middle;
+  for (std::uint32_t i : all)
+    if ((grid.project(points[i]) - centre).cwiseAbs().maxCoeff() < 0.05f) middle.push_back(i);
+  EXPECT_EQ(grid.count_inside(square, 0.0f, grid.footprint(points, middle, 1)), 0u);
 }
 
 }  // namespace

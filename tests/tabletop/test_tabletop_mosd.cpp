@@ -54,13 +54,8 @@ TEST_P(MosdObjects, MeanObjectIouAtLeast090) {
       << "; best IoU per object:" << per_object;
 }
 
-INSTANTIATE_TEST_SUITE_P(Mosd, MosdObjects, ::testing::Values("learn0"));
-// Not met yet (issue [4/7] stays open): Euclidean clustering cannot join an object split by a
-// nearer occluder (learn18, learn28), the inside and outside of rimless bowls/pots (learn36), or
-// separate a can standing on a tin (learn42); PCL's clustering scores the same. Enable these when
-// the segmentation handles occlusion splits and stacked objects.
-INSTANTIATE_TEST_SUITE_P(DISABLED_NotYetMet, MosdObjects,
-                         ::testing::Values("learn18", "learn28", "learn36", "learn42"));
+INSTANTIATE_TEST_SUITE_P(Mosd, MosdObjects,
+                         ::testing::Values("learn0", "learn18", "learn28", "learn36", "learn42"));
 
 TEST(MosdDeterminism, SameResultForOneAndTwoThreads) {
   const std::string path = mosd("learn36");

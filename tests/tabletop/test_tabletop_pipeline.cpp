@@ -110,6 +110,54 @@ TEST(TabletopPipeline, EstimatedUpFindsTheTableFromATiltedSensor) {
   EXPECT_GT(scores.mean_object_iou, 0.95);
 }
 
+// The sensor's pose turns its up (-y of the camera) into +z.
+Viewpoint upright_sensor(const Vec3f& origin) {
+  Viewpoint viewpoint;
+  viewpoint.origin = origin;
+  viewpoint.orientation = Eigen::AngleAxisf(-float(M_PI) / 2, Vec3f::UnitX());
+  return viewpoint;
+}
+
+TEST(TabletopPipeline, SensorPoseGivesTheUpAxis) {
+  PointCloud cloud = synthetic_scene();
+  cloud.viewpoint = upright_sensor(cloud.viewpoint.origin);
+  TabletopOptions options;
+  options.up_source = UpAxisSource::kSensor;
+  options.threads = 2;
+  const TabletopResult result = segment_tabletop(cloud, options);
+  ASSERT_TRUE(result.ok()) << result.message;
+  EXPECT_GT(result.up.z(), 0.9999f);
+  const SegmentationScores scores = evaluate_segmentation(cloud, result);
+  EXPECT_GT(scores.table_f1, 0.99);
+  EXPECT_GT(scores.mean_object_iou, 0.95);
+}
+
+TEST(TabletopPipeline, APlaneSlicingThroughWallsIsNotATable) {
+  // A room's four walls and nothing horizontal: within 15 deg of the sensor's up, the best plane
+  // is a horizontal slice through the walls - a wide ring of points, dense and two-dimensional
+  // in extent, but every one of them on a wall.
+  PointCloud room;
+  for (float s = 0; s < 2.0f; s += 0.01f)
+    for (float z = 0; z < 1.0f; z += 0.01f) {
+      room.xyz.emplace_back(s, 0.0f, z);
+      room.xyz.emplace_back(s, 2.0f, z);
+      room.xyz.emplace_back(0.0f, s, z);
+      room.xyz.emplace_back(2.0f, s, z);
+    }
+  room.width = static_cast<std::uint32_t>(room.size());
+  room.viewpoint = upright_sensor(Vec3f(1.0f, 1.0f, 1.5f));
+  TabletopOptions options;
+  options.up_source = UpAxisSource::kSensor;
+  options.threads = 2;
+  const TabletopResult result = segment_tabletop(room, options);
+  EXPECT_EQ(result.status, TabletopStatus::kPlaneNotHorizontal) << result.message;
+  EXPECT_NE(result.message.find("slice"), std::string::npos) << result.message;
+  EXPECT_NEAR(result.tilt_deg, 90.0f, 1.0f);  // the dominant plane: a wall
+  EXPECT_TRUE(result.table_inliers.empty());
+  options.min_table_parallel = 0.0f;  // without the check the slice passes for a table
+  EXPECT_TRUE(segment_tabletop(room, options).ok());
+}
+
 TEST(TabletopPipeline, VoxelGridGivesTheSameSegmentation) {
   const PointCloud cloud = synthetic_scene();
   TabletopOptions options = given_up_options();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -21,13 +22,17 @@ void OcclusionMergeOptions::validate() const {
   if (!non_negative(max_gap)) fail("occlusion merge max gap must be >= 0");
   if (!non_negative(footprint_margin)) fail("occlusion merge footprint margin must be >= 0");
   if (!non_negative(max_table_fraction)) fail("occlusion merge max table fraction must be >= 0");
+  if (!non_negative(max_chromaticity_difference))
+    fail("occlusion merge max chromaticity difference must be >= 0");
 }
 
 namespace {
 
 struct Link {
-  int scanlines = 0;
+  int across_occluder = 0;  // scanlines with pixels of a nearer surface between the two ends
+  int adjacent = 0;         // scanlines where one end itself hides the other's continuation
   float gap = std::numeric_limits<float>::infinity();  // smallest 3D distance of linked ends
+  int scanlines() const { return across_occluder + adjacent; }
 };
 
 // Finds, along image rows and columns, pairs of clusters separated only by occluding pixels.
@@ -72,29 +77,35 @@ class LinkScanner {
         if (y == x) break;
         if (y >= 0 && std::find(found.begin(), found.end(), y) == found.end()) {
           found.push_back(y);
-          if (occluded_between(start, step, s, t)) add_link(y, x, q, p);
+          const Gap gap = classify_gap(start, step, s, t);
+          if (gap != Gap::kFreeSpace) add_link(y, x, q, p, gap == Gap::kOccluder);
         }
         if (!std::isnan(range_[q]) && !(range_[q] < range_[p] - options_.depth_margin)) break;
       }
     }
   }
 
-  // True when every valid pixel strictly between s and t is nearer than the straight line
-  // between the ranges at s and t, by depth_margin.
-  bool occluded_between(std::size_t start, std::size_t step, std::size_t s, std::size_t t) const {
+  enum class Gap { kFreeSpace, kAdjacent, kOccluder };
+
+  // kOccluder when the pixels strictly between s and t include valid ones and every valid one is
+  // nearer than the straight line between the ranges at s and t by depth_margin; kAdjacent when
+  // there is no valid pixel between them; kFreeSpace otherwise.
+  Gap classify_gap(std::size_t start, std::size_t step, std::size_t s, std::size_t t) const {
     const float rs = range_[pixel(start, step, s)], rt = range_[pixel(start, step, t)];
+    bool occluder = false;
     for (std::size_t k = s + 1; k < t; ++k) {
       const float r = range_[pixel(start, step, k)];
       if (std::isnan(r)) continue;
       const float line = rs + (rt - rs) * float(k - s) / float(t - s);
-      if (!(r < line - options_.depth_margin)) return false;
+      if (!(r < line - options_.depth_margin)) return Gap::kFreeSpace;
+      occluder = true;
     }
-    return true;
+    return occluder ? Gap::kOccluder : Gap::kAdjacent;
   }
 
-  void add_link(std::int32_t a, std::int32_t b, std::size_t pa, std::size_t pb) {
+  void add_link(std::int32_t a, std::int32_t b, std::size_t pa, std::size_t pb, bool occluder) {
     Link& link = links_[{std::min(a, b), std::max(a, b)}];
-    ++link.scanlines;
+    ++(occluder ? link.across_occluder : link.adjacent);
     link.gap = std::min(link.gap, (cloud_.xyz[pa] - cloud_.xyz[pb]).norm());
   }
 
@@ -104,6 +115,23 @@ class LinkScanner {
   std::vector<float> range_;
   std::map<std::pair<std::int32_t, std::int32_t>, Link> links_;
 };
+
+// Mean chromaticity (r, g) / (r + g + b) of the cluster's pixels that are not too dark to tell:
+// the surface's material, largely independent of its shading. NaN without colour.
+Eigen::Vector2f chromaticity(const std::vector<std::uint32_t>& cluster, const PointCloud& cloud) {
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  std::size_t counted = 0;
+  if (cloud.has_rgba())
+    for (std::uint32_t i : cluster) {
+      const std::uint32_t c = cloud.rgba[i];
+      const double r = (c >> 16) & 0xFF, g = (c >> 8) & 0xFF, b = c & 0xFF;
+      if (r + g + b < 60.0) continue;
+      sum += Eigen::Vector2d(r, g) / (r + g + b);
+      ++counted;
+    }
+  if (counted == 0) return Eigen::Vector2f::Constant(std::numeric_limits<float>::quiet_NaN());
+  return (sum / double(counted)).cast<float>();
+}
 
 // The height below which 99% of the cluster's points lie: the top, robust to flying pixels.
 float top_height(const std::vector<std::uint32_t>& cluster, const std::vector<float>& height) {
@@ -132,20 +160,26 @@ std::vector<std::vector<std::uint32_t>> merge_occluded(
 
   std::vector<std::pair<std::pair<std::int32_t, std::int32_t>, Link>> links;
   for (const auto& entry : LinkScanner(cloud, clusters, options).scan())
-    if (entry.second.scanlines >= options.min_scanlines) links.push_back(entry);
+    if (entry.second.scanlines() >= options.min_scanlines) links.push_back(entry);
   std::stable_sort(links.begin(), links.end(), [](const auto& a, const auto& b) {
-    return a.second.scanlines > b.second.scanlines;
+    return a.second.scanlines() > b.second.scanlines();
   });
 
-  // Groups of joined clusters: root, top height, footprint hull and point count.
+  // Table cells this close to a part count as under it.
+  const int under_cells = static_cast<int>(std::ceil(options.footprint_margin / table.cell()));
+  // Groups of joined clusters: root, top height, footprint (cells and hull) and point count.
   const std::size_t n = clusters.size();
   std::vector<std::uint32_t> root(n);
   std::vector<float> top(n);
+  std::vector<std::vector<std::uint64_t>> cells(n);
   std::vector<std::vector<Vec2f>> hull(n);
   std::vector<std::size_t> count(n);
+  std::vector<Eigen::Vector2f> colour(n);  // per cluster, not per group: the linked surfaces'
   for (std::size_t k = 0; k < n; ++k) {
+    colour[k] = chromaticity(clusters[k], cloud);
     root[k] = static_cast<std::uint32_t>(k);
     top[k] = top_height(clusters[k], height);
+    cells[k] = table.footprint(cloud.xyz, clusters[k], under_cells);
     std::vector<Vec2f> footprint;
     footprint.reserve(clusters[k].size());
     for (std::uint32_t i : clusters[k]) footprint.push_back(table.project(cloud.xyz[i]));
@@ -160,15 +194,27 @@ std::vector<std::vector<std::uint32_t>> merge_occluded(
     const std::uint32_t a = find(pair.first), b = find(pair.second);
     if (a == b || std::abs(top[a] - top[b]) > options.top_tolerance || link.gap > options.max_gap)
       continue;
+    // Without a separate occluder, neighbouring objects look the same: ask for one material.
+    const float colour_difference = (colour[pair.first] - colour[pair.second]).norm();
+    if (link.across_occluder < options.min_scanlines &&
+        colour_difference > options.max_chromaticity_difference)
+      continue;
     std::vector<Vec2f> joint = hull[a];
     joint.insert(joint.end(), hull[b].begin(), hull[b].end());
     joint = convex_hull(std::move(joint));
-    const std::size_t table_inside = table.count_inside(joint, options.footprint_margin);
+    // Table seen where neither part is above it: free space between them. (Table under a part,
+    // e.g. beside a bowl's foot under its overhanging rim, says nothing.)
+    std::vector<std::uint64_t> joint_cells;
+    std::merge(cells[a].begin(), cells[a].end(), cells[b].begin(), cells[b].end(),
+               std::back_inserter(joint_cells));
+    const std::size_t table_inside =
+        table.count_inside(joint, options.footprint_margin, joint_cells);
     if (double(table_inside) > options.max_table_fraction * double(count[a] + count[b])) continue;
     const std::uint32_t kept = std::min(a, b), gone = std::max(a, b);
     root[gone] = kept;
     top[kept] = std::max(top[a], top[b]);
     hull[kept] = std::move(joint);
+    cells[kept] = std::move(joint_cells);
     count[kept] += count[gone];
   }
 

@@ -63,7 +63,8 @@ class Splitter {
     for (std::uint32_t i : cluster) ++counts[bin_of(height_[i])];
     std::vector<std::size_t> sorted = counts;
     std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-    const double peak = options_.peak_factor * double(std::max<std::size_t>(sorted[sorted.size() / 2], 1));
+    const double peak =
+        options_.peak_factor * double(std::max<std::size_t>(sorted[sorted.size() / 2], 1));
 
     for (std::size_t b = 0; b < counts.size();) {
       if (double(counts[b]) < peak ||
@@ -73,8 +74,9 @@ class Splitter {
       }
       std::size_t e = b;  // the surface's band: the run of peak bins [b, e)
       while (e < counts.size() && double(counts[e]) >= peak) ++e;
-      const float band_low = lowest + float(b) * options_.bin;
-      const float band_top = lowest + float(e) * options_.bin;
+      // One more bin either side takes in the surface's noise and slight tilt.
+      const float band_low = lowest + (float(b) - 1.0f) * options_.bin;
+      const float band_top = lowest + (float(e) + 1.0f) * options_.bin;
       if (try_split(cluster, band_low, band_top, highest, lower, upper)) return true;
       b = e;
     }

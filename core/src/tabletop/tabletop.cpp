@@ -224,10 +224,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
 
   Vec3f u, v;
   plane_basis(plane.head<3>(), u, v);
-  std::vector<Vec2f> projected;
-  projected.reserve(result.table_inliers.size());
-  for (std::uint32_t i : result.table_inliers) projected.emplace_back(xyz[i].dot(u), xyz[i].dot(v));
-  const std::vector<Vec2f> hull = convex_hull(std::move(projected));
+  const std::vector<Vec2f> hull = convex_hull(band_grid.hull_candidates(result.table_inliers));
   const Vec3f on_plane = -plane[3] * plane.head<3>();
   for (const Vec2f& q : hull) result.hull.push_back(on_plane + q.x() * u + q.y() * v);
   result.timings.table_ms = ms_since(table_start);
@@ -238,7 +235,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   std::vector<std::uint32_t> candidates;
   for (std::uint32_t i : valid) {
     if (is_table[i] || height[i] < min_height || height[i] > options.max_object_height) continue;
-    if (hull_contains(hull, Vec2f(xyz[i].dot(u), xyz[i].dot(v)), options.hull_margin))
+    if (hull_contains(hull, band_grid.project(xyz[i]), options.hull_margin))
       candidates.push_back(i);
   }
   if (voxelized) {
@@ -259,11 +256,8 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   // parts can still be joined to what remains of it.
   const auto refine_start = Clock::now();
   result.clusters = split_stacked(xyz, height, plane, std::move(result.clusters), options.split);
-  if (options.merge.enabled && cloud.organized() && result.clusters.size() > 1) {
-    const PlaneGrid table_grid(xyz, result.table_inliers, plane, options.table_connectivity);
-    result.clusters =
-        merge_occluded(cloud, height, table_grid, std::move(result.clusters), options.merge);
-  }
+  result.clusters =
+      merge_occluded(cloud, height, band_grid, std::move(result.clusters), options.merge);
   result.timings.refine_ms = ms_since(refine_start);
   result.timings.objects_ms = ms_since(objects_start);
 

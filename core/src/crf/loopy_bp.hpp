@@ -1,0 +1,67 @@
+#pragma once
+// Loopy belief propagation with associative pairwise potentials in O(K) per message, on a
+// synchronous schedule: every iteration computes all new messages from the previous ones, each
+// directed slot written by exactly one node, so any thread count gives the same messages.
+//
+// Messages are float, normalised to max 1 and floored at kMessageFloor; the belief products are
+// double (a node of degree 20 multiplies 20 messages). The message on slot p of row i is
+// m_{i -> neighbors[p]}. The messages persist between runs, so training can warm-start.
+
+#include <vector>
+
+#include "potentials.hpp"
+
+namespace primlabel::crf::detail {
+
+inline constexpr float kMessageFloor = 1e-30f;
+inline constexpr int kMaxBpClasses = 256;
+
+struct BpSettings {
+  bool max_product = false;
+  int max_iterations = 30;
+  float damping = 0.5f;
+  float tolerance = 1e-3f;
+  int threads = 1;
+};
+
+struct BpRun {
+  int iterations = 0;
+  bool converged = false;
+  float final_change = 0.0f;
+};
+
+// phi_i(k) = exp(theta_i(k) - max_k theta_i(k)): num_nodes x K, max 1 per row.
+RowMatrixXd node_potentials(const RowMatrixXf& node_scores, int threads);
+
+// Turns theta_ij(k, k) into psi_ij(k) - 1 = exp(theta_ij(k, k)) - 1, in place (theta is capped
+// at 60 so psi stays far from float overflow).
+void edge_scores_to_potentials_minus_one(RowMatrixXf& edge_scores, int threads);
+
+class LoopyBp {
+ public:
+  LoopyBp(const Graph& graph, int num_classes);
+
+  // Sets every message to 1 (uniform).
+  void reset();
+
+  // Iterates until the largest message change is below the tolerance or max_iterations.
+  BpRun run(const RowMatrixXd& phi, const RowMatrixXf& psi_minus_one, const BpSettings& settings);
+
+  // b_i(k) ∝ phi_i(k) prod_j m_{j->i}(k), rows normalised to sum 1; inactive rows are zero.
+  RowMatrixXd beliefs(const RowMatrixXd& phi, int threads) const;
+
+  // All messages (slot-major), e.g. to restore a state after a run that did not converge.
+  const std::vector<float>& messages() const { return messages_; }
+  void set_messages(const std::vector<float>& messages) { messages_ = messages; }
+
+  // Message m_{i -> neighbors[p]} for slot p.
+  const float* message(std::size_t slot) const { return messages_.data() + slot * num_classes_; }
+
+ private:
+  const Graph& graph_;
+  int num_classes_;
+  std::vector<float> messages_;
+  std::vector<float> next_;
+};
+
+}  // namespace primlabel::crf::detail

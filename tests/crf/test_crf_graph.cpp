@@ -1,0 +1,127 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "primlabel/crf/graph.hpp"
+
+namespace primlabel::crf {
+namespace {
+
+std::vector<Vec3f> line_points(int n) {
+  std::vector<Vec3f> points(n);
+  for (int i = 0; i < n; ++i) points[i] = Vec3f(float(i), 0.1f * float(i % 3), 0.0f);
+  return points;
+}
+
+void expect_well_formed(const Graph& g) {
+  ASSERT_EQ(g.offsets.size(), g.num_nodes() + 1);
+  ASSERT_EQ(g.reverse.size(), g.num_slots());
+  for (std::size_t i = 0; i < g.num_nodes(); ++i) {
+    const auto row = g.neighbors_of(i);
+    EXPECT_TRUE(std::is_sorted(row.begin(), row.end()));
+    EXPECT_EQ(std::adjacent_find(row.begin(), row.end()), row.end());
+    if (!g.active[i]) {
+      EXPECT_EQ(row.size(), 0u);
+    }
+    for (std::uint32_t p = g.offsets[i]; p < g.offsets[i + 1]; ++p) {
+      const std::uint32_t j = g.neighbors[p];
+      EXPECT_NE(j, i);
+      EXPECT_TRUE(g.active[j]);
+      const std::uint32_t r = g.reverse[p];
+      EXPECT_EQ(g.neighbors[r], i);  // the opposite slot lives in row j and points back at i
+      EXPECT_GE(r, g.offsets[j]);
+      EXPECT_LT(r, g.offsets[j + 1]);
+      EXPECT_EQ(g.reverse[r], p);
+    }
+  }
+}
+
+TEST(CrfGraph, KnnIsSymmetricWithoutSelfLoops) {
+  const auto points = line_points(50);
+  const std::vector<float> descriptors(50 * 2, 1.0f);
+  GraphOptions options;
+  options.neighborhood = Neighborhood::Knn(4);
+  const Graph g = build_graph(points, descriptors, 2, options);
+  expect_well_formed(g);
+  EXPECT_EQ(g.num_active(), 50u);
+  for (std::size_t i = 0; i < 50; ++i) EXPECT_GE(g.degree(i), 4u);
+  // On a line the 4 nearest are the two on either side (union adds no more in the interior).
+  EXPECT_EQ(std::vector<std::uint32_t>(g.neighbors_of(10).begin(), g.neighbors_of(10).end()),
+            (std::vector<std::uint32_t>{8, 9, 11, 12}));
+}
+
+TEST(CrfGraph, RadiusAndHybrid) {
+  const auto points = line_points(30);
+  const std::vector<float> descriptors(30, 0.0f);  // all-zero descriptors are valid
+  GraphOptions options;
+  options.neighborhood = Neighborhood::Radius(1.5f);
+  const Graph g = build_graph(points, descriptors, 1, options);
+  expect_well_formed(g);
+  EXPECT_EQ(g.degree(0), 1u);
+  EXPECT_EQ(g.degree(15), 2u);
+  options.neighborhood = Neighborhood::Hybrid(10.0f, 2);
+  const Graph h = build_graph(points, descriptors, 1, options);
+  expect_well_formed(h);
+  for (std::size_t i = 0; i < 30; ++i) EXPECT_GE(h.degree(i), 2u);
+}
+
+TEST(CrfGraph, InvalidPointsAreInactiveAndIsolated) {
+  auto points = line_points(20);
+  std::vector<float> descriptors(20 * 3, 5.0f);
+  descriptors[4 * 3 + 1] = std::nanf("");
+  points[9] = Vec3f::Constant(std::nanf(""));
+  GraphOptions options;
+  options.neighborhood = Neighborhood::Knn(2);
+  const Graph g = build_graph(points, descriptors, 3, options);
+  expect_well_formed(g);
+  EXPECT_FALSE(g.active[4]);
+  EXPECT_FALSE(g.active[9]);
+  EXPECT_EQ(g.num_active(), 18u);
+  // The nearest valid neighbours skip the invalid point 4.
+  for (std::uint32_t j : g.neighbors_of(3)) EXPECT_NE(j, 4u);
+}
+
+TEST(CrfGraph, DeterministicForAnyThreadsAndWithOrWithoutSearch) {
+  std::vector<Vec3f> points;
+  for (int i = 0; i < 2000; ++i)
+    points.emplace_back(std::sin(0.37f * i) * 3.0f, std::cos(0.11f * i) * 2.0f, 0.001f * i);
+  const std::vector<float> descriptors(points.size() * 2, 1.0f);
+  GraphOptions options;
+  options.threads = 1;
+  const Graph one = build_graph(points, descriptors, 2, options);
+  options.threads = 2;
+  const Graph two = build_graph(points, descriptors, 2, options);
+  const NeighborSearch search(points);
+  const Graph reused = build_graph(points, descriptors, 2, options, &search);
+  expect_well_formed(one);
+  EXPECT_EQ(one.offsets, two.offsets);
+  EXPECT_EQ(one.neighbors, two.neighbors);
+  EXPECT_EQ(one.neighbors, reused.neighbors);
+  EXPECT_EQ(one.reverse, reused.reverse);
+}
+
+TEST(CrfGraph, FromEdgesAndRestrict) {
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>> edges = {{0, 1}, {1, 0}, {1, 2},
+                                                                      {2, 2}, {2, 3}, {3, 4}};
+  const Graph g = graph_from_edges(5, edges);
+  expect_well_formed(g);
+  EXPECT_EQ(g.num_edges(), 4u);  // duplicate and self loop dropped
+  const std::vector<std::uint8_t> keep = {1, 1, 0, 1, 1};
+  const Graph r = restrict_graph(g, keep);
+  expect_well_formed(r);
+  EXPECT_EQ(r.num_edges(), 2u);  // 0-1 and 3-4
+  EXPECT_FALSE(r.active[2]);
+  EXPECT_THROW(graph_from_edges(2, std::vector<std::pair<std::uint32_t, std::uint32_t>>{{0, 5}}),
+               std::invalid_argument);
+}
+
+TEST(CrfGraph, Empty) {
+  const Graph g = build_graph({}, {}, 33);
+  EXPECT_EQ(g.num_nodes(), 0u);
+  EXPECT_EQ(g.num_slots(), 0u);
+  EXPECT_EQ(g.offsets.size(), 1u);
+}
+
+}  // namespace
+}  // namespace primlabel::crf

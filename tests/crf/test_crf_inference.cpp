@@ -1,0 +1,205 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "brute_force.hpp"
+#include "primlabel/crf/inference.hpp"
+#include "synthetic.hpp"
+
+namespace primlabel::crf {
+namespace {
+
+using testing::SceneSpec;
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Prints (does not assert) the speed on a 70k-point kNN-8 graph with K = 10, d = 33.
+TEST(CrfInference, Speed70k) {
+  SceneSpec spec;
+  spec.width = 265;
+  spec.height = 265;
+  spec.num_classes = 10;
+  spec.noise = 40.0f;
+  const LabeledGraph scene = testing::make_grid_scene(spec);
+  const CrfModel model = testing::prototype_model(spec, 4.0f, 1.0f);
+  const std::size_t n = scene.graph.num_nodes();
+  std::printf("graph: %zu nodes, %zu edges\n", n, scene.graph.num_edges());
+  for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
+    for (const bool max_product : {false, true}) {
+      if (method == InferenceMethod::kMeanField && max_product) continue;
+      InferenceOptions options;
+      options.method = method;
+      options.max_product = max_product;
+      options.threads = 2;
+      const auto start = std::chrono::steady_clock::now();
+      const InferenceResult result = infer(model, scene.descriptors, scene.graph, options);
+      const double s = seconds_since(start);
+      std::size_t correct = 0;
+      for (std::size_t i = 0; i < n; ++i)
+        correct += result.labels[i] == std::uint32_t(scene.labels[i] + 1);
+      std::printf("%-10s %-11s %6.1f ms  %9.0f points/s  %2d iterations%s  accuracy %.3f\n",
+                  method == InferenceMethod::kLoopyBp ? "loopy-bp" : "mean-field",
+                  max_product ? "max-product" : "sum-product", 1e3 * s, n / s, result.iterations,
+                  result.converged ? " (converged)" : "", double(correct) / n);
+    }
+  }
+  CrfModel node_only = model;
+  node_only.edge_weights.setZero();
+  const InferenceResult plain = infer(node_only, scene.descriptors, scene.graph, {});
+  std::size_t correct = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    correct += plain.labels[i] == std::uint32_t(scene.labels[i] + 1);
+  std::printf("node-only accuracy %.3f\n", double(correct) / n);
+}
+
+// A random model with d = 3 and random descriptors: potentials with no special structure.
+struct TinyProblem {
+  CrfModel model;
+  std::vector<float> descriptors;
+  Graph graph;
+};
+
+TinyProblem tiny_problem(std::size_t n,
+                         const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
+                         int classes, std::uint32_t seed, float edge_strength) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  std::uniform_real_distribution<float> value(0.0f, 100.0f);
+  TinyProblem t;
+  std::vector<std::uint32_t> ids(classes);
+  for (int k = 0; k < classes; ++k) ids[k] = 10 + k;
+  t.model = CrfModel::zeros(ids, 3);
+  for (int k = 0; k < classes; ++k)
+    for (int f = 0; f < 4; ++f) {
+      t.model.node_weights(k, f) = 2.0f * uniform(rng);
+      t.model.edge_weights(k, f) = edge_strength * uniform(rng);
+    }
+  t.descriptors.resize(n * 3);
+  for (float& v : t.descriptors) v = value(rng);
+  t.graph = graph_from_edges(n, edges);
+  return t;
+}
+
+const std::vector<std::pair<std::uint32_t, std::uint32_t>> kTree = {{0, 1}, {1, 2}, {1, 3},
+                                                                    {3, 4}, {3, 5}, {0, 6}};
+const std::vector<std::pair<std::uint32_t, std::uint32_t>> kLoopy = {{0, 1}, {1, 2}, {2, 3},
+                                                                     {3, 0}, {0, 2}, {3, 4}};
+
+TEST(CrfInference, SumProductIsExactOnATree) {
+  for (std::uint32_t seed = 1; seed <= 5; ++seed) {
+    const TinyProblem t = tiny_problem(7, kTree, 3, seed, 2.0f);
+    const testing::Exact exact = testing::brute_force(t.model, t.descriptors, t.graph);
+    InferenceOptions options;
+    options.compute_marginals = true;
+    options.max_iterations = 200;
+    options.tolerance = 1e-7f;
+    const InferenceResult r = infer(t.model, t.descriptors, t.graph, options);
+    EXPECT_TRUE(r.converged);
+    for (std::size_t i = 0; i < 7; ++i)
+      for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(r.marginals(i, k), exact.marginals[i][k], 2e-5)
+            << "seed " << seed << " node " << i;
+  }
+}
+
+TEST(CrfInference, MaxProductFindsTheMapLabelling) {
+  for (const auto* edges : {&kTree, &kLoopy}) {
+    const std::size_t n = edges == &kTree ? 7 : 5;
+    for (std::uint32_t seed = 1; seed <= 8; ++seed) {
+      const TinyProblem t = tiny_problem(n, *edges, 3, seed, 2.0f);
+      const testing::Exact exact = testing::brute_force(t.model, t.descriptors, t.graph);
+      InferenceOptions options;
+      options.max_product = true;
+      options.max_iterations = 200;
+      options.tolerance = 1e-7f;
+      const InferenceResult r = infer(t.model, t.descriptors, t.graph, options);
+      for (std::size_t i = 0; i < n; ++i)
+        EXPECT_EQ(r.labels[i], t.model.class_ids[exact.map[i]])
+            << (edges == &kTree ? "tree" : "loopy") << " seed " << seed << " node " << i;
+    }
+  }
+}
+
+TEST(CrfInference, SameResultForAnyThreadCount) {
+  SceneSpec spec;
+  spec.width = 100;  // big enough that 3 threads really run (small graphs use one)
+  spec.height = 60;
+  spec.num_classes = 4;
+  const LabeledGraph scene = testing::make_grid_scene(spec);
+  const CrfModel model = testing::prototype_model(spec, 3.0f, 0.8f);
+  for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
+    for (const bool max_product : {false, true}) {
+      InferenceOptions options;
+      options.method = method;
+      options.max_product = max_product;
+      options.compute_marginals = true;
+      options.max_iterations = 15;
+      options.threads = 1;
+      const InferenceResult one = infer(model, scene.descriptors, scene.graph, options);
+      for (int threads : {2, 3}) {
+        options.threads = threads;
+        const InferenceResult many = infer(model, scene.descriptors, scene.graph, options);
+        EXPECT_EQ(one.labels, many.labels);
+        EXPECT_EQ(one.iterations, many.iterations);
+        EXPECT_TRUE(one.marginals.cwiseEqual(many.marginals).all());
+      }
+    }
+  }
+}
+
+TEST(CrfInference, PointsWithoutDescriptorGetTheUnknownLabel) {
+  SceneSpec spec;
+  spec.width = 20;
+  spec.height = 20;
+  std::vector<Vec3f> points;
+  LabeledGraph scene = testing::make_grid_scene(spec, &points);
+  for (std::size_t i : {0u, 57u, 222u}) scene.descriptors[i * spec.dim + 3] = std::nanf("");
+  points[300] = Vec3f::Constant(std::nanf(""));
+  const Graph graph = build_graph(points, scene.descriptors, spec.dim);
+  const CrfModel model = testing::prototype_model(spec, 3.0f, 1.0f);
+  for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
+    InferenceOptions options;
+    options.method = method;
+    options.unknown_label = 99;
+    options.compute_marginals = true;
+    const InferenceResult r = infer(model, scene.descriptors, graph, options);
+    for (std::size_t i = 0; i < r.labels.size(); ++i) {
+      const bool invalid = i == 0 || i == 57 || i == 222 || i == 300;
+      if (invalid) {
+        EXPECT_EQ(r.labels[i], 99u);
+        EXPECT_TRUE(r.marginals.row(i).array().isNaN().all());
+      } else {
+        EXPECT_NE(r.labels[i], 99u);
+        EXPECT_NEAR(r.marginals.row(i).sum(), 1.0f, 1e-5f);
+      }
+    }
+  }
+}
+
+TEST(CrfInference, EmptyGraphAndNodeOnlyModels) {
+  const CrfModel model = CrfModel::zeros({1, 2}, 4);
+  const Graph empty = graph_from_edges(0, {});
+  const InferenceResult r = infer(model, {}, empty, {});
+  EXPECT_TRUE(r.labels.empty());
+
+  // Without edge weights, inference is the per-node argmax.
+  SceneSpec spec;
+  spec.width = 10;
+  spec.height = 10;
+  const LabeledGraph scene = testing::make_grid_scene(spec);
+  CrfModel node_only = testing::prototype_model(spec, 3.0f, 0.0f);
+  const InferenceResult plain = infer(node_only, scene.descriptors, scene.graph, {});
+  const Graph no_edges = graph_from_edges(scene.graph.num_nodes(), {});
+  CrfModel coupled = testing::prototype_model(spec, 3.0f, 5.0f);
+  EXPECT_EQ(infer(coupled, scene.descriptors, no_edges, {}).labels, plain.labels);
+
+  EXPECT_THROW(infer(model, std::vector<float>(3), empty, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace primlabel::crf

@@ -1,0 +1,195 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <sstream>
+
+#include "brute_force.hpp"
+#include "crf/objectives.hpp"  // white-box: the objectives behind train_crf
+#include "primlabel/crf/inference.hpp"
+#include "primlabel/crf/training.hpp"
+#include "synthetic.hpp"
+
+namespace primlabel::crf {
+namespace {
+
+using testing::SceneSpec;
+
+std::vector<std::uint32_t> ids(int k) {
+  std::vector<std::uint32_t> v(k);
+  for (int i = 0; i < k; ++i) v[i] = i + 1;
+  return v;
+}
+
+Eigen::VectorXd random_parameters(Eigen::Index size, std::uint32_t seed, double scale) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-scale, scale);
+  Eigen::VectorXd x(size);
+  for (Eigen::Index i = 0; i < size; ++i) x(i) = u(rng);
+  return x;
+}
+
+// Largest |analytic - central difference| over every coordinate.
+double gradient_error(detail::Objective& objective, const Eigen::VectorXd& x, double h) {
+  Eigen::VectorXd grad(x.size()), scratch(x.size());
+  objective.evaluate(x, grad);
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < x.size(); ++i) {
+    Eigen::VectorXd plus = x, minus = x;
+    plus(i) += h;
+    minus(i) -= h;
+    const double fd =
+        (objective.evaluate(plus, scratch) - objective.evaluate(minus, scratch)) / (2 * h);
+    worst = std::max(worst, std::abs(fd - grad(i)));
+  }
+  return worst;
+}
+
+LabeledGraph small_scene(std::uint32_t seed, int width = 12, int height = 10) {
+  SceneSpec spec;
+  spec.width = width;
+  spec.height = height;
+  spec.num_classes = 3;
+  spec.dim = 5;
+  spec.region = 4;
+  spec.seed = seed;
+  LabeledGraph scene = testing::make_grid_scene(spec);
+  for (std::size_t i = 0; i < scene.labels.size(); i += 7) scene.labels[i] = kIgnoreLabel;
+  return scene;
+}
+
+TEST(CrfTraining, PseudoLikelihoodAndNodeOnlyGradientsMatchFiniteDifferences) {
+  const std::vector<LabeledGraph> scenes = {small_scene(1), small_scene(2)};
+  const auto prepared = detail::prepare_scenes(scenes, 0.01f);
+  for (const bool edges : {true, false}) {
+    detail::ParameterShape shape{3, 5, edges};
+    auto objective = detail::make_pseudo_likelihood(prepared, shape, 2);
+    const Eigen::VectorXd x = random_parameters(shape.size(), 3, 1.0);
+    EXPECT_LT(gradient_error(*objective, x, 1e-5), 1e-7) << (edges ? "PL" : "node-only");
+  }
+}
+
+// On a tree the Bethe free energy is exact, so the BP objective is the exact negative
+// log-likelihood and its gradient the exact gradient.
+TEST(CrfTraining, BetheObjectiveIsExactOnATree) {
+  const std::vector<std::pair<std::uint32_t, std::uint32_t>> tree = {{0, 1}, {1, 2}, {1, 3},
+                                                                     {3, 4}, {3, 5}, {0, 6}};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> value(0.0f, 100.0f);
+  LabeledGraph scene;
+  scene.descriptor_dim = 3;
+  scene.descriptors.resize(7 * 3);
+  for (float& v : scene.descriptors) v = value(rng);
+  scene.graph = graph_from_edges(7, tree);
+  scene.labels = {0, 0, 1, 2, 2, 1, 0};
+  const std::vector<LabeledGraph> scenes = {scene};
+  const auto prepared = detail::prepare_scenes(scenes, 0.01f);
+  const detail::ParameterShape shape{3, 3, true};
+  detail::BpSettings bp;
+  bp.max_iterations = 300;
+  bp.tolerance = 1e-7f;
+  bp.threads = 1;
+  auto objective = detail::make_bethe(prepared, shape, bp);
+  const Eigen::VectorXd x = random_parameters(shape.size(), 11, 1.5);
+  Eigen::VectorXd grad(x.size());
+  const double value_bethe = objective->evaluate(x, grad);
+
+  const CrfModel model = detail::model_from_parameters(x, shape, ids(3), 0.01f);
+  const testing::Exact exact = testing::brute_force(model, scene.descriptors, scene.graph);
+  const double exact_nll = (exact.log_z - exact.score(scene.labels)) / 7.0;
+  EXPECT_NEAR(value_bethe, exact_nll, 1e-4);
+  EXPECT_LT(gradient_error(*objective, x, 1e-4), 2e-3);
+}
+
+struct Accuracies {
+  double node_only, pseudo_likelihood, bethe;
+};
+
+TEST(CrfTraining, CrfBeatsNodeOnlyOnHeldOutData) {
+  SceneSpec spec;
+  spec.width = 48;
+  spec.height = 48;
+  spec.num_classes = 3;
+  spec.noise = 100.0f;
+  spec.seed = 1;
+  const std::vector<LabeledGraph> train = {testing::make_grid_scene(spec)};
+  spec.seed = 2;
+  const std::vector<LabeledGraph> test = {testing::make_grid_scene(spec)};
+  InferenceOptions inference;
+  const auto run = [&](TrainingObjective objective) {
+    TrainingOptions options;
+    options.objective = objective;
+    options.max_iterations = 40;
+    const TrainingResult r = train_crf(train, {}, ids(3), options);
+    const double acc = labeled_accuracy(r.model, test, inference);
+    std::printf("%-18s %3d iterations  objective %.4f  held-out accuracy %.3f  %s\n",
+                objective == TrainingObjective::kNodeOnly           ? "node-only"
+                : objective == TrainingObjective::kPseudoLikelihood ? "pseudo-likelihood"
+                                                                    : "bethe-bp",
+                r.iterations, r.objective, acc, r.message.c_str());
+    return acc;
+  };
+  const double node_only = run(TrainingObjective::kNodeOnly);
+  const double pl = run(TrainingObjective::kPseudoLikelihood);
+  const double bethe = run(TrainingObjective::kBetheBp);
+  EXPECT_LT(node_only, 0.95);
+  EXPECT_GT(pl, node_only + 0.05);
+  EXPECT_GT(bethe, node_only + 0.05);
+}
+
+TEST(CrfTraining, SameModelForOneAndTwoThreads) {
+  // Big enough (2 x 1200 nodes) that two threads really run; small problems use one.
+  const std::vector<LabeledGraph> scenes = {small_scene(3, 40, 30), small_scene(4, 40, 30)};
+  for (const auto objective : {TrainingObjective::kPseudoLikelihood, TrainingObjective::kBetheBp,
+                               TrainingObjective::kNodeOnly}) {
+    TrainingOptions options;
+    options.objective = objective;
+    options.max_iterations = 10;
+    options.threads = 1;
+    const TrainingResult one = train_crf(scenes, {}, ids(3), options);
+    options.threads = 2;
+    const TrainingResult two = train_crf(scenes, {}, ids(3), options);
+    EXPECT_TRUE(one.model.node_weights.cwiseEqual(two.model.node_weights).all());
+    EXPECT_TRUE(one.model.edge_weights.cwiseEqual(two.model.edge_weights).all());
+    EXPECT_EQ(one.objective, two.objective);
+  }
+}
+
+TEST(CrfTraining, ReportsTheTrainingCurve) {
+  const std::vector<LabeledGraph> train = {small_scene(5)};
+  const std::vector<LabeledGraph> validation = {small_scene(6)};
+  std::vector<TrainingIteration> seen;
+  TrainingOptions options;
+  options.max_iterations = 8;
+  options.on_iteration = [&](const TrainingIteration& it) { seen.push_back(it); };
+  const TrainingResult r = train_crf(train, validation, ids(3), options);
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.size(), r.curve.size());
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_EQ(seen[i].iteration, int(i) + 1);
+    EXPECT_GE(seen[i].train_accuracy, 0.0);
+    EXPECT_LE(seen[i].train_accuracy, 1.0);
+    EXPECT_FALSE(std::isnan(seen[i].validation_accuracy));
+    if (i > 0) EXPECT_LE(seen[i].objective, seen[i - 1].objective + 1e-12);
+  }
+  std::ostringstream csv;
+  write_training_curve_csv(csv, r.curve);
+  EXPECT_EQ(
+      csv.str().rfind("iteration,objective,train_accuracy,validation_accuracy,seconds\n1,", 0), 0u);
+
+  // Without a validation set the column is empty.
+  const TrainingResult no_validation = train_crf(train, {}, ids(3), options);
+  EXPECT_TRUE(std::isnan(no_validation.curve.front().validation_accuracy));
+  EXPECT_NE(training_curve_csv_row(no_validation.curve.front()).find(",,"), std::string::npos);
+}
+
+TEST(CrfTraining, RejectsInconsistentData) {
+  std::vector<LabeledGraph> scenes = {small_scene(7)};
+  scenes[0].labels[3] = 5;
+  EXPECT_THROW(train_crf(scenes, {}, ids(3), {}), std::invalid_argument);
+  EXPECT_THROW(train_crf({}, {}, ids(3), {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace primlabel::crf

@@ -1,0 +1,149 @@
+// Model files: what is saved comes back, and every kind of broken file is refused with a
+// message that names the file and the problem.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "primlabel/core/taxonomy.hpp"
+#include "primlabel/model/label_model.hpp"
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+LabelModel sample_crf() {
+  LabelModel m;
+  m.name = "tabletop";
+  m.version = "7";
+  m.kind = ModelKind::kCrf;
+  m.features.normals = Neighborhood::Radius(0.012f);
+  m.features.features = Neighborhood::Hybrid(0.025f, 300);
+  m.features.fpfh_variant = FpfhVariant::kWithOwnSpfh;
+  m.graph.neighborhood = Neighborhood::Knn(8);
+  m.weights =
+      crf::CrfModel::zeros({class_id(PrimitiveClass::kPlane), class_id(PrimitiveClass::kEdgeConvex),
+                            class_id(PrimitiveClass::kCylinderConvex)},
+                           kFpfhSize);
+  m.weights.node_weights.setRandom();
+  m.weights.edge_weights.setRandom();
+  m.inference.max_product = true;
+  m.inference.max_iterations = 17;
+  m.training.sources = {"synth lms400 train 1000-1019"};
+  m.training.scenes = 20;
+  m.training.points = 1750000;
+  m.training.class_points = {1000000, 500000, 250000};
+  m.training.objective = "pseudo-likelihood";
+  m.validation.accuracy = 0.975;
+  m.validation.per_class = {{0.99, 0.98, 0.985, 100}, {0.9, 0.8, 0.85, 10}, {0.7, 0.6, 0.65, 5}};
+  m.created_unix_ms = 1763776800000;
+  m.created_by = "test";
+  return m;
+}
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+TEST(LabelModel, CrfRoundTrip) {
+  test::TempDir dir;
+  const LabelModel saved = sample_crf();
+  save_model(dir.file("m.plm"), saved);
+  const LabelModel loaded = load_model(dir.file("m.plm"));
+  EXPECT_EQ(loaded.name, "tabletop");
+  EXPECT_EQ(loaded.version, "7");
+  EXPECT_EQ(loaded.kind, ModelKind::kCrf);
+  EXPECT_EQ(loaded.class_ids(), saved.class_ids());
+  EXPECT_EQ(loaded.features.fpfh_variant, FpfhVariant::kWithOwnSpfh);
+  EXPECT_EQ(loaded.features.features.radius, 0.025f);
+  EXPECT_EQ(loaded.features.features.max_neighbors, 300);
+  EXPECT_EQ(loaded.features.normals.radius, 0.012f);
+  EXPECT_EQ(loaded.graph.neighborhood.k, 8);
+  EXPECT_TRUE(loaded.weights.node_weights == saved.weights.node_weights);
+  EXPECT_TRUE(loaded.weights.edge_weights == saved.weights.edge_weights);
+  EXPECT_TRUE(loaded.inference.max_product);
+  EXPECT_EQ(loaded.inference.max_iterations, 17);
+  EXPECT_EQ(loaded.training.class_points, saved.training.class_points);
+  EXPECT_EQ(loaded.validation.per_class.size(), 3u);
+  EXPECT_DOUBLE_EQ(loaded.validation.per_class[1].f1, 0.85);
+  EXPECT_EQ(loaded.created_unix_ms, saved.created_unix_ms);
+}
+
+TEST(LabelModel, NodeOnlyAndSvmRoundTrip) {
+  LabelModel node = sample_crf();
+  node.kind = ModelKind::kNodeOnly;
+  const LabelModel node_back = parse_model(serialize_model(node), "node");
+  EXPECT_EQ(node_back.kind, ModelKind::kNodeOnly);
+  EXPECT_TRUE(node_back.weights.edge_weights.isZero());
+  EXPECT_TRUE(node_back.weights.node_weights == node.weights.node_weights);
+
+  LabelModel svm = sample_crf();
+  svm.kind = ModelKind::kSvm;
+  svm.svm_model = "svm_type c_svc\nkernel_type rbf\n";
+  svm.svm_class_ids = svm.weights.class_ids;
+  const LabelModel svm_back = parse_model(serialize_model(svm), "svm");
+  EXPECT_EQ(svm_back.kind, ModelKind::kSvm);
+  EXPECT_EQ(svm_back.svm_model, svm.svm_model);
+  EXPECT_EQ(svm_back.class_ids(), svm.class_ids());
+}
+
+std::string load_error(const std::string& path) {
+  try {
+    load_model(path);
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(LabelModel, BrokenFilesAreRefusedWithTheirNameAndReason) {
+  test::TempDir dir;
+  const std::string good = serialize_model(sample_crf());
+
+  EXPECT_NE(load_error(dir.file("missing.plm")).find("missing.plm: no such model file"),
+            std::string::npos);
+
+  write_bytes(dir.file("text.plm"), "hello, I am a PCD file\n");
+  EXPECT_NE(load_error(dir.file("text.plm")).find("not a primlabel model file"), std::string::npos);
+
+  for (std::size_t cut : {good.size() / 2, good.size() - 3, std::size_t(20)}) {
+    write_bytes(dir.file("cut.plm"), good.substr(0, cut));
+    const std::string error = load_error(dir.file("cut.plm"));
+    EXPECT_NE(error.find("cut.plm: "), std::string::npos) << cut;
+    EXPECT_TRUE(error.find("truncated") != std::string::npos ||
+                error.find("checksum") != std::string::npos)
+        << error;
+  }
+
+  std::string flipped = good;
+  flipped[flipped.size() - 40] ^= 0x5A;  // inside the weights
+  write_bytes(dir.file("flip.plm"), flipped);
+  const std::string flip_error = load_error(dir.file("flip.plm"));
+  EXPECT_TRUE(flip_error.find("checksum mismatch") != std::string::npos ||
+              flip_error.find("corrupt") != std::string::npos)
+      << flip_error;
+}
+
+TEST(LabelModel, NewerFormatAndInconsistentModelsAreRefused) {
+  // Rewrite the envelope's version field (field 1, varint) to 99.
+  std::string bytes = serialize_model(sample_crf());
+  ASSERT_EQ(bytes[16], 0x08);
+  ASSERT_EQ(bytes[17], static_cast<char>(kModelFormatVersion));
+  bytes[17] = 99;
+  try {
+    parse_model(bytes, "future.plm");
+    FAIL() << "accepted a newer format";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("format version 99 is newer"), std::string::npos);
+  }
+
+  LabelModel bad = sample_crf();
+  bad.weights.node_weights.resize(3, 10);  // not 33 + 1 columns
+  EXPECT_THROW(serialize_model(bad), ModelError);
+  LabelModel unknown_class = sample_crf();
+  unknown_class.weights.class_ids[2] = 4242;
+  EXPECT_THROW(serialize_model(unknown_class), ModelError);
+}
+
+}  // namespace
+}  // namespace primlabel
