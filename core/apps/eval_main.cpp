@@ -1,0 +1,206 @@
+// primlabel-eval: labels clouds with a trained model and scores them against their ground truth,
+// or re-measures the paper's Table I.
+//
+//   primlabel-eval --model table.plm scene.pcd [--json] [--out labeled.pcd]
+//   primlabel-eval --model table.plm --no-truth mosd_scene.pcd     # predicted label histogram
+//   primlabel-eval --table1 [--json]
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "cli_common.hpp"
+#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/crf/metrics.hpp"
+#include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/pipeline/table1.hpp"
+#include "primlabel/synth/labeled_cloud.hpp"
+
+namespace {
+
+using namespace primlabel;
+
+struct Arguments {
+  std::string model, classes, out;
+  std::vector<std::string> files;
+  bool json = false, no_truth = false, tabletop_only = false, quiet = false;
+  bool table1 = false, no_pfh = false, no_svm = false;
+  int table1_train = 3, table1_test = 2, pfh_max_neighbors = 40, threads = 0;
+};
+
+std::string class_name(std::uint32_t id) {
+  const auto c = class_from_id(id);
+  return c ? std::string(name(*c)) : std::to_string(id);
+}
+
+// JSON numbers cannot be NaN.
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.6f", v);
+  return buffer;
+}
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) >= 0x20) out += c;
+  }
+  return out + "\"";
+}
+
+void print_scores(const std::string& path, const crf::ConfusionMatrix& confusion, bool json) {
+  std::vector<std::string> names;
+  for (std::uint32_t id : confusion.class_ids()) names.push_back(class_name(id));
+  if (!json) {
+    std::printf("%s: %llu points scored, accuracy %.2f%%\n%s\n", path.c_str(),
+                static_cast<unsigned long long>(confusion.total()), 100 * confusion.accuracy(),
+                confusion.to_text(names).c_str());
+    return;
+  }
+  std::string line = "{\"file\":" + json_string(path) +
+                     ",\"points\":" + std::to_string(confusion.total()) +
+                     ",\"accuracy\":" + json_number(confusion.accuracy()) +
+                     ",\"macro_f1\":" + json_number(confusion.macro_f1()) + ",\"classes\":{";
+  for (int k = 0; k < confusion.num_classes(); ++k) {
+    const crf::ClassScores s = confusion.scores(k);
+    line += (k ? "," : "") + json_string(names[k]) + ":{\"precision\":" + json_number(s.precision) +
+            ",\"recall\":" + json_number(s.recall) + ",\"f1\":" + json_number(s.f1) +
+            ",\"support\":" + std::to_string(s.support) + "}";
+  }
+  line += "},\"confusion\":[";
+  for (int t = 0; t < confusion.num_classes(); ++t) {
+    line += t ? ",[" : "[";
+    for (int p = 0; p <= confusion.num_classes(); ++p)
+      line += (p ? "," : "") + std::to_string(confusion.count(t, p));
+    line += "]";
+  }
+  std::printf("%s]}\n", line.c_str());
+}
+
+void print_histogram(const std::string& path, const std::vector<std::uint32_t>& labels, bool json) {
+  std::vector<std::uint64_t> counts(kPrimitiveClassCount, 0);
+  for (std::uint32_t id : labels)
+    if (id < kPrimitiveClassCount) ++counts[id];
+  if (json) {
+    std::string line = "{\"file\":" + json_string(path) +
+                       ",\"points\":" + std::to_string(labels.size()) + ",\"histogram\":{";
+    for (std::uint32_t id = 0; id < kPrimitiveClassCount; ++id)
+      line += (id ? "," : "") + json_string(class_name(id)) + ":" + std::to_string(counts[id]);
+    std::printf("%s}}\n", line.c_str());
+    return;
+  }
+  std::printf("%s: %zu points, predicted labels:\n", path.c_str(), labels.size());
+  for (std::uint32_t id = 0; id < kPrimitiveClassCount; ++id)
+    if (counts[id])
+      std::printf("  %-18s %10llu  %6.2f%%\n", class_name(id).c_str(),
+                  static_cast<unsigned long long>(counts[id]),
+                  100.0 * double(counts[id]) / double(std::max<std::size_t>(labels.size(), 1)));
+}
+
+int evaluate_files(const Arguments& args) {
+  const LabelModel model = load_model(args.model);
+  const ClassMap map = args.classes.empty() ? ClassMap{} : read_class_map(args.classes);
+  for (const std::string& path : args.files) {
+    PointCloud cloud = read_cloud(path);
+    const bool scored = !args.no_truth && cloud.has_labels();
+    if (scored)  // the labels as taxonomy ids (through the file's or the given class map)
+      cloud = args.classes.empty() ? load_labeled_cloud(path) : load_labeled_cloud(path, map);
+    pipeline::LabelingOptions options;
+    options.threads = args.threads;
+    options.tabletop_only = args.tabletop_only;
+    const pipeline::LabelingResult result = pipeline::label_cloud(model, cloud, options);
+    if (!args.quiet)
+      std::fprintf(stderr, "%s: %zu points, features %.2f s, inference %.2f s\n", path.c_str(),
+                   cloud.size(), result.feature_seconds, result.inference_seconds);
+    if (scored) {
+      crf::ConfusionMatrix confusion(model.class_ids());
+      confusion.add(cloud.labels, result.labels, class_id(PrimitiveClass::kUnknown));
+      print_scores(path, confusion, args.json);
+    } else {
+      print_histogram(path, result.labels, args.json);
+    }
+    if (!args.out.empty()) {
+      cloud.labels = result.labels;
+      write_tagged_cloud(args.out, cloud, {{"classes", class_map_tag(ClassMap::taxonomy())}});
+    }
+  }
+  return cli::kExitOk;
+}
+
+int table1(const Arguments& args) {
+  pipeline::Table1Options options;
+  options.train_scenes = args.table1_train;
+  options.test_scenes = args.table1_test;
+  options.with_pfh = !args.no_pfh;
+  options.with_svm = !args.no_svm;
+  options.pfh_max_neighbors = args.pfh_max_neighbors;
+  options.threads = args.threads;
+  if (!args.quiet)
+    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  const auto rows = pipeline::run_table1(options);
+  std::fputs((args.json ? pipeline::table1_json(rows) : pipeline::table1_text(rows)).c_str(),
+             stdout);
+  return cli::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Label clouds with a trained model and score them, or re-measure Table I."};
+  app.name("primlabel-eval");
+  Arguments args;
+  auto* files = app.add_option("files", args.files, "clouds to label (.pcd or .ply)");
+  auto* model = app.add_option("--model", args.model, "model file (primlabel-train -o)");
+  app.add_flag("--json", args.json, "one JSON object per file (or per Table I row) on stdout");
+  app.add_flag("--no-truth", args.no_truth,
+               "the files' labels are no primitive classes (e.g. segment ids): print the "
+               "predicted label histogram");
+  app.add_option("--classes", args.classes, "class map of the files' labels (id name per line)");
+  app.add_option("--out", args.out, "write the predicted labels (one input file)");
+  app.add_flag("--tabletop-only", args.tabletop_only, "label only the table and the objects on it");
+  auto* t1 = app.add_flag("--table1", args.table1,
+                          "re-measure the paper's Table I on synthetic LMS400 scenes");
+  app.add_option("--table1-train", args.table1_train, "Table I: training scenes (default 3)")
+      ->check(CLI::PositiveNumber)
+      ->needs(t1);
+  app.add_option("--table1-test", args.table1_test, "Table I: test scenes (default 2)")
+      ->check(CLI::PositiveNumber)
+      ->needs(t1);
+  app.add_flag("--no-pfh", args.no_pfh, "Table I: FPFH rows only")->needs(t1);
+  app.add_flag("--no-svm", args.no_svm, "Table I: no SVM rows")->needs(t1);
+  app.add_option("--pfh-max-neighbors", args.pfh_max_neighbors,
+                 "Table I: PFH uses the M nearest within the feature radius (default 40)")
+      ->check(CLI::PositiveNumber)
+      ->needs(t1);
+  app.add_option("--threads", args.threads, "worker threads (default: all cores)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
+  t1->excludes(model)->excludes(files);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "primlabel-eval: usage error: %s (see --help)\n", e.what());
+    return cli::kExitUsage;
+  }
+  if (!args.table1 && (args.model.empty() || args.files.empty())) {
+    std::fprintf(stderr,
+                 "primlabel-eval: usage error: give --model and at least one file, or --table1 "
+                 "(see --help)\n");
+    return cli::kExitUsage;
+  }
+  if (!args.out.empty() && args.files.size() != 1) {
+    std::fprintf(stderr, "primlabel-eval: usage error: --out takes exactly one input file\n");
+    return cli::kExitUsage;
+  }
+  try {
+    return args.table1 ? table1(args) : evaluate_files(args);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "primlabel-eval: error: %s\n", e.what());
+    return cli::kExitFailure;
+  }
+}

@@ -1,0 +1,136 @@
+// primlabel-train and primlabel-eval as a user runs them: a model trained by the tool loads and
+// labels, exit codes 0 / 1 / 2 and one-line errors.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "primlabel/core/features.hpp"
+#include "primlabel/pipeline/training.hpp"
+#include "primlabel/synth/labeled_cloud.hpp"
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int exit_code;
+  std::string output;  // stdout and stderr
+};
+
+Result run(const std::string& command) {
+  Result result{-1, {}};
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+int lines(const std::string& text) { return int(std::count(text.begin(), text.end(), '\n')); }
+
+class PipelineCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    // One folder per process: ctest runs the cases in parallel processes.
+    dir_ = new fs::path(fs::temp_directory_path() /
+                        ("primlabel_pipeline_cli_" + std::to_string(::getpid())));
+    fs::create_directories(*dir_);
+    // An all-zero node-only model: loads and labels instantly (the trained one is tested below).
+    LabelModel zero;
+    zero.kind = ModelKind::kNodeOnly;
+    zero.weights = crf::CrfModel::zeros({1, 2, 4}, kFpfhSize);
+    save_model(zero_model_path(), zero);
+    synth::GenerateOptions options;
+    options.seed = synth::set_seed(synth::SceneSet::kTest, 0);
+    const synth::Generated scene = synth::generate(options);
+    write_tagged_cloud(scene_path(), scene.cloud, scene.tags);
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete dir_;
+  }
+  static std::string model_path() { return (*dir_ / "model.plm").string(); }
+  static std::string zero_model_path() { return (*dir_ / "zero.plm").string(); }
+  static std::string scene_path() { return (*dir_ / "scene.pcd").string(); }
+  static std::string eval() { return test::binary("primlabel-eval"); }
+
+  static inline fs::path* dir_ = nullptr;
+};
+
+// A node-only model from one training scene: fast, and enough to check the tools.
+TEST_F(PipelineCli, TrainedModelLoadsAndLabelsWithJsonScores) {
+  const Result trained = run(test::binary("primlabel-train") +
+                             " --synth-train 1 --synth-val 0 --kind node --iterations 30 "
+                             "--threads 2 -q -o " +
+                             model_path());
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  const Result r = run(eval() + " --model " + model_path() + " --json -q " + scene_path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("\"accuracy\":0."), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\"plane\":{\"precision\""), std::string::npos) << r.output;
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  const LabelModel model = load_model(model_path());
+  EXPECT_EQ(model.kind, ModelKind::kNodeOnly);
+  EXPECT_EQ(model.training.scenes, 1u);
+  EXPECT_FALSE(model.class_ids().empty());
+}
+
+TEST_F(PipelineCli, WritesPredictedLabelsAndHistogramWithoutTruth) {
+  const std::string out = (*dir_ / "labeled.pcd").string();
+  const Result r = run(eval() + " --model " + zero_model_path() + " --no-truth -q --out " + out +
+                       " " + scene_path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("predicted labels"), std::string::npos) << r.output;
+  const PointCloud labeled = load_labeled_cloud(out);
+  EXPECT_TRUE(labeled.has_labels());
+}
+
+TEST_F(PipelineCli, MissingFileFailsWithOneLine) {
+  const Result r = run(eval() + " --model " + zero_model_path() + " -q /nonexistent/scene.pcd");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("primlabel-eval: error:"), std::string::npos) << r.output;
+}
+
+TEST_F(PipelineCli, CorruptModelFailsWithOneLine) {
+  const std::string corrupt = (*dir_ / "corrupt.plm").string();
+  std::ofstream(corrupt) << "PRIMLABEL-MODEL\nnot a protobuf at all";
+  const Result r = run(eval() + " --model " + corrupt + " -q " + scene_path());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+  const std::string missing = (*dir_ / "missing.plm").string();
+  EXPECT_EQ(run(eval() + " --model " + missing + " -q " + scene_path()).exit_code, 1);
+}
+
+TEST_F(PipelineCli, BadUsageExitsTwo) {
+  for (const std::string& command :
+       {eval() + " --model", eval() + " --bogus-flag x.pcd", eval() + " x.pcd",
+        eval() + " --table1 --model m.plm",
+        test::binary("primlabel-train") + " --kind nonsense -o m.plm",
+        test::binary("primlabel-train") + " --synth-train 1",
+        test::binary("primlabel-train") + " --kind svm -o m.plm",
+        test::binary("primlabel-train") + " --train a.pcd --synth-train 2 -o m.plm"}) {
+    const Result r = run(command);
+    EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
+    EXPECT_EQ(lines(r.output), 1) << command << "\n" << r.output;
+  }
+}
+
+TEST_F(PipelineCli, TrainMissingFileFails) {
+  const Result r = run(test::binary("primlabel-train") + " --train /nonexistent/a.pcd -q -o " +
+                       (*dir_ / "x.plm").string());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(lines(r.output), 1) << r.output;
+}
+
+}  // namespace
+}  // namespace primlabel

@@ -1,0 +1,167 @@
+// label_cloud end to end: a model trained on two synthetic LMS400 training scenes labels a
+// held-out test scene far better than chance, the same for 1 and 2 threads, and survives a
+// round trip through its file.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <limits>
+
+#include "primlabel/crf/metrics.hpp"
+#include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/pipeline/training.hpp"
+
+namespace primlabel {
+namespace {
+
+using pipeline::SceneData;
+
+// A node-only model trained on two training scenes, and a held-out test scene.
+struct Trained {
+  LabelModel model;
+  PointCloud test_scene;
+};
+
+Trained train_on_two_scenes() {
+  const crf::GraphOptions graph;
+  const FeatureSettings features;
+  std::vector<std::uint32_t> every_class;
+  for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
+  std::vector<SceneData> train;
+  for (int i = 0; i < 2; ++i)
+    train.push_back(pipeline::prepare_scene(
+        pipeline::synthetic_scene(synth::SceneSet::kTrain, i, synth::SensorKind::kLms400), "train",
+        features, graph, every_class, 2));
+  const auto class_ids = pipeline::classes_present(train);
+  for (SceneData& s : train) pipeline::assign_labels(s, class_ids);
+  pipeline::ModelTrainingOptions options;
+  options.kind = ModelKind::kNodeOnly;
+  options.iterations = 100;
+  options.threads = 2;
+  return {pipeline::train_label_model(train, {}, class_ids, features, graph, options).model,
+          pipeline::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400)};
+}
+
+double accuracy(const LabelModel& model, const PointCloud& truth,
+                const std::vector<std::uint32_t>& predicted) {
+  crf::ConfusionMatrix confusion(model.class_ids());
+  confusion.add(truth.labels, predicted, 0u);
+  return confusion.accuracy();
+}
+
+// A CRF: the node-only weights plus an associative coupling between neighbours.
+LabelModel with_coupling(LabelModel model, float coupling) {
+  model.kind = ModelKind::kCrf;
+  crf::CrfModel& w = model.weights;
+  w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.feature_dim());
+  w.edge_weights.col(w.feature_dim() - 1).setConstant(coupling);
+  return model;
+}
+
+// Untrained: all-zero weights over three classes (labels every described point "plane").
+LabelModel zero_model() {
+  LabelModel model;
+  model.kind = ModelKind::kNodeOnly;
+  model.weights = crf::CrfModel::zeros({1, 2, 4}, kFpfhSize);
+  return model;
+}
+
+PointCloud small_scene() {
+  PointCloud scene =
+      pipeline::synthetic_scene(synth::SceneSet::kTest, 1, synth::SensorKind::kLms400);
+  return scene;
+}
+
+double majority_fraction(const PointCloud& cloud) {
+  std::vector<std::size_t> counts(kPrimitiveClassCount, 0);
+  std::size_t total = 0;
+  for (std::uint32_t id : cloud.labels)
+    if (id != 0) ++counts[id], ++total;
+  return double(*std::max_element(counts.begin(), counts.end())) / double(total);
+}
+
+// One case, so the training runs once per process (ctest runs each case in its own process).
+TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRoundTrip) {
+  const Trained trained = train_on_two_scenes();
+  const LabelModel& model = trained.model;
+
+  // Node-only, with probabilities: far above chance (the majority class, the table, ~60%).
+  PointCloud cloud = trained.test_scene;
+  pipeline::LabelingOptions options;
+  options.threads = 2;
+  options.want_probabilities = true;
+  const auto result = pipeline::label_cloud(model, cloud, options);
+  ASSERT_EQ(result.labels.size(), cloud.size());
+  const double node_accuracy = accuracy(model, trained.test_scene, result.labels);
+  EXPECT_GT(node_accuracy, 0.80);
+  EXPECT_GT(node_accuracy, majority_fraction(trained.test_scene) + 0.15);
+  ASSERT_EQ(result.probabilities.rows(), Eigen::Index(cloud.size()));
+  ASSERT_EQ(result.probabilities.cols(), Eigen::Index(model.class_ids().size()));
+  for (Eigen::Index i = 0; i < result.probabilities.rows(); i += 997)
+    if (result.probabilities.row(i).allFinite())
+      EXPECT_NEAR(result.probabilities.row(i).sum(), 1.0f, 1e-4f);
+
+  // CRF: same labels for 1 and 2 threads.
+  const LabelModel crf = with_coupling(model, 0.5f);
+  PointCloud one = trained.test_scene, two = trained.test_scene;
+  options = {};
+  options.threads = 1;
+  const auto with_one = pipeline::label_cloud(crf, one, options);
+  options.threads = 2;
+  const auto with_two = pipeline::label_cloud(crf, two, options);
+  EXPECT_EQ(with_one.labels, with_two.labels);
+  EXPECT_GT(accuracy(crf, trained.test_scene, with_two.labels), 0.80);
+
+  // The model file round trip labels the same.
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("primlabel_pipeline_model_" + std::to_string(::getpid()) + ".plm");
+  save_model(path.string(), crf);
+  const LabelModel loaded = load_model(path.string());
+  std::filesystem::remove(path);
+  PointCloud again = trained.test_scene;
+  EXPECT_EQ(pipeline::label_cloud(loaded, again, options).labels, with_two.labels);
+}
+
+TEST(PipelineLabeling, UnlabelablePointsGetUnknown) {
+  PointCloud cloud = small_scene();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  cloud.xyz[0] = Vec3f(nan, nan, nan);
+  cloud.xyz.push_back(Vec3f(50, 50, 50));  // isolated: no normal, so no descriptor
+  cloud.labels.push_back(0);
+  cloud.width = std::uint32_t(cloud.xyz.size());
+  const auto result = pipeline::label_cloud(zero_model(), cloud, {});
+  EXPECT_EQ(result.labels.front(), 0u);
+  EXPECT_EQ(result.labels.back(), 0u);
+  EXPECT_GT(result.labeled_points, cloud.size() / 2);
+}
+
+TEST(PipelineLabeling, LabelsOutsideTheModelClassesAreIgnoredInTraining) {
+  PointCloud cloud = small_scene();
+  const FeatureSettings features;
+  pipeline::DescribedCloud described = pipeline::describe_cloud(cloud, features, 2);
+  crf::Graph graph = pipeline::build_scene_graph(cloud, described, {});
+  const std::vector<std::uint32_t> only_plane{class_id(PrimitiveClass::kPlane)};
+  const crf::LabeledGraph scene =
+      pipeline::to_labeled_graph(cloud, std::move(described), std::move(graph), only_plane);
+  std::size_t mismatches = 0, planes = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const bool plane = cloud.labels[i] == class_id(PrimitiveClass::kPlane) && scene.graph.active[i];
+    planes += plane;
+    mismatches += scene.labels[i] != (plane ? 0 : crf::kIgnoreLabel);
+  }
+  EXPECT_EQ(mismatches, 0u);
+  EXPECT_GT(planes, 0u);
+}
+
+TEST(PipelineLabeling, SvmModelsAreRejectedWithAModelError) {
+  LabelModel svm = zero_model();
+  svm.kind = ModelKind::kSvm;
+  svm.svm_model = "svm_type c_svc";
+  PointCloud cloud = small_scene();
+  EXPECT_THROW(pipeline::label_cloud(svm, cloud), ModelError);
+}
+
+}  // namespace
+}  // namespace primlabel
