@@ -152,6 +152,89 @@ TEST(CrfInference, SameResultForAnyThreadCount) {
   }
 }
 
+// A kept workspace (reused across graphs of other sizes, methods and thread counts) gives
+// bit-identical results to a fresh one.
+TEST(CrfInference, WorkspaceReuseGivesIdenticalResults) {
+  SceneSpec big;
+  big.width = 64;  // 2 threads really run (small graphs use one)
+  big.height = 40;
+  big.num_classes = 5;
+  SceneSpec small = big;
+  small.width = 30;
+  small.height = 20;
+  small.seed = 3;
+  const LabeledGraph big_scene = testing::make_grid_scene(big);
+  const LabeledGraph small_scene = testing::make_grid_scene(small);
+  const CrfModel model = testing::prototype_model(big, 3.0f, 0.8f);
+  InferenceWorkspace workspace;
+  for (const LabeledGraph* scene : {&big_scene, &small_scene}) {
+    for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
+      for (const bool max_product : {false, true}) {
+        if (method == InferenceMethod::kMeanField && max_product) continue;
+        for (const int threads : {1, 2}) {
+          InferenceOptions options;
+          options.method = method;
+          options.max_product = max_product;
+          options.compute_marginals = true;
+          options.threads = threads;
+          const InferenceResult fresh = infer(model, scene->descriptors, scene->graph, options);
+          const InferenceResult kept =
+              infer(model, scene->descriptors, scene->graph, options, workspace);
+          EXPECT_EQ(fresh.labels, kept.labels);
+          EXPECT_EQ(fresh.iterations, kept.iterations);
+          EXPECT_TRUE(fresh.marginals.cwiseEqual(kept.marginals).all());
+        }
+      }
+    }
+  }
+  EXPECT_GT(workspace.bytes(), 0u);
+  workspace.release();
+  EXPECT_EQ(workspace.bytes(), 0u);
+}
+
+// The default stopping rule (belief change, 15 iterations, settled nodes skipped) fires on a
+// scan-like scene and labels as well as running BP / mean-field to a tight fixed point.
+TEST(CrfInference, DefaultStoppingKeepsAccuracy) {
+  SceneSpec spec;
+  spec.width = 120;
+  spec.height = 90;
+  spec.num_classes = 6;
+  spec.noise = 40.0f;
+  const LabeledGraph scene = testing::make_grid_scene(spec);
+  const CrfModel model = testing::prototype_model(spec, 4.0f, 1.0f);
+  const std::size_t n = scene.graph.num_nodes();
+  const auto accuracy = [&](const InferenceResult& r) {
+    std::size_t correct = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      correct += r.labels[i] == std::uint32_t(scene.labels[i] + 1);
+    return double(correct) / double(n);
+  };
+  CrfModel node_only = model;
+  node_only.edge_weights.setZero();
+  const double plain = accuracy(infer(node_only, scene.descriptors, scene.graph, {}));
+  for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
+    for (const bool max_product : {false, true}) {
+      if (method == InferenceMethod::kMeanField && max_product) continue;
+      InferenceOptions options;
+      options.method = method;
+      options.max_product = max_product;
+      const InferenceResult quick = infer(model, scene.descriptors, scene.graph, options);
+      options.max_iterations = 200;
+      options.tolerance = 1e-6f;
+      const InferenceResult tight = infer(model, scene.descriptors, scene.graph, options);
+      const double a_quick = accuracy(quick), a_tight = accuracy(tight);
+      std::printf("method %d max %d: node-only %.4f, default %.4f (%d it%s), tight %.4f (%d it)\n",
+                  int(method), int(max_product), plain, a_quick, quick.iterations,
+                  quick.converged ? ", converged" : "", a_tight, tight.iterations);
+      EXPECT_GT(a_quick, plain + 0.01);
+      EXPECT_GE(a_quick, a_tight - 1e-3);
+      if (method == InferenceMethod::kLoopyBp) {
+        EXPECT_TRUE(quick.converged);
+      }
+    }
+  }
+}
+
 TEST(CrfInference, PointsWithoutDescriptorGetTheUnknownLabel) {
   SceneSpec spec;
   spec.width = 20;

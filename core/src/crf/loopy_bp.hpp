@@ -64,4 +64,37 @@ class LoopyBp {
   std::vector<float> next_;
 };
 
+// ---- Inference fast path -----------------------------------------------------------------------
+// The same messages as LoopyBp, on the padded layouts of potentials.hpp, with psi stored once per
+// undirected edge and buffers owned by the caller (InferenceWorkspace), so repeated calls allocate
+// nothing. Convergence is tested on what inference returns: the run stops when no node's belief
+// (normalised to sum 1) moved more than the tolerance between two iterations. A node is skipped
+// while its own messages and all its incoming ones moved less than the tolerance in the previous
+// iteration (it would only repeat itself); that decision uses the previous iteration alone, so
+// results stay identical for any thread count.
+struct FastBpProblem {
+  const Graph* graph = nullptr;
+  int classes = 0;                         // K; rows have padded_classes(K) entries
+  const float* phi = nullptr;              // num_nodes x kp, max 1 per active row, pads 0
+  const float* psi_minus_one = nullptr;    // num_edges x kp, pads 0
+  const std::uint32_t* edge_of = nullptr;  // slot -> undirected edge
+};
+
+struct FastBpBuffers {
+  ScratchBuffer<float> messages, next;  // num_slots x kp; pads are 1
+  ScratchBuffer<float> beliefs;         // num_nodes x kp: the last iteration's beliefs
+  ScratchBuffer<std::uint8_t> moved, moved_next, same;  // per node, see run_fast_bp
+};
+
+// Synchronous damped BP from uniform messages; the messages end in buffers.messages. The first
+// iteration is not damped: blending with the uniform start would only delay every message.
+BpRun run_fast_bp(const FastBpProblem& problem, const BpSettings& settings, FastBpBuffers& buffers);
+
+// From the final messages: labels[i] = class_ids[argmax_k b_i(k)] (first maximum) for active
+// nodes, unknown_label otherwise, and, when `marginals` is not null, b_i normalised to sum 1
+// (NaN rows for inactive nodes) into the column-major num_nodes x K matrix `marginals`.
+void fast_bp_outputs(const FastBpProblem& problem, const FastBpBuffers& buffers,
+                     const std::vector<std::uint32_t>& class_ids, std::uint32_t unknown_label,
+                     int threads, std::uint32_t* labels, float* marginals);
+
 }  // namespace primlabel::crf::detail

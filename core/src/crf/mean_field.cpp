@@ -2,97 +2,117 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace primlabel::crf::detail {
 namespace {
 
-void softmax_into(const double* a, int k_count, double* q) {
-  double mx = a[0];
-  for (int k = 1; k < k_count; ++k) mx = std::max(mx, a[k]);
-  double sum = 0.0;
-  for (int k = 0; k < k_count; ++k) sum += (q[k] = std::exp(a[k] - mx));
-  for (int k = 0; k < k_count; ++k) q[k] /= sum;
-}
+// Pads get this score, so exp makes them exactly 0 (and -inf would risk inf - inf).
+constexpr float kPadScore = -1e30f;
 
-}  // namespace
+template <int KP>
+class MeanFieldUpdater {
+  using ArrayF = Eigen::Array<float, KP, 1>;
+  using ConstMapF = Eigen::Map<const ArrayF>;
 
-namespace {
-
-// One node's mean-field update; KC fixed at compile time when possible (see loopy_bp.cpp).
-template <int KC>
-float update_all(const Graph& graph, const RowMatrixXf& node_scores, const RowMatrixXf& edge_scores,
-                 const RowMatrixXd& q, RowMatrixXd& next, double keep, int threads) {
-  using ArrayD = Eigen::Array<double, KC, 1>;
-  using ConstMapD = Eigen::Map<const ArrayD>;
-  using ConstMapF = Eigen::Map<const Eigen::Array<float, KC, 1>>;
-  const long long n = static_cast<long long>(graph.num_nodes());
-  const int k_count = static_cast<int>(node_scores.cols());
-  float max_change = 0.0f;
-#pragma omp parallel num_threads(threads) reduction(max : max_change)
-  {
-    ArrayD a(k_count), fresh(k_count);
-#pragma omp for schedule(dynamic, 512)
-    for (long long i = 0; i < n; ++i) {
-      if (graph.offsets[i] == graph.offsets[i + 1]) continue;  // no neighbours: q is final
-      a = ConstMapF(node_scores.row(i).data(), k_count).template cast<double>();
-      for (std::uint32_t p = graph.offsets[i]; p < graph.offsets[i + 1]; ++p)
-        a += ConstMapD(q.row(graph.neighbors[p]).data(), k_count) *
-             ConstMapF(edge_scores.row(p).data(), k_count).template cast<double>();
-      fresh = (a - a.maxCoeff()).exp();
-      fresh *= 1.0 / fresh.sum();
-      const ConstMapD old(q.row(i).data(), k_count);
-      Eigen::Map<ArrayD> out(next.row(i).data(), k_count);
-      out = (1.0 - keep) * fresh + keep * old;
-      max_change = std::max(max_change, static_cast<float>((out - old).abs().maxCoeff()));
-    }
+ public:
+  MeanFieldUpdater(int k_count, int kp) : k_(k_count), kp_(kp), a_(kp), fresh_(kp), pad_(kp) {
+    for (int k = 0; k < kp; ++k) pad_(k) = k < k_count ? 0.0f : kPadScore;
   }
-  return max_change;
-}
 
-float update_all_dispatch(const Graph& graph, const RowMatrixXf& node_scores,
-                          const RowMatrixXf& edge_scores, const RowMatrixXd& q, RowMatrixXd& next,
-                          double keep, int threads) {
-  switch (node_scores.cols()) {
-    case 2:
-      return update_all<2>(graph, node_scores, edge_scores, q, next, keep, threads);
-    case 4:
-      return update_all<4>(graph, node_scores, edge_scores, q, next, keep, threads);
-    case 8:
-      return update_all<8>(graph, node_scores, edge_scores, q, next, keep, threads);
-    case 10:
-      return update_all<10>(graph, node_scores, edge_scores, q, next, keep, threads);
-    case 12:
-      return update_all<12>(graph, node_scores, edge_scores, q, next, keep, threads);
-    default:
-      return update_all<Eigen::Dynamic>(graph, node_scores, edge_scores, q, next, keep, threads);
+  // fresh = softmax(a) over the K real classes, pads 0 (a's pads are 0 on entry).
+  void softmax() {
+    a_ += pad_;  // in registers: scalar stores into a_ would stall the vector loads that follow
+    fresh_ = (a_ - a_.maxCoeff()).exp();
+    fresh_ *= 1.0f / fresh_.sum();
   }
-}
 
-}  // namespace
+  void start(const MeanFieldProblem& pr, std::size_t i, float* q) {
+    a_ = ConstMapF(pr.node_scores + i * kp_, kp_);
+    softmax();
+    Eigen::Map<ArrayF>(q + i * kp_, kp_) = fresh_;
+  }
 
-RowMatrixXd run_mean_field(const Graph& graph, const RowMatrixXf& node_scores,
-                           const RowMatrixXf& edge_scores, const BpSettings& settings,
-                           BpRun& report) {
-  const long long n = static_cast<long long>(graph.num_nodes());
-  const int k_count = static_cast<int>(node_scores.cols());
-  RowMatrixXd q = RowMatrixXd::Zero(n, k_count);
-  // Start from the node-only posterior.
+  float update(const MeanFieldProblem& pr, const float* q, float* next, float keep, std::size_t i) {
+    const Graph& g = *pr.graph;
+    a_ = ConstMapF(pr.node_scores + i * kp_, kp_);
+    for (std::uint32_t p = g.offsets[i]; p < g.offsets[i + 1]; ++p)
+      a_ += ConstMapF(q + std::size_t(g.neighbors[p]) * kp_, kp_) *
+            ConstMapF(pr.edge_scores + std::size_t(pr.edge_of[p]) * kp_, kp_);
+    softmax();
+    const ConstMapF old(q + i * kp_, kp_);
+    Eigen::Map<ArrayF> out(next + i * kp_, kp_);
+    out = (1.0f - keep) * fresh_ + keep * old;
+    return (out - old).abs().maxCoeff();
+  }
+
+ private:
+  int k_, kp_;
+  ArrayF a_, fresh_, pad_;
+};
+
+template <int KP>
+BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, MeanFieldBuffers& buffers) {
+  ScratchBuffer<float>& q_buf = buffers.q;
+  ScratchBuffer<float>& next_buf = buffers.next;
+  const Graph& g = *pr.graph;
+  const long long n = static_cast<long long>(g.num_nodes());
+  const int kp = padded_classes(pr.classes);
+  float* q = q_buf.resize(g.num_nodes() * kp);
+  float* next = next_buf.resize(g.num_nodes() * kp);
+  // Start from the node-only posterior, in both buffers: rows without neighbours are never
+  // rewritten.
 #pragma omp parallel num_threads(settings.threads)
   {
-    std::vector<double> a(k_count);
+    FlushSubnormals flush;  // exp of very negative scores would run into slow subnormals
+    MeanFieldUpdater<KP> updater(pr.classes, kp);
 #pragma omp for schedule(static)
     for (long long i = 0; i < n; ++i) {
-      if (!graph.active[i]) continue;
-      for (int k = 0; k < k_count; ++k) a[k] = node_scores(i, k);
-      softmax_into(a.data(), k_count, q.row(i).data());
+      if (g.active[i]) {
+        updater.start(pr, i, q);
+      } else {
+        std::fill_n(q + i * kp, kp, 0.0f);
+      }
+      std::copy_n(q + i * kp, kp, next + i * kp);
     }
   }
-  RowMatrixXd next = q;
-  report = BpRun{};
+  std::uint8_t* moved_before = buffers.moved.resize(g.num_nodes());
+  std::uint8_t* moved = buffers.moved_next.resize(g.num_nodes());
+  std::uint8_t* same = buffers.same.resize(g.num_nodes());
+  std::fill_n(moved_before, g.num_nodes(), std::uint8_t{1});
+  std::fill_n(same, g.num_nodes(), std::uint8_t{1});  // both buffers start equal
+  BpRun report;
   for (int iteration = 1; iteration <= settings.max_iterations; ++iteration) {
-    const float max_change = update_all_dispatch(graph, node_scores, edge_scores, q, next,
-                                                 settings.damping, settings.threads);
-    q.swap(next);  // rows without neighbours are never rewritten and start equal in both
+    float max_change = 0.0f;
+#pragma omp parallel num_threads(settings.threads) reduction(max : max_change)
+    {
+      FlushSubnormals flush;
+      MeanFieldUpdater<KP> updater(pr.classes, kp);
+#pragma omp for schedule(dynamic, 1024)
+      for (long long i = 0; i < n; ++i) {
+        if (g.offsets[i] == g.offsets[i + 1]) continue;  // no neighbours: q is final
+        // Skip a node whose q and neighbours' q all settled last iteration (decided from the
+        // previous iteration alone: thread-count independent).
+        bool needed = moved_before[i] != 0;
+        for (std::uint32_t p = g.offsets[i]; !needed && p < g.offsets[i + 1]; ++p)
+          needed = moved_before[g.neighbors[p]] != 0;
+        if (!needed) {
+          if (!same[i]) {
+            std::copy_n(q + i * kp, kp, next + i * kp);
+            same[i] = 1;
+          }
+          moved[i] = 0;
+          continue;
+        }
+        same[i] = 0;
+        const float change = updater.update(pr, q, next, settings.damping, i);
+        moved[i] = change >= settings.tolerance;
+        max_change = std::max(max_change, change);
+      }
+    }
+    std::swap(q_buf, next_buf);
+    std::swap(q, next);
+    std::swap(moved_before, moved);
     report.iterations = iteration;
     report.final_change = max_change;
     if (max_change < settings.tolerance) {
@@ -100,7 +120,25 @@ RowMatrixXd run_mean_field(const Graph& graph, const RowMatrixXf& node_scores,
       break;
     }
   }
-  return q;
+  return report;
+}
+
+}  // namespace
+
+BpRun run_mean_field(const MeanFieldProblem& problem, const BpSettings& settings,
+                     MeanFieldBuffers& buffers) {
+  switch (padded_classes(problem.classes)) {
+    case 4:
+      return run<4>(problem, settings, buffers);
+    case 8:
+      return run<8>(problem, settings, buffers);
+    case 12:
+      return run<12>(problem, settings, buffers);
+    case 16:
+      return run<16>(problem, settings, buffers);
+    default:
+      return run<Eigen::Dynamic>(problem, settings, buffers);
+  }
 }
 
 }  // namespace primlabel::crf::detail

@@ -13,6 +13,8 @@ namespace {
 // parallel itself, so every score comes out of the same serial kernel whatever the thread count.
 constexpr long long kNodeBlock = 128;
 constexpr int kEdgeBatch = 128;
+// psi = exp(theta) stays far from float overflow (messages are products of psi and values <= 1).
+constexpr float kMaxEdgeScore = 60.0f;
 
 using ConstRowMap = Eigen::Map<const Eigen::RowVectorXf>;
 
@@ -111,6 +113,133 @@ RowMatrixXf edge_scores(const CrfModel& model, std::span<const float> descriptor
     }
   }
   return scores;
+}
+
+}  // namespace primlabel::crf::detail
+
+namespace primlabel::crf::detail {
+
+std::size_t number_edges(const Graph& graph, int threads, ScratchBuffer<std::uint32_t>& edge_of,
+                         ScratchBuffer<std::uint32_t>& block_first_edge) {
+  const long long n = static_cast<long long>(graph.num_nodes());
+  const long long blocks = (n + kNodeBlock - 1) / kNodeBlock;
+  std::uint32_t* first = block_first_edge.resize(blocks + 1);
+  std::uint32_t* of = edge_of.resize(graph.num_slots());
+  const std::uint32_t* offsets = graph.offsets.data();
+  const std::uint32_t* neighbors = graph.neighbors.data();
+  const std::uint32_t* reverse = graph.reverse.data();
+  // Fixed node blocks and a serial prefix sum: the numbering never depends on the threads.
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (long long b = 0; b < blocks; ++b) {
+    std::uint32_t count = 0;
+    const long long last = std::min(n, (b + 1) * kNodeBlock);
+    for (long long i = b * kNodeBlock; i < last; ++i)
+      for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p) count += neighbors[p] > i;
+    first[b + 1] = count;
+  }
+  first[0] = 0;
+  for (long long b = 0; b < blocks; ++b) first[b + 1] += first[b];
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (long long b = 0; b < blocks; ++b) {
+    std::uint32_t e = first[b];
+    const long long last = std::min(n, (b + 1) * kNodeBlock);
+    for (long long i = b * kNodeBlock; i < last; ++i)
+      for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p)
+        if (neighbors[p] > i) {
+          of[p] = e;
+          of[reverse[p]] = e;  // each slot is written once, by the owner of its edge
+          ++e;
+        }
+  }
+  return first[blocks];
+}
+
+void node_scores_padded(const CrfModel& model, std::span<const float> descriptors,
+                        const Graph& graph, int threads, float* out) {
+  const long long n = static_cast<long long>(graph.num_nodes());
+  const int d = model.descriptor_dim;
+  const int k_count = model.num_classes();
+  const int kp = padded_classes(k_count);
+  const float scale = model.feature_scale;
+  const Eigen::MatrixXf weights_t = model.node_weights.transpose();  // (d + 1) x K
+  const long long blocks = (n + kNodeBlock - 1) / kNodeBlock;
+#pragma omp parallel num_threads(threads)
+  {
+    RowMatrixXf features(kNodeBlock, d + 1);
+    RowMatrixXf scores(kNodeBlock, k_count);
+#pragma omp for schedule(static)
+    for (long long b = 0; b < blocks; ++b) {
+      const long long first = b * kNodeBlock;
+      const long long count = std::min(kNodeBlock, n - first);
+      for (long long r = 0; r < count; ++r) {
+        const long long i = first + r;
+        if (graph.active[i]) {
+          features.row(r).head(d) = scale * ConstRowMap(descriptors.data() + i * d, d);
+          features(r, d) = 1.0f;
+        } else {
+          features.row(r).setZero();
+        }
+      }
+      scores.topRows(count).noalias() = features.topRows(count) * weights_t;
+      for (long long r = 0; r < count; ++r) {
+        float* row = out + (first + r) * kp;
+        std::copy_n(scores.row(r).data(), k_count, row);
+        std::fill(row + k_count, row + kp, 0.0f);
+      }
+    }
+  }
+}
+
+void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors,
+                       const Graph& graph, const std::uint32_t* block_first_edge, int threads,
+                       bool potentials_minus_one, float* out) {
+  const long long n = static_cast<long long>(graph.num_nodes());
+  const int d = model.descriptor_dim;
+  const int k_count = model.num_classes();
+  const int kp = padded_classes(k_count);
+  const float scale2 = model.feature_scale * model.feature_scale;
+  const Eigen::MatrixXf weights_t = model.edge_weights.transpose();  // (d + 1) x K
+  const long long blocks = (n + kNodeBlock - 1) / kNodeBlock;
+#pragma omp parallel num_threads(threads)
+  {
+    RowMatrixXf features(kEdgeBatch, d + 1);
+    RowMatrixXf batch(kEdgeBatch, k_count);
+    std::size_t batch_first = 0;  // edge number of the batch's first row
+    int m = 0;
+    const auto flush = [&] {
+      if (m == 0) return;
+      batch.topRows(m).noalias() = features.topRows(m) * weights_t;
+      if (potentials_minus_one) {
+        // One vectorised exp over the whole batch while it is in cache.
+        Eigen::Map<Eigen::ArrayXf> flat(batch.data(), Eigen::Index(m) * k_count);
+        flat = flat.min(kMaxEdgeScore).exp() - 1.0f;
+      }
+      for (int r = 0; r < m; ++r) {
+        float* row = out + (batch_first + r) * kp;
+        std::copy_n(batch.row(r).data(), k_count, row);
+        std::fill(row + k_count, row + kp, 0.0f);
+      }
+      batch_first += m;
+      m = 0;
+    };
+#pragma omp for schedule(static)
+    for (long long b = 0; b < blocks; ++b) {
+      batch_first = block_first_edge[b];
+      const long long last = std::min(n, (b + 1) * kNodeBlock);
+      for (long long i = b * kNodeBlock; i < last; ++i) {
+        const ConstRowMap xi(descriptors.data() + i * d, d);
+        for (std::uint32_t p = graph.offsets[i]; p < graph.offsets[i + 1]; ++p) {
+          const std::uint32_t j = graph.neighbors[p];
+          if (j < i) continue;  // edges in the order number_edges gives them
+          features.row(m).head(d) =
+              scale2 * xi.cwiseProduct(ConstRowMap(descriptors.data() + std::size_t(j) * d, d));
+          features(m, d) = 1.0f;
+          if (++m == kEdgeBatch) flush();
+        }
+      }
+      flush();  // batches never span blocks, so they do not depend on the schedule
+    }
+  }
 }
 
 }  // namespace primlabel::crf::detail

@@ -4,8 +4,15 @@
 // thread count.
 
 #include <Eigen/Core>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
+
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
 
 #include "primlabel/crf/graph.hpp"
 #include "primlabel/crf/model.hpp"
@@ -23,6 +30,77 @@ RowMatrixXf node_scores(const CrfModel& model, std::span<const float> descriptor
 // row). Zero when the model has no edge terms.
 RowMatrixXf edge_scores(const CrfModel& model, std::span<const float> descriptors,
                         const Graph& graph, int threads);
+
+// ---- Padded layouts of the inference fast path ------------------------------------------------
+// Rows of K classes are stored with a stride padded to a multiple of 4 floats, so the per-class
+// loops run on whole SSE/AVX vectors; pad entries are 0 unless stated otherwise.
+inline int padded_classes(int k_count) { return (k_count + 3) / 4 * 4; }
+
+// A growable buffer of trivially constructible values that is never zero-filled: resizing to a
+// size it already has is free, and fresh pages are first touched by the (parallel) code that
+// writes them instead of by a serial fill.
+template <typename T>
+class ScratchBuffer {
+ public:
+  T* resize(std::size_t n) {
+    if (n > capacity_) {
+      data_.reset(new T[n]);  // default-initialised: no fill
+      capacity_ = n;
+    }
+    size_ = n;
+    return data_.get();
+  }
+  T* data() { return data_.get(); }
+  const T* data() const { return data_.get(); }
+  std::size_t size() const { return size_; }
+  std::size_t bytes() const { return capacity_ * sizeof(T); }
+  void release() {
+    data_.reset();
+    capacity_ = size_ = 0;
+  }
+
+ private:
+  std::unique_ptr<T[]> data_;
+  std::size_t capacity_ = 0;
+  std::size_t size_ = 0;
+};
+
+// Undirected edge numbering: edge e is owned by the slot p of its lower endpoint i (neighbors[p]
+// > i), numbered in node order; edge_of[p] = edge_of[reverse[p]] = e. Returns num_edges().
+std::size_t number_edges(const Graph& graph, int threads, ScratchBuffer<std::uint32_t>& edge_of,
+                         ScratchBuffer<std::uint32_t>& block_first_edge);
+
+// theta_i(k) for every node into `out` (num_nodes x padded K, pads 0; inactive rows 0).
+void node_scores_padded(const CrfModel& model, std::span<const float> descriptors,
+                        const Graph& graph, int threads, float* out);
+
+// theta_ij(k, k) per undirected edge (numbered by number_edges) into `out` (num_edges x padded K,
+// pads 0), or psi_ij(k) - 1 = exp(min(theta, 60)) - 1 when `potentials_minus_one`.
+void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors,
+                       const Graph& graph, const std::uint32_t* block_first_edge, int threads,
+                       bool potentials_minus_one, float* out);
+
+// Products of tiny values would otherwise run into subnormals, which are ~100x slower on x86;
+// flushing them to zero changes nothing that matters next to a maximum of 1.
+class FlushSubnormals {
+ public:
+  FlushSubnormals() {
+#if defined(__SSE2__)
+    saved_ = _mm_getcsr();
+    _mm_setcsr(saved_ | 0x8040);  // FTZ | DAZ
+#endif
+  }
+  ~FlushSubnormals() {
+#if defined(__SSE2__)
+    _mm_setcsr(saved_);
+#endif
+  }
+  FlushSubnormals(const FlushSubnormals&) = delete;
+  FlushSubnormals& operator=(const FlushSubnormals&) = delete;
+
+ private:
+  unsigned saved_ = 0;
+};
 
 // Threads worth starting for `nodes` nodes: small graphs run on one thread, since a parallel
 // region per BP iteration costs more than it saves there (and stalls on a busy machine).

@@ -9,7 +9,9 @@
 // m_{i->j}(l) = max(max_{k != l} h(k), h(l) psi_ij(l)). Both cost O(K) instead of O(K^2).
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -26,9 +28,17 @@ enum class InferenceMethod {
 struct InferenceOptions {
   InferenceMethod method = InferenceMethod::kLoopyBp;
   bool max_product = false;  // BP only: MAP labels from max-marginals instead of marginals
-  int max_iterations = 30;
-  float damping = 0.5f;     // new = (1 - damping) * update + damping * old
-  float tolerance = 1e-3f;  // converged when no message / q value moved more than this
+  // BP and mean-field converge on scan-like graphs within ~15 iterations (damping 0.5); nodes
+  // that settled are skipped, so the last iterations cost little.
+  int max_iterations = 15;
+  // new = (1 - damping) * update + damping * old (BP's first iteration, from uniform messages,
+  // is not damped).
+  float damping = 0.5f;
+  // Converged when no node's result moved more than this between two iterations: BP tests the
+  // beliefs (normalised to sum 1, the marginals it returns), mean-field the q values. A node
+  // whose messages (q) and whose neighbours' moved less than this in the previous iteration is
+  // not recomputed.
+  float tolerance = 1e-3f;
   bool compute_marginals = false;
   std::uint32_t unknown_label = 0;  // label of points without a descriptor
   int threads = 0;                  // 0 = OpenMP default; results do not depend on it
@@ -41,7 +51,31 @@ struct InferenceResult {
   Eigen::MatrixXf marginals;
   int iterations = 0;
   bool converged = false;
-  float final_change = 0.0f;  // largest message (or q) change in the last iteration
+  float final_change = 0.0f;  // largest belief (or q) change in the last iteration
+};
+
+// The buffers of one inference call (node and edge potentials, messages, beliefs: ~1.2 kB per
+// point for K = 10 and a kNN-8 graph). Keep one per calling thread and pass it to every call to
+// label repeatedly without allocating (fresh buffers are page-faulted in on every call). Not
+// thread-safe; results never depend on it.
+class InferenceWorkspace {
+ public:
+  InferenceWorkspace();
+  ~InferenceWorkspace();
+  InferenceWorkspace(InferenceWorkspace&&) noexcept;
+  InferenceWorkspace& operator=(InferenceWorkspace&&) noexcept;
+  InferenceWorkspace(const InferenceWorkspace&) = delete;
+  InferenceWorkspace& operator=(const InferenceWorkspace&) = delete;
+
+  std::size_t bytes() const;  // memory held
+  void release();             // frees it all
+
+  struct Buffers;  // defined in core/src/crf/inference.cpp
+
+ private:
+  friend InferenceResult infer(const CrfModel&, std::span<const float>, const Graph&,
+                               const InferenceOptions&, InferenceWorkspace&);
+  std::unique_ptr<Buffers> buffers_;
 };
 
 // `descriptors` is row-major graph.num_nodes() x model.descriptor_dim. Nodes the graph marks
@@ -49,5 +83,8 @@ struct InferenceResult {
 // reduces to the per-node argmax. Throws std::invalid_argument on shape mismatches.
 InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
                       const InferenceOptions& options = {});
+// The same, with the caller's buffers (bit-identical results).
+InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
+                      const InferenceOptions& options, InferenceWorkspace& workspace);
 
 }  // namespace primlabel::crf
