@@ -14,21 +14,9 @@
 namespace primlabel {
 namespace {
 
-struct Result {
-  int exit_code;
-  std::string output;  // stdout and stderr
-};
+using Result = test::CommandResult;
 
-Result run(const std::string& command) {
-  Result result{-1, {}};
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+Result run(const std::string& command) { return test::run_command(command); }
 
 std::string features_tool() { return test::binary("primlabel-features"); }
 

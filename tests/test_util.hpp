@@ -2,8 +2,11 @@
 // Helpers shared by the test executables: fixture paths, CSV fixtures, synthetic clouds.
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -46,6 +49,28 @@ inline std::vector<std::vector<float>> read_csv(const std::string& path) {
     if (numeric) rows.push_back(std::move(row));
   }
   return rows;
+}
+
+// What a command printed (stdout and stderr together) and how it exited (-1: killed or not run).
+struct CommandResult {
+  int exit_code;
+  std::string output;
+};
+
+// Runs `command` through the shell, as a user would type it.
+inline CommandResult run_command(const std::string& command) {
+  CommandResult result{-1, {}};
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return result;
+  char buffer[4096];
+  while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+inline int count_lines(const std::string& text) {
+  return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
 }
 
 // A fresh temporary directory, removed when the object dies.

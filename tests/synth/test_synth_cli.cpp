@@ -17,23 +17,13 @@
 namespace primlabel {
 namespace {
 
-struct Result {
-  int exit_code;
-  std::string output;  // stdout and stderr
-};
+using Result = test::CommandResult;
 
 Result run(const std::string& arguments) {
-  Result result{-1, {}};
-  FILE* pipe = popen((test::binary("primlabel-synth") + " " + arguments + " 2>&1").c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
+  return test::run_command(test::binary("primlabel-synth") + " " + arguments);
 }
 
-int lines(const std::string& text) { return int(std::count(text.begin(), text.end(), '\n')); }
+int lines(const std::string& text) { return test::count_lines(text); }
 
 TEST(SynthCli, ListsTheClassesAsAClassMap) {
   const Result r = run("--list-classes");

@@ -13,20 +13,10 @@
 namespace primlabel {
 namespace {
 
-struct Result {
-  int exit_code;
-  std::string output;  // stdout and stderr
-};
+using Result = test::CommandResult;
 
 Result run(const std::string& arguments) {
-  Result result{-1, {}};
-  FILE* pipe = popen((test::binary("primlabel-tabletop") + " " + arguments + " 2>&1").c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
+  return test::run_command(test::binary("primlabel-tabletop") + " " + arguments);
 }
 
 std::string last_line(const std::string& text) {
