@@ -13,6 +13,7 @@
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <numeric>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -24,6 +25,7 @@
 #include "primlabel/core/neighbor_search.hpp"
 #include "primlabel/core/normals.hpp"
 #include "primlabel/core/point_cloud.hpp"
+#include "primlabel/tabletop/voxel_grid.hpp"
 
 #ifdef PRIMLABEL_HAVE_PCL
 #include "pcl_peer.hpp"
@@ -115,43 +117,6 @@ PointCloud finite_points(const PointCloud& cloud) {
   out.width = static_cast<std::uint32_t>(out.xyz.size());
   out.height = 1;
   return out;
-}
-
-// Voxel-grid downsample: one point per occupied voxel, at the centroid of the voxel's points (as
-// pcl::VoxelGrid does), in voxel order. A local stand-in until the core gets a voxel filter.
-// `points` must be finite.
-std::vector<Vec3f> voxel_downsample(const std::vector<Vec3f>& points, float voxel) {
-  if (points.empty()) return {};
-  Eigen::Array3f lo = points[0].array(), hi = lo;
-  for (const Vec3f& p : points) {
-    lo = lo.min(p.array());
-    hi = hi.max(p.array());
-  }
-  const Eigen::Array3d extent = ((hi - lo).cast<double>() / voxel).floor() + 1.0;
-  if (extent.prod() > 9e18) throw std::invalid_argument("voxel size too small for this cloud");
-  const auto nx = static_cast<std::uint64_t>(extent.x());
-  const auto ny = static_cast<std::uint64_t>(extent.y());
-
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Array3d cell = ((points[i].array() - lo).cast<double>() / voxel).floor();
-    const auto x = static_cast<std::uint64_t>(cell.x());
-    const auto y = static_cast<std::uint64_t>(cell.y());
-    const auto z = static_cast<std::uint64_t>(cell.z());
-    keyed[i] = {x + nx * (y + ny * z), static_cast<std::uint32_t>(i)};
-  }
-  std::sort(keyed.begin(), keyed.end());  // by voxel, then by index: deterministic sums
-
-  std::vector<Vec3f> centroids;
-  for (std::size_t begin = 0; begin < keyed.size();) {
-    std::size_t end = begin;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (; end < keyed.size() && keyed[end].first == keyed[begin].first; ++end)
-      sum += points[keyed[end].second].cast<double>();
-    centroids.push_back((sum / static_cast<double>(end - begin)).cast<float>());
-    begin = end;
-  }
-  return centroids;
 }
 
 // Evenly spaced indices 0, n/m, 2n/m, ... : at most `m` of them, the same on every run.
@@ -422,7 +387,10 @@ int run_features_bench(const FeaturesBenchOptions& options) {
   std::cerr << options.input << ": " << raw.size() << " points, " << cloud.size()
             << " finite (read in " << load_seconds << " s; peak RSS " << peak_rss_mb() << " MB)\n";
   if (options.voxel > 0.0f) {
-    cloud.xyz = voxel_downsample(cloud.xyz, options.voxel);
+    // The input holds finite points only (dropped above), so every point takes part.
+    std::vector<std::uint32_t> all(cloud.size());
+    std::iota(all.begin(), all.end(), 0u);
+    cloud.xyz = tabletop::voxel_downsample(cloud.xyz, all, options.voxel).centroids;
     cloud.width = static_cast<std::uint32_t>(cloud.size());
     std::cerr << "voxel " << options.voxel << ": " << cloud.size() << " points\n";
   }
