@@ -7,6 +7,8 @@
 #include <string>
 #include <tuple>
 
+#include "disjoint_sets.hpp"
+
 namespace primlabel::tabletop {
 
 void ClusterOptions::validate() const {
@@ -30,25 +32,6 @@ std::uint64_t pack(std::int64_t x, std::int64_t y, std::int64_t z) {
 struct Cell {
   std::uint64_t key;
   std::uint32_t begin, end;  // range in the sorted point order
-};
-
-class DisjointSets {
- public:
-  explicit DisjointSets(std::size_t n) : parent_(n) {
-    std::iota(parent_.begin(), parent_.end(), 0u);
-  }
-  std::uint32_t find(std::uint32_t a) {
-    while (parent_[a] != a) a = parent_[a] = parent_[parent_[a]];
-    return a;
-  }
-  void join(std::uint32_t a, std::uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-  }
-
- private:
-  std::vector<std::uint32_t> parent_;
 };
 
 }  // namespace

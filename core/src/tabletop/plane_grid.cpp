@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "disjoint_sets.hpp"
+
 namespace primlabel::tabletop {
 
 namespace {
@@ -17,26 +19,6 @@ std::uint64_t pack(std::int32_t x, std::int32_t y) {
 std::size_t hash_slot(std::uint64_t key, std::size_t slots) {
   return static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 17) & (slots - 1);
 }
-
-// Disjoint sets whose root is the smallest member, so that results follow the input order.
-class DisjointSets {
- public:
-  explicit DisjointSets(std::size_t n) : parent_(n) {
-    for (std::size_t i = 0; i < n; ++i) parent_[i] = static_cast<std::uint32_t>(i);
-  }
-  std::uint32_t find(std::uint32_t a) {
-    while (parent_[a] != a) a = parent_[a] = parent_[parent_[a]];
-    return a;
-  }
-  void join(std::uint32_t a, std::uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-  }
-
- private:
-  std::vector<std::uint32_t> parent_;
-};
 
 // 2D cross product of (a - o) and (b - o), in double: see convex_hull.cpp.
 double cross(const Vec2f& o, const Vec2f& a, const Vec2f& b) {
