@@ -3,7 +3,6 @@
 
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -11,33 +10,12 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <new>
 #include <string>
 #include <vector>
 
+#include "allocation_guard.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "test_util.hpp"
-
-// Records the largest single allocation, so tests can prove that absurd header values are
-// rejected before anything of that size is allocated.
-namespace {
-std::atomic<std::size_t> g_largest_allocation{0};
-
-void* guarded_allocate(std::size_t size) {
-  std::size_t seen = g_largest_allocation.load(std::memory_order_relaxed);
-  while (size > seen && !g_largest_allocation.compare_exchange_weak(seen, size)) {
-  }
-  if (void* p = std::malloc(size ? size : 1)) return p;
-  throw std::bad_alloc();
-}
-}  // namespace
-
-void* operator new(std::size_t size) { return guarded_allocate(size); }
-void* operator new[](std::size_t size) { return guarded_allocate(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace primlabel {
 namespace {
@@ -732,13 +710,19 @@ TEST(PcdMalformedFiles, DirectoryIsNotARegularFile) {
 // Absurd sizes in tiny files must fail on the size check, before allocating anything like them.
 class PcdHugeHeader : public ::testing::TestWithParam<MalformedPcd> {};
 
+TEST(AllocationGuard, SeesLargeAllocations) {  // else the test below would prove nothing
+  test::reset_largest_allocation();
+  std::vector<char> big(std::size_t{2} << 20);
+  EXPECT_GE(test::largest_allocation(), big.size());
+}
+
 TEST_P(PcdHugeHeader, FailsWithoutAllocatingTheDeclaredSize) {
   test::TempDir dir;
   const std::string path = dir.file(std::string(GetParam().name) + ".pcd");
   write_bytes(path, GetParam().contents);
-  g_largest_allocation = 0;
+  test::reset_largest_allocation();
   expect_read_error(path, GetParam().expected);
-  EXPECT_LT(g_largest_allocation.load(), std::size_t{1} << 20)
+  EXPECT_LT(test::largest_allocation(), std::size_t{1} << 20)
       << "largest allocation while reading a " << GetParam().contents.size() << "-byte file";
 }
 
