@@ -21,6 +21,7 @@ PACKAGES=(
   build-essential cmake pkg-config
   libeigen3-dev libnanoflann-dev liblzf-dev libcli11-dev libpng-dev zlib1g-dev
   libprotobuf-dev protobuf-compiler liblbfgspp-dev libsvm-dev
+  libgrpc++-dev protobuf-compiler-grpc
   libgtest-dev
 )
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev)
