@@ -131,7 +131,8 @@ void LabelServer::shutdown(std::chrono::milliseconds drain) {
   std::lock_guard shutdown_lock(shutdown_mutex_);
   if (shut_down_) return;
   shut_down_ = true;
-  log_info("shutting_down").kv("drain_ms", std::int64_t(drain.count()))
+  log_info("shutting_down")
+      .kv("drain_ms", std::int64_t(drain.count()))
       .kv("in_flight", admission_->admitted());
   {
     std::lock_guard lock(health_mutex_);

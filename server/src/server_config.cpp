@@ -128,7 +128,8 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
   } catch (const CLI::ParseError& e) {
     std::ostringstream out, err;
     app.exit(e, out, err);
-    throw ConfigError{e.get_exit_code() == 0 ? out.str() : err.str(), e.get_exit_code() == 0 ? 0 : 2};
+    throw ConfigError{e.get_exit_code() == 0 ? out.str() : err.str(),
+                      e.get_exit_code() == 0 ? 0 : 2};
   }
 
   for (const std::string& pin : pins) {
