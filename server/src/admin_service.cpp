@@ -1,25 +1,10 @@
 #include "admin_service.hpp"
 
 #include "labeler_service.hpp"
+#include "registry_status.hpp"
 #include "request_record.hpp"
 
 namespace primlabel::server {
-
-namespace {
-
-grpc::Status from_registry_error(const RegistryError& error) {
-  switch (error.kind()) {
-    case RegistryError::Kind::kNotFound:
-      return {grpc::StatusCode::NOT_FOUND, error.what()};
-    case RegistryError::Kind::kInvalidArgument:
-      return {grpc::StatusCode::INVALID_ARGUMENT, error.what()};
-    case RegistryError::Kind::kLoadFailed:
-      return {grpc::StatusCode::FAILED_PRECONDITION, error.what()};
-  }
-  return {grpc::StatusCode::INTERNAL, error.what()};
-}
-
-}  // namespace
 
 grpc::Status AdminService::LoadModel(grpc::ServerContext* context,
                                      const v1::LoadModelRequest* request,
@@ -34,7 +19,7 @@ grpc::Status AdminService::LoadModel(grpc::ServerContext* context,
     env_.metrics->reloads(1, 0);
   } catch (const RegistryError& error) {
     if (error.kind() == RegistryError::Kind::kLoadFailed) env_.metrics->reloads(0, 1);
-    return record.finish(from_registry_error(error));
+    return record.finish(registry_status(error));
   }
   env_.models_changed();
   for (const ServedModel& model : env_.registry->list())
@@ -53,7 +38,7 @@ grpc::Status AdminService::UnloadModel(grpc::ServerContext* context,
   try {
     response->set_unloaded_versions(env_.registry->unload(request->model(), request->version()));
   } catch (const RegistryError& error) {
-    return record.finish(from_registry_error(error));
+    return record.finish(registry_status(error));
   }
   env_.models_changed();
   return record.finish(grpc::Status::OK);
@@ -72,7 +57,7 @@ grpc::Status AdminService::ReloadModels(grpc::ServerContext* context,
     response->set_failed(report.failed);
     for (const std::string& error : report.errors) response->add_errors(error);
   } catch (const RegistryError& error) {
-    return record.finish(from_registry_error(error));
+    return record.finish(registry_status(error));
   }
   env_.models_changed();
   for (const ServedModel& model : env_.registry->list())

@@ -5,24 +5,13 @@
 #include <stop_token>
 
 #include "logging.hpp"
+#include "registry_status.hpp"
 
 namespace primlabel::server {
 
 namespace {
 
 constexpr auto kPollInterval = std::chrono::milliseconds(5);
-
-grpc::Status from_registry_error(const RegistryError& error) {
-  switch (error.kind()) {
-    case RegistryError::Kind::kNotFound:
-      return {grpc::StatusCode::NOT_FOUND, error.what()};
-    case RegistryError::Kind::kInvalidArgument:
-      return {grpc::StatusCode::INVALID_ARGUMENT, error.what()};
-    case RegistryError::Kind::kLoadFailed:
-      return {grpc::StatusCode::FAILED_PRECONDITION, error.what()};
-  }
-  return {grpc::StatusCode::INTERNAL, error.what()};
-}
 
 // Why the call must stop now, if it must.
 grpc::Status stop_reason(grpc::ServerContext& context) {
@@ -41,7 +30,7 @@ grpc::Status plan_labeling(const v1::ScanHeader& header, const ServiceEnvironmen
   try {
     plan.entry = env.registry->resolve(header.model(), header.model_version());
   } catch (const RegistryError& error) {
-    return from_registry_error(error);
+    return registry_status(error);
   }
   const LabelModel& model = *plan.entry->model;
   const std::string which =

@@ -3,6 +3,7 @@
 #include <grpcpp/support/method_handler.h>
 
 #include "label_stream.hpp"
+#include "registry_status.hpp"
 #include "request_record.hpp"
 
 namespace primlabel::server {
@@ -73,7 +74,7 @@ grpc::Status LabelerService::GetModelMetadata(grpc::ServerContext* context,
     record.version = entry->version;
     *response = entry->metadata;
   } catch (const RegistryError& error) {
-    return record.finish({grpc::StatusCode::NOT_FOUND, error.what()});
+    return record.finish(registry_status(error));
   }
   return record.finish(grpc::Status::OK);
 }
