@@ -20,10 +20,10 @@ namespace {
 using namespace primlabel;
 
 struct Arguments {
-  int synth_train = 3, synth_val = 1, iterations = 100, graph_k = 8, threads = 0;
-  std::string sensor = "lms400", kind = "crf", objective = "pl", descriptor = "fpfh";
-  std::string fpfh_variant = "pcl";
-  double label_radius = synth::kDefaultLabelRadius, l2 = 1e-5;
+  int synth_train = 8, synth_val = 1, iterations = 200, graph_k = 8, threads = 0;
+  std::string sensor = "lms400", kind = "crf", objective = "piecewise", descriptor = "fpfh";
+  std::string fpfh_variant = "paper";
+  double label_radius = synth::kDefaultLabelRadius, l2 = 1e-6;
   float feature_radius = 0.025f, normal_radius = 0.01f;
   std::vector<std::string> train_files, val_files;
   std::string classes, output, curve_csv, curve_png, name;
@@ -98,7 +98,8 @@ int run(const Arguments& args) {
   pipeline::ModelTrainingOptions options;
   options.kind = args.kind == "node" ? ModelKind::kNodeOnly : ModelKind::kCrf;
   options.objective = args.objective == "bethe" ? crf::TrainingObjective::kBetheBp
-                                                : crf::TrainingObjective::kPseudoLikelihood;
+                      : args.objective == "pl"  ? crf::TrainingObjective::kPseudoLikelihood
+                                                : crf::TrainingObjective::kPiecewise;
   options.l2 = args.l2;
   options.iterations = args.iterations;
   options.threads = args.threads;
@@ -145,7 +146,7 @@ int main(int argc, char** argv) {
   app.name("primlabel-train");
   Arguments args;
   auto* synth_train =
-      app.add_option("--synth-train", args.synth_train, "synthetic training scenes (default 3)")
+      app.add_option("--synth-train", args.synth_train, "synthetic training scenes (default 8)")
           ->check(CLI::PositiveNumber);
   auto* synth_val =
       app.add_option("--synth-val", args.synth_val, "synthetic validation scenes (default 1)")
@@ -163,16 +164,18 @@ int main(int argc, char** argv) {
       ->needs(train_files);
   app.add_option("--kind", args.kind, "crf, node (node-only) or svm")
       ->check(CLI::IsMember({"crf", "node", "svm"}));
-  app.add_option("--objective", args.objective, "CRF objective: pl (pseudo-likelihood) or bethe")
-      ->check(CLI::IsMember({"pl", "bethe"}));
+  app.add_option("--objective", args.objective,
+                 "CRF objective: piecewise (default: node factors, then a validated coupling), "
+                 "pl (pseudo-likelihood) or bethe (loopy BP)")
+      ->check(CLI::IsMember({"piecewise", "pl", "bethe"}));
   app.add_option("--descriptor", args.descriptor, "fpfh or pfh")
       ->check(CLI::IsMember({"fpfh", "pfh"}));
   app.add_option("--fpfh-variant", args.fpfh_variant,
-                 "pcl (as PCL) or paper (also the point's own SPFH, as Open3D)")
+                 "paper (default: also the point's own SPFH, as Open3D) or pcl (as PCL)")
       ->check(CLI::IsMember({"pcl", "paper"}));
-  app.add_option("--l2", args.l2, "L2 regularisation (default 1e-5)")
+  app.add_option("--l2", args.l2, "L2 regularisation (default 1e-6)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--iterations", args.iterations, "L-BFGS iterations (default 100)")
+  app.add_option("--iterations", args.iterations, "L-BFGS iterations (default 200)")
       ->check(CLI::PositiveNumber);
   app.add_option("--feature-radius", args.feature_radius, "descriptor radius (m, default 0.025)")
       ->check(CLI::PositiveNumber);
