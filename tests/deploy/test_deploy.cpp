@@ -124,6 +124,15 @@ TEST(Deploy, MakeDefaultModelIsExecutableAndWrapsSetup) {
   EXPECT_EQ(run_command(script).exit_code, 2);  // usage
 }
 
+TEST(Deploy, ShellScriptsParse) {
+  for (const char* script :
+       {"deploy/setup.sh", "deploy/make-default-model.sh", "deploy/local-proof.sh"}) {
+    const auto result = run_command("bash -n " + source_path(script));
+    EXPECT_EQ(result.exit_code, 0) << script << "\n" << result.output;
+    EXPECT_EQ(access(source_path(script).c_str(), X_OK), 0) << script << " is not executable";
+  }
+}
+
 // ---- each check fails on a broken copy ----
 
 TEST_F(BrokenCopy, DockerfileRunningAsRootFails) {
