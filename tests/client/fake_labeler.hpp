@@ -15,6 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "primlabel/client/client.hpp"
+#include "primlabel/metrics/counter.hpp"
+#include "primlabel/metrics/family.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "wire.hpp"
 
@@ -37,9 +40,34 @@ class FakeLabeler final : public v1::Labeler::Service {
   std::mutex mutex;
   std::vector<std::string> scan_ids;  // in arrival order
 
+  // When set, every Label / LabelCloud call is counted here as the real server does:
+  // primlabel_requests_total{method, model, status}.
+  metrics::Family<metrics::Counter>* requests_total = nullptr;
+
   grpc::Status Label(
       grpc::ServerContext* context,
       grpc::ServerReaderWriter<v1::LabelResponse, v1::LabelRequest>* stream) override {
+    return counted("Label", label_stream(context, stream));
+  }
+
+  grpc::Status LabelCloud(grpc::ServerContext* context, const v1::LabelCloudRequest* request,
+                          v1::LabelCloudResponse* response) override {
+    return counted("LabelCloud", label_unary(context, request, response));
+  }
+
+ private:
+  grpc::Status counted(const std::string& method, grpc::Status status) {
+    if (requests_total)
+      requests_total
+          ->Add({{"method", method},
+                 {"model", "fake"},
+                 {"status", client::status_code_name(status.error_code())}})
+          .Increment();
+    return status;
+  }
+
+  grpc::Status label_stream(grpc::ServerContext* context,
+                            grpc::ServerReaderWriter<v1::LabelResponse, v1::LabelRequest>* stream) {
     ++label_calls;
     if (auto status = admit(context); !status.ok()) return status;
     v1::LabelRequest request;
@@ -72,8 +100,8 @@ class FakeLabeler final : public v1::Labeler::Service {
     return grpc::Status::OK;
   }
 
-  grpc::Status LabelCloud(grpc::ServerContext* context, const v1::LabelCloudRequest* request,
-                          v1::LabelCloudResponse* response) override {
+  grpc::Status label_unary(grpc::ServerContext* context, const v1::LabelCloudRequest* request,
+                           v1::LabelCloudResponse* response) {
     ++label_calls;
     if (auto status = admit(context); !status.ok()) return status;
     const auto points = client::wire::unpack_vec3(request->points().xyz());
@@ -86,6 +114,7 @@ class FakeLabeler final : public v1::Labeler::Service {
     return grpc::Status::OK;
   }
 
+ public:
   grpc::Status ListModels(grpc::ServerContext*, const v1::ListModelsRequest*,
                           v1::ListModelsResponse* response) override {
     auto* m = response->add_models();
