@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 
@@ -96,22 +97,28 @@ Spool::Spool(fs::path dir, SpoolLimits limits) : dir_(std::move(dir)), limits_(l
     fs::remove(entry.path(), ec);
     ++removed_temp_files_;
   }
-  struct Found {
-    fs::file_time_type time;
-    SpooledScan scan;
-  };
-  std::vector<Found> found;
+  // Files are "<sequence>_<id><ext>": the sequence keeps the acceptance order across restarts
+  // (modification times are too coarse to order scans accepted in the same millisecond).
+  std::vector<std::pair<std::uint64_t, SpooledScan>> found;
   for (const auto& entry : fs::directory_iterator(dir_ / kScans)) {
     if (!entry.is_regular_file() || !is_scan_file(entry.path())) continue;
-    found.push_back(
-        {entry.last_write_time(), {entry.path().stem().string(), entry.path(), entry.file_size()}});
+    const std::string stem = entry.path().stem().string();
+    const auto underscore = stem.find('_');
+    if (underscore == std::string::npos) continue;  // not ours
+    std::uint64_t sequence = 0;
+    try {
+      sequence = std::stoull(stem.substr(0, underscore));
+    } catch (const std::exception&) {
+      continue;
+    }
+    found.push_back({sequence, {stem.substr(underscore + 1), entry.path(), entry.file_size()}});
   }
-  std::sort(found.begin(), found.end(), [](const Found& a, const Found& b) {
-    return a.time != b.time ? a.time < b.time : a.scan.id < b.scan.id;
-  });
-  for (auto& f : found) {
-    bytes_ += f.scan.bytes;
-    scans_.push_back(std::move(f.scan));
+  std::sort(found.begin(), found.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (auto& [sequence, scan] : found) {
+    next_sequence_ = std::max(next_sequence_, sequence + 1);
+    bytes_ += scan.bytes;
+    scans_.push_back(std::move(scan));
   }
 }
 
@@ -120,17 +127,25 @@ std::vector<SpooledScan>::const_iterator Spool::find(const std::string& id) cons
                       [&](const SpooledScan& s) { return s.id == id; });
 }
 
-Spool::Accepted Spool::accept(const std::string& id, std::string_view bytes,
-                              const std::string& ext) {
+Spool::Accepted Spool::accept(const std::string& id, std::string_view bytes, const std::string& ext,
+                              SpooledScan* stored) {
   std::lock_guard lock(mutex_);
-  if (find(id) != scans_.end()) return Accepted::kAlreadyQueued;
+  if (const auto it = find(id); it != scans_.end()) {
+    if (stored) *stored = *it;
+    return Accepted::kAlreadyQueued;
+  }
   if (scans_.size() + 1 > limits_.max_scans || bytes_ + bytes.size() > limits_.max_bytes)
     throw SpoolFull("spool full (" + std::to_string(scans_.size()) + " scans, " +
                     std::to_string(bytes_) + " of " + std::to_string(limits_.max_bytes) +
                     " bytes): scan of " + std::to_string(bytes.size()) + " bytes not accepted");
-  const fs::path target = dir_ / kScans / (id + ext);
+  char sequence[24];
+  std::snprintf(sequence, sizeof sequence, "%016llu_",
+                static_cast<unsigned long long>(next_sequence_));
+  const fs::path target = dir_ / kScans / (sequence + id + ext);
   write_file_durably(target, bytes, dir_ / kTemp);
+  ++next_sequence_;
   scans_.push_back({id, target, bytes.size()});
+  if (stored) *stored = scans_.back();
   bytes_ += bytes.size();
   return Accepted::kNew;
 }
@@ -161,7 +176,7 @@ void Spool::fail(const std::string& id, const std::string& reason) {
   std::lock_guard lock(mutex_);
   const auto it = find(id);
   if (it == scans_.end()) return;
-  const fs::path target = dir_ / kFailed / it->path.filename();
+  const fs::path target = dir_ / kFailed / (id + it->path.extension().string());
   write_file_durably(dir_ / kFailed / (id + ".error"), reason + "\n", dir_ / kTemp);
   if (::rename(it->path.c_str(), target.c_str()) != 0) fail_errno("cannot move", it->path);
   fsync_path(dir_ / kFailed);

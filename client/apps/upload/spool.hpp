@@ -1,5 +1,5 @@
 #pragma once
-// The uploader's durable spool: every accepted scan lives in <dir>/scans/<id>.<ext> until its
+// The uploader's durable spool: every accepted scan lives in <dir>/scans/<seq>_<id>.<ext> until its
 // labels are safely in the output directory. A scan is accepted only once its bytes are on disk:
 // written to <dir>/tmp/, fsynced, renamed into scans/ and the directory fsynced, so a crash or
 // power loss at any moment leaves either no trace of an unacknowledged scan (a leftover temp
@@ -46,9 +46,10 @@ class Spool {
 
   enum class Accepted { kNew, kAlreadyQueued };
 
-  // Stores the scan durably under `id` with extension `ext` (".pcd" or ".ply"). Throws SpoolFull
-  // when it does not fit, std::runtime_error when the disk write fails.
-  Accepted accept(const std::string& id, std::string_view bytes, const std::string& ext);
+  // Stores the scan durably under `id` with extension `ext` (".pcd" or ".ply") and tells where
+  // (`stored`). Throws SpoolFull when it does not fit, std::runtime_error when the write fails.
+  Accepted accept(const std::string& id, std::string_view bytes, const std::string& ext,
+                  SpooledScan* stored = nullptr);
 
   // Scans waiting, oldest accepted first (as indexed at start, then in acceptance order).
   std::vector<SpooledScan> pending() const;
@@ -74,6 +75,7 @@ class Spool {
   mutable std::mutex mutex_;
   std::vector<SpooledScan> scans_;  // acceptance order
   std::uint64_t bytes_ = 0;
+  std::uint64_t next_sequence_ = 0;
   std::size_t removed_temp_files_ = 0;
 };
 

@@ -158,9 +158,9 @@ std::string summary_line(const UploadCounters& c, std::size_t left) {
   char line[400];
   std::snprintf(
       line, sizeof line,
-      "summary: accepted %llu (%llu already queued, %llu already labeled), uploaded "
-      "%llu (%llu points), failed %llu, rejected %llu (spool full), retries %llu, left "
-      "in spool %zu",
+      "summary: accepted %llu new, %llu already spooled, %llu already labeled; uploaded "
+      "%llu (%llu points), failed %llu, rejected %llu (spool full), retries %llu, left in "
+      "spool %zu",
       static_cast<unsigned long long>(c.accepted),
       static_cast<unsigned long long>(c.already_queued),
       static_cast<unsigned long long>(c.already_labeled),

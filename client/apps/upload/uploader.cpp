@@ -73,8 +73,9 @@ Uploader::Submitted Uploader::submit(std::string_view bytes, const std::string& 
     return Submitted::kAlreadyLabeled;
   }
   Spool::Accepted accepted;
+  SpooledScan stored;
   try {
-    accepted = spool_.accept(id, bytes, ext);
+    accepted = spool_.accept(id, bytes, ext, &stored);
   } catch (const SpoolFull& e) {
     if (reason) *reason = e.what();
     std::lock_guard lock(mutex_);
@@ -86,7 +87,7 @@ Uploader::Submitted Uploader::submit(std::string_view bytes, const std::string& 
     ++counters_.already_queued;
     return Submitted::kAlreadyQueued;
   }
-  queue_.push_back({id, spool_.dir() / "scans" / (id + ext), bytes.size()});
+  queue_.push_back(stored);
   ++counters_.accepted;
   changed_.notify_all();
   return Submitted::kAccepted;
