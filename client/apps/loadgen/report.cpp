@@ -57,10 +57,12 @@ void write_text(std::FILE* out, const std::vector<ReportRow>& rows) {
   }
   for (const auto& row : rows) {
     const StepResult& r = row.step;
-    if (r.stats.errors() > 0 || r.stats.skipped() > 0)
-      std::fprintf(out, "conc %d: errors %s%s%llu skipped (client saturated)\n", r.spec.concurrency,
-                   errors_text(r.stats, ", ", " ").c_str(), r.stats.errors() ? "; " : "",
-                   static_cast<unsigned long long>(r.stats.skipped()));
+    if (r.stats.errors() > 0)
+      std::fprintf(out, "conc %d: errors %s\n", r.spec.concurrency,
+                   errors_text(r.stats, ", ", " ").c_str());
+    if (r.stats.skipped() > 0)
+      std::fprintf(out, "conc %d: %llu calls not sent (client had --max-outstanding in flight)\n",
+                   r.spec.concurrency, static_cast<unsigned long long>(r.stats.skipped()));
     if (row.server) {
       const auto sent = r.stats.ok() + r.stats.errors();
       std::fprintf(out, "conc %d: server counted %lld requests (%s); loadgen sent %llu: %s\n",
