@@ -58,9 +58,8 @@ std::shared_ptr<Admission::Job> Admission::submit(const Ticket&, std::function<v
 
 bool Admission::Job::wait_for(std::chrono::milliseconds timeout) {
   std::unique_lock lock(mutex_);
-  return done_.wait_for(lock, timeout, [this] {
-    return state_ == State::kDone || state_ == State::kAbandoned;
-  });
+  return done_.wait_for(lock, timeout,
+                        [this] { return state_ == State::kDone || state_ == State::kAbandoned; });
 }
 
 bool Admission::abandon(const std::shared_ptr<Job>& job) {

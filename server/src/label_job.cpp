@@ -44,7 +44,8 @@ grpc::Status plan_labeling(const v1::ScanHeader& header, const ServiceEnvironmen
     return from_registry_error(error);
   }
   const LabelModel& model = *plan.entry->model;
-  const std::string which = "model '" + plan.entry->name + "' version '" + plan.entry->version + "'";
+  const std::string which =
+      "model '" + plan.entry->name + "' version '" + plan.entry->version + "'";
   if (model.kind == ModelKind::kSvm)
     return {grpc::StatusCode::FAILED_PRECONDITION,
             which + " is an SVM model, which the server cannot apply yet"};
@@ -64,9 +65,8 @@ grpc::Status plan_labeling(const v1::ScanHeader& header, const ServiceEnvironmen
 }
 
 grpc::Status run_labeling(grpc::ServerContext& context, const ServiceEnvironment& env,
-                          const Admission::Ticket& ticket, const LabelPlan& plan,
-                          PointCloud& cloud, pipeline::LabelingResult& result,
-                          RequestRecord& record) {
+                          const Admission::Ticket& ticket, const LabelPlan& plan, PointCloud& cloud,
+                          pipeline::LabelingResult& result, RequestRecord& record) {
   std::stop_source stop;
   pipeline::LabelingOptions options = plan.options;
   options.stop = stop.get_token();
@@ -99,9 +99,9 @@ grpc::Status run_labeling(grpc::ServerContext& context, const ServiceEnvironment
     log_info("labeling_stopped")
         .kv("request_id", record.id())
         .kv("reason", stopped.error_message())
-        .kv("stop_ms", std::chrono::duration<double, std::milli>(
-                           std::chrono::steady_clock::now() - stop_time)
-                           .count());
+        .kv("stop_ms",
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - stop_time)
+                .count());
     return stopped;
   }
   if (!outcome.ok()) return outcome;

@@ -27,9 +27,8 @@ grpc::Status plan_labeling(const v1::ScanHeader& header, const ServiceEnvironmen
 // Runs label_cloud on a worker, polling the call every few milliseconds; fills the record's
 // prefilter / normals / features / inference times. CANCELLED or DEADLINE_EXCEEDED when stopped.
 grpc::Status run_labeling(grpc::ServerContext& context, const ServiceEnvironment& env,
-                          const Admission::Ticket& ticket, const LabelPlan& plan,
-                          PointCloud& cloud, pipeline::LabelingResult& result,
-                          RequestRecord& record);
+                          const Admission::Ticket& ticket, const LabelPlan& plan, PointCloud& cloud,
+                          pipeline::LabelingResult& result, RequestRecord& record);
 
 // RESOURCE_EXHAUSTED naming the limits, for a request refused at admission.
 grpc::Status server_busy(const Admission& admission);

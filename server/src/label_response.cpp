@@ -13,12 +13,13 @@ LabelResponder::LabelResponder(const pipeline::LabelingResult& result,
     : result_(result),
       points_(result.labels.size()),
       classes_(std::uint64_t(result.probabilities.cols())) {
-  bytes_per_point_ = wire::kLabelBytesPerPoint + sizeof(float) * std::uint64_t(result.descriptor_dim) *
-                                                     (result.descriptors.empty() ? 0 : 1) +
-                     sizeof(float) * classes_;
+  bytes_per_point_ =
+      wire::kLabelBytesPerPoint +
+      sizeof(float) * std::uint64_t(result.descriptor_dim) * (result.descriptors.empty() ? 0 : 1) +
+      sizeof(float) * classes_;
   const std::uint64_t fitting = std::max<std::uint64_t>(1, max_bytes / bytes_per_point_);
-  chunk_points_ = requested_points > 0 ? std::min<std::uint64_t>(requested_points, fitting)
-                                       : fitting;
+  chunk_points_ =
+      requested_points > 0 ? std::min<std::uint64_t>(requested_points, fitting) : fitting;
 }
 
 std::uint64_t LabelResponder::chunk_count() const {

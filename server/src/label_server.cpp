@@ -12,6 +12,8 @@ namespace primlabel::server {
 
 namespace {
 
+constexpr auto kShutdownGrace = std::chrono::milliseconds(250);
+
 ModelRegistry::Options registry_options(const ServerConfig& config) {
   ModelRegistry::Options options;
   options.root = config.models_dir;
@@ -131,7 +133,8 @@ void LabelServer::shutdown(std::chrono::milliseconds drain) {
   std::lock_guard shutdown_lock(shutdown_mutex_);
   if (shut_down_) return;
   shut_down_ = true;
-  log_info("shutting_down").kv("drain_ms", std::int64_t(drain.count()))
+  log_info("shutting_down")
+      .kv("drain_ms", std::int64_t(drain.count()))
       .kv("in_flight", admission_->admitted());
   {
     std::lock_guard lock(health_mutex_);
@@ -139,8 +142,16 @@ void LabelServer::shutdown(std::chrono::milliseconds drain) {
     if (server_) server_->GetHealthCheckService()->Shutdown();  // NOT_SERVING from now on
   }
   poller_ = {};  // stops and joins
+  // Drain ourselves: new labeling calls are refused (UNAVAILABLE) while admitted ones finish.
+  // gRPC's own Shutdown deadline would also wait for idle client connections to close, which
+  // clients without active calls notice only seconds later.
+  const auto deadline = std::chrono::system_clock::now() + drain;
+  while (admission_->admitted() > 0 && std::chrono::system_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
   if (server_) {
-    server_->Shutdown(std::chrono::system_clock::now() + drain);
+    // Short calls (model queries) get a moment; labeling calls still running past the drain
+    // deadline are cancelled and stop within a block of points.
+    server_->Shutdown(std::min(deadline, std::chrono::system_clock::now() + kShutdownGrace));
     server_->Wait();
   }
   exposer_.reset();

@@ -95,8 +95,7 @@ grpc::Status serve_label_stream(const ServiceEnvironment& env, grpc::ServerConte
   ScanAssembler assembler(header, limits_of(*env.config));
   for (std::uint64_t index = 2;; ++index) {
     if (!stream.Read(&buffer)) {
-      if (context.IsCancelled())
-        return record.finish(client_gone(context, "while sending points"));
+      if (context.IsCancelled()) return record.finish(client_gone(context, "while sending points"));
       break;  // half-close ends the scan
     }
     if (!parse_message(buffer, request))
@@ -180,11 +179,11 @@ grpc::Status serve_label_cloud(const ServiceEnvironment& env, grpc::ServerContex
   const LabelResponder responder(result, 0, std::uint64_t(-1));
   const std::uint64_t bytes = responder.bytes_per_point() * result.labels.size();
   if (bytes + 4096 > std::uint64_t(env.config->max_message_bytes))
-    return record.finish({grpc::StatusCode::RESOURCE_EXHAUSTED,
-                          "the response would take " + std::to_string(bytes) +
-                              " bytes, over the server's message limit of " +
-                              std::to_string(env.config->max_message_bytes) +
-                              "; use the streaming Label RPC"});
+    return record.finish(
+        {grpc::StatusCode::RESOURCE_EXHAUSTED, "the response would take " + std::to_string(bytes) +
+                                                   " bytes, over the server's message limit of " +
+                                                   std::to_string(env.config->max_message_bytes) +
+                                                   "; use the streaming Label RPC"});
   v1::LabelCloudResponse response;
   responder.fill_range(0, result.labels.size(), *response.mutable_result());
   record.stages.send = 0;

@@ -21,20 +21,20 @@ using RawHandler =
 LabelerService::LabelerService(const ServiceEnvironment& env) : env_(env) {
   // The labeling methods read raw bytes (a malformed message gets a precise INVALID_ARGUMENT
   // instead of looking like the end of the stream). LabelCloud stays unary on the wire.
-  MarkMethodStreamed(kLabelMethod,
-                     new RawHandler(
-                         [](LabelerService* service, grpc::ServerContext* context,
-                            RawStream* stream) {
-                           return serve_label_stream(service->env_, *context, *stream);
-                         },
-                         this));
-  MarkMethodStreamed(kLabelCloudMethod,
-                     new RawHandler(
-                         [](LabelerService* service, grpc::ServerContext* context,
-                            RawStream* stream) {
-                           return serve_label_cloud(service->env_, *context, *stream);
-                         },
-                         this));
+  MarkMethodStreamed(
+      kLabelMethod,
+      new RawHandler(
+          [](LabelerService* service, grpc::ServerContext* context, RawStream* stream) {
+            return serve_label_stream(service->env_, *context, *stream);
+          },
+          this));
+  MarkMethodStreamed(
+      kLabelCloudMethod,
+      new RawHandler(
+          [](LabelerService* service, grpc::ServerContext* context, RawStream* stream) {
+            return serve_label_cloud(service->env_, *context, *stream);
+          },
+          this));
 }
 
 void fill_model_info(const ServedModel& model, v1::ModelInfo& info) {
@@ -50,8 +50,7 @@ void fill_model_info(const ServedModel& model, v1::ModelInfo& info) {
   info.set_loaded_unix_ms(entry.loaded_unix_ms);
 }
 
-grpc::Status LabelerService::ListModels(grpc::ServerContext* context,
-                                        const v1::ListModelsRequest*,
+grpc::Status LabelerService::ListModels(grpc::ServerContext* context, const v1::ListModelsRequest*,
                                         v1::ListModelsResponse* response) {
   RequestRecord record("ListModels", *env_.metrics);
   if (grpc::Status status = env_.auth->check(*context, false); !status.ok())

@@ -3,12 +3,11 @@
 // take raw bytes so that a malformed message is answered with INVALID_ARGUMENT naming it,
 // rather than read as the end of the stream.
 
+#include <google/protobuf/message_lite.h>
 #include <grpcpp/impl/codegen/proto_utils.h>
 #include <grpcpp/support/byte_buffer.h>
 #include <grpcpp/support/proto_buffer_reader.h>
 #include <grpcpp/support/proto_buffer_writer.h>
-
-#include <google/protobuf/message_lite.h>
 
 namespace primlabel::server {
 

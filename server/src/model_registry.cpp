@@ -121,15 +121,14 @@ std::map<ModelRegistry::Key, ModelRegistry::Found> ModelRegistry::discover() con
       entry.file = files.front();  // several files: the first by name (documented)
       entry.signature.size = fs::file_size(entry.file, error);
       entry.signature.mtime = fs::last_write_time(entry.file, error);
-      found[{model_dir.path().filename().string(), version_dir.path().filename().string()}] =
-          entry;
+      found[{model_dir.path().filename().string(), version_dir.path().filename().string()}] = entry;
     }
   }
   return found;
 }
 
 std::shared_ptr<const ModelEntry> ModelRegistry::read_entry(const Key& key,
-                                                           const Found& found) const {
+                                                            const Found& found) const {
   const std::string relative = fs::relative(found.file, options_.root).string();
   const std::string bytes = read_file(found.file);
   auto entry = std::make_shared<ModelEntry>();
@@ -174,8 +173,10 @@ ReloadReport ModelRegistry::rescan() {
       }
       failed_.erase(key);
       ++report.loaded;
-      log_info("model_loaded").kv("model", key.first).kv("version", key.second).kv("path",
-                                                                                   entry->path);
+      log_info("model_loaded")
+          .kv("model", key.first)
+          .kv("version", key.second)
+          .kv("path", entry->path);
     } catch (const std::exception& e) {
       failed_[key] = file.signature;
       ++report.failed;
@@ -221,8 +222,8 @@ std::shared_ptr<const ModelEntry> ModelRegistry::load(const std::string& model,
   if (!file)
     throw RegistryError(RegistryError::Kind::kNotFound,
                         "no model file for model '" + model + "'" +
-                            (version.empty() ? "" : " version '" + version + "'") +
-                            " under " + options_.root.string());
+                            (version.empty() ? "" : " version '" + version + "'") + " under " +
+                            options_.root.string());
   const Key key{model, chosen};
   std::shared_ptr<const ModelEntry> entry;
   try {
@@ -316,9 +317,9 @@ std::shared_ptr<const ModelEntry> ModelRegistry::resolve(const std::string& mode
   if (version.empty()) return served_locked(name, found->second);
   auto exact = found->second.find(version);
   if (exact == found->second.end())
-    throw RegistryError(RegistryError::Kind::kNotFound, "model '" + name + "' has no version '" +
-                                                            version + "'; " +
-                                                            describe_loaded_locked());
+    throw RegistryError(
+        RegistryError::Kind::kNotFound,
+        "model '" + name + "' has no version '" + version + "'; " + describe_loaded_locked());
   return exact->second;
 }
 

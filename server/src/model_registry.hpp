@@ -43,8 +43,7 @@ struct ModelEntry {
 class RegistryError : public std::runtime_error {
  public:
   enum class Kind { kNotFound, kInvalidArgument, kLoadFailed };
-  RegistryError(Kind kind, const std::string& message)
-      : std::runtime_error(message), kind_(kind) {}
+  RegistryError(Kind kind, const std::string& message) : std::runtime_error(message), kind_(kind) {}
   Kind kind() const { return kind_; }
 
  private:
@@ -52,9 +51,9 @@ class RegistryError : public std::runtime_error {
 };
 
 struct ReloadReport {
-  unsigned loaded = 0;   // versions newly loaded or replaced
-  unsigned failed = 0;   // versions that failed to load (old ones keep serving)
-  unsigned removed = 0;  // versions whose directory disappeared
+  unsigned loaded = 0;              // versions newly loaded or replaced
+  unsigned failed = 0;              // versions that failed to load (old ones keep serving)
+  unsigned removed = 0;             // versions whose directory disappeared
   std::vector<std::string> errors;  // "path: reason"
 };
 
@@ -121,11 +120,11 @@ class ModelRegistry {
   std::string describe_loaded_locked() const;
 
   Options options_;
-  std::mutex reload_mutex_;  // one rescan / load / unload at a time
+  std::mutex reload_mutex_;   // one rescan / load / unload at a time
   mutable std::mutex mutex_;  // guards models_ (held only to look up or swap)
   std::map<std::string, Versions> models_;
   std::map<Key, FileSignature> failed_;  // files that failed to load, until they change
-  std::set<Key> unloaded_;                // (model, "") = every version of the model
+  std::set<Key> unloaded_;               // (model, "") = every version of the model
 };
 
 }  // namespace primlabel::server

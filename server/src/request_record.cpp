@@ -37,9 +37,8 @@ grpc::Status RequestRecord::finish(const grpc::Status& status) {
   if (status.ok() && points > 0) metrics_.points_labeled(model, double(points));
   if (dropped_non_finite > 0) metrics_.points_dropped("non_finite", double(dropped_non_finite));
   const std::pair<const char*, double> named_stages[] = {
-      {"receive", stages.receive},     {"prefilter", stages.prefilter},
-      {"normals", stages.normals},     {"features", stages.features},
-      {"inference", stages.inference}, {"send", stages.send}};
+      {"receive", stages.receive},   {"prefilter", stages.prefilter}, {"normals", stages.normals},
+      {"features", stages.features}, {"inference", stages.inference}, {"send", stages.send}};
   LogLine line(status.ok() ? LogLevel::kInfo : LogLevel::kWarn, "request");
   line.kv("method", method_)
       .kv("request_id", id_)

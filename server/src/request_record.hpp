@@ -2,11 +2,11 @@
 // One RPC's id, what it labeled and how long each stage took; on finish() it writes the
 // request's log line and its metrics.
 
+#include <grpcpp/support/status.h>
+
 #include <chrono>
 #include <cstdint>
 #include <string>
-
-#include <grpcpp/support/status.h>
 
 #include "server_metrics.hpp"
 

@@ -65,8 +65,8 @@ grpc::Status ScanAssembler::add(const v1::PointChunk& chunk) {
                    " bytes, not a multiple of 12 (float32 x, y, z per point)");
   const std::uint64_t n = xyz.size() / wire::kXyzBytesPerPoint;
   if (normals_ && chunk.normals().size() != n * wire::kNormalBytesPerPoint)
-    return invalid(where + ": normals has " + std::to_string(chunk.normals().size()) +
-                   " bytes; " + std::to_string(n) + " points need " +
+    return invalid(where + ": normals has " + std::to_string(chunk.normals().size()) + " bytes; " +
+                   std::to_string(n) + " points need " +
                    std::to_string(n * wire::kNormalBytesPerPoint));
   if (!normals_ && !chunk.normals().empty())
     return invalid(where + " carries normals but the header's layout does not declare them");

@@ -23,6 +23,58 @@ std::string read_token_file(const std::string& path) {
   return token;
 }
 
+std::string trim(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t\r");
+  if (first == std::string::npos) return {};
+  const auto last = text.find_last_not_of(" \t\r");
+  return text.substr(first, last - first + 1);
+}
+
+bool given_on_command_line(const std::vector<std::string>& args, const std::string& flag) {
+  for (const std::string& arg : args)
+    if (arg == flag || arg.rfind(flag + "=", 0) == 0) return true;
+  return false;
+}
+
+// The command line with the config file's settings put in front of it, leaving out every
+// setting that a flag or an environment variable gives: flags > environment > file.
+std::vector<std::string> with_config_file(CLI::App& app, int argc, const char* const* argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  std::string path;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--config" && i + 1 < args.size()) path = args[i + 1];
+    if (args[i].rfind("--config=", 0) == 0) path = args[i].substr(9);
+  }
+  if (const char* env = std::getenv("PRIMLABEL_CONFIG"); path.empty() && env) path = env;
+  std::vector<std::string> out{argv[0]};
+  if (!path.empty()) {
+    std::ifstream in(path);
+    if (!in) throw ConfigError{"cannot read the config file '" + path + "'", 2};
+    std::string line;
+    for (int number = 1; std::getline(in, line); ++number) {
+      line = trim(line);
+      if (line.empty() || line[0] == '#' || line[0] == ';') continue;
+      const auto eq = line.find('=');
+      const std::string where = path + ":" + std::to_string(number);
+      if (eq == std::string::npos) throw ConfigError{where + ": expected `key = value`", 2};
+      std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
+      if (key.rfind("--", 0) == 0) key = key.substr(2);
+      if (value.size() >= 2 && (value.front() == '"' || value.front() == '\'') &&
+          value.back() == value.front())
+        value = value.substr(1, value.size() - 2);
+      const std::string flag = "--" + key;
+      const CLI::Option* option = app.get_option_no_throw(flag);
+      if (!option || key == "config" || key == "help")
+        throw ConfigError{where + ": unknown setting '" + key + "'", 2};
+      const std::string env = option->get_envname();
+      if (given_on_command_line(args, flag) || (!env.empty() && std::getenv(env.c_str()))) continue;
+      out.push_back(flag + "=" + value);
+    }
+  }
+  out.insert(out.end(), args.begin(), args.end());
+  return out;
+}
+
 int hardware_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 
 }  // namespace
@@ -40,7 +92,10 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
   ServerConfig config;
   CLI::App app{"primlabel-server: the gRPC point labeling service."};
   app.name("primlabel-server");
-  app.set_config("--config", "", "config file of `key = value` lines (keys as the flags)")
+  std::string config_file;  // read before parsing, see with_config_file
+  app.add_option("--config", config_file,
+                 "config file of `key = value` lines, keys named like the flags; "
+                 "flags and environment variables win over it")
       ->envname("PRIMLABEL_CONFIG");
 
   app.add_option("--models", config.models_dir, "model repository: DIR/<model>/<version>/*.plm")
@@ -124,11 +179,15 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
       ->capture_default_str();
 
   try {
-    app.parse(argc, argv);
+    const std::vector<std::string> args = with_config_file(app, argc, argv);
+    std::vector<const char*> pointers;
+    for (const std::string& arg : args) pointers.push_back(arg.c_str());
+    app.parse(int(pointers.size()), pointers.data());
   } catch (const CLI::ParseError& e) {
     std::ostringstream out, err;
     app.exit(e, out, err);
-    throw ConfigError{e.get_exit_code() == 0 ? out.str() : err.str(), e.get_exit_code() == 0 ? 0 : 2};
+    throw ConfigError{e.get_exit_code() == 0 ? out.str() : err.str(),
+                      e.get_exit_code() == 0 ? 0 : 2};
   }
 
   for (const std::string& pin : pins) {
