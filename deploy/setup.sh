@@ -26,6 +26,7 @@ PACKAGES=(
   libprotobuf-dev protobuf-compiler liblbfgspp-dev libsvm-dev
   libgrpc++-dev protobuf-compiler-grpc
   libgtest-dev
+  python3-yaml nginx prometheus
 )
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev)
 

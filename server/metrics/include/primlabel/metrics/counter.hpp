@@ -5,6 +5,9 @@
 
 namespace primlabel::metrics {
 
+// The hot path must never take a lock.
+static_assert(std::atomic<double>::is_always_lock_free);
+
 class Counter {
  public:
   // Adds v. Like prometheus-cpp, a negative or NaN v is ignored: a counter never goes down, and
