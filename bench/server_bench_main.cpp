@@ -180,7 +180,9 @@ double cancel_latency(server::LabelServer& server, v1::Labeler::Stub& stub,
 int main(int argc, char** argv) {
   int reps_table = 20, reps_kinect = 5, threads = 2;
   std::size_t cancel_points = 5'000'000;
-  bool skip_cancel = false;
+  bool skip_cancel = false, cancel_only = false;
+  // When to stop the cancelled request (ms after it started / after the upload ended).
+  std::vector<int> cancel_at = {300, 1500, 4000, 8000};
   CLI::App app{"End-to-end latency of primlabel-server against label_cloud in process."};
   app.name("primlabel-bench-server");
   app.add_option("--reps-table", reps_table, "repetitions on the 22k table scene")
@@ -191,6 +193,9 @@ int main(int argc, char** argv) {
   app.add_option("--cancel-points", cancel_points, "points of the cancelled request")
       ->capture_default_str();
   app.add_flag("--skip-cancel", skip_cancel, "no cancellation figures");
+  app.add_flag("--cancel-only", cancel_only, "only the cancellation figures (no table / kinect)");
+  app.add_option("--cancel-at", cancel_at, "moments (ms) at which the 5M request is cancelled")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   server::set_log_level(server::LogLevel::kWarn);
@@ -212,16 +217,19 @@ int main(int argc, char** argv) {
   auto stub = v1::Labeler::NewStub(grpc::CreateCustomChannel(
       "127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials(), args));
 
-  const Latency table = compare("table", model, table_scene(22000), *stub, reps_table, threads);
-  const PointCloud kinect =
-      pipeline::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kKinect);
-  const Latency frame = compare("kinect", model, kinect, *stub, reps_kinect, threads);
+  Latency table, frame;
+  PointCloud kinect;
+  if (!cancel_only) {
+    table = compare("table", model, table_scene(22000), *stub, reps_table, threads);
+    kinect = pipeline::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kKinect);
+    frame = compare("kinect", model, kinect, *stub, reps_kinect, threads);
+  }
 
   std::vector<double> cancel_ms, local_stop_ms;
   if (!skip_cancel) {
     const PointCloud big = large_surface(cancel_points);
     // In process first: stop at several moments, time from request_stop to Cancelled.
-    for (int after_ms : {300, 1500, 4000, 8000}) {
+    for (int after_ms : cancel_at) {
       PointCloud copy = big;
       std::stop_source stop;
       pipeline::LabelingOptions options;
@@ -244,7 +252,7 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     }
     const auto requests = requests_for(big, 87381);
-    for (int after_ms : {300, 1500, 4000, 8000}) {
+    for (int after_ms : cancel_at) {
       cancel_ms.push_back(cancel_latency(server, *stub, requests, after_ms));
       std::printf(
           "cancel  %zu points over gRPC, %5d ms after upload: slot free %6.1f ms after "
@@ -265,7 +273,8 @@ int main(int argc, char** argv) {
       "\"cancel_grpc_max_ms\":%.1f,\"cancel_local_max_ms\":%.1f}\n",
       std::size_t(22000), p50(table.server_ms), p99(table.server_ms), p50(table.local_ms),
       kinect.size(), p50(frame.server_ms), p99(frame.server_ms), p50(frame.local_ms),
-      (p50(frame.server_ms) - p50(frame.local_ms)) / p50(frame.local_ms),
+      frame.local_ms.empty() ? 0.0
+                             : (p50(frame.server_ms) - p50(frame.local_ms)) / p50(frame.local_ms),
       cancel_ms.empty() ? 0.0 : *std::max_element(cancel_ms.begin(), cancel_ms.end()),
       local_stop_ms.empty() ? 0.0 : *std::max_element(local_stop_ms.begin(), local_stop_ms.end()));
   return 0;

@@ -2,9 +2,15 @@
 
 #include <algorithm>
 #include <limits>
+#include <stop_token>
 
+#include "primlabel/core/cancellation.hpp"
 #include "primlabel/core/neighbor_search.hpp"
 #include "test_util.hpp"
+
+// As core/src/neighbor_search.cpp compiles it (ties lowest index first).
+#define NANOFLANN_FIRST_MATCH
+#include <nanoflann.hpp>
 
 namespace primlabel {
 namespace {
@@ -143,6 +149,96 @@ TEST(NeighborSearch, NonFiniteQueryEmptyCloudAndBadParameters) {
   EXPECT_EQ(found.size(), 2u);
   EXPECT_THROW(search.find(Vec3f::Zero(), Neighborhood{-1.0f, 0, 0}, found), std::invalid_argument);
   EXPECT_THROW(search.find(Vec3f::Zero(), Neighborhood{}, found), std::invalid_argument);
+}
+
+// ---- Cancellation of the index build ------------------------------------------------------------
+
+std::stop_token stopped_token(std::stop_source& source) {
+  source.request_stop();
+  return source.get_token();
+}
+
+TEST(NeighborSearchCancellation, AStoppedTokenCancelsTheBuild) {
+  // Small (one nanoflann call) and large (split into checked subtrees) clouds alike.
+  for (int n : {0, 500, 200000}) {
+    const PointCloud cloud = test::random_box(n, 1.0f, 3);
+    std::stop_source source;
+    EXPECT_THROW(NeighborSearch(cloud.xyz, stopped_token(source)), Cancelled) << n;
+  }
+}
+
+// nanoflann's own build (KdTree::buildIndex, no stop checks) over the same points, as the search
+// built it before it took a stop token.
+struct Points {
+  std::vector<Vec3f> points;
+  std::size_t kdtree_get_point_count() const { return points.size(); }
+  float kdtree_get_pt(std::size_t i, std::size_t dim) const { return points[i][dim]; }
+  template <class BBox>
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
+};
+using ReferenceTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Points>, Points, 3,
+                                        std::uint32_t>;
+
+// Unsorted radius results in nanoflann's tree order (what NeighborSearch reports for a radius
+// that gets no grid).
+std::vector<std::uint32_t> tree_order(const ReferenceTree& tree, const Vec3f& q, float radius) {
+  std::vector<std::pair<std::uint32_t, float>> found;
+  nanoflann::SearchParams params(32, 0.0f, false);
+  tree.radiusSearch(q.data(), radius * radius, found, params);
+  std::vector<std::uint32_t> out;
+  for (const auto& item : found)
+    if (item.second < radius * radius) out.push_back(item.first);
+  return out;
+}
+
+TEST(NeighborSearchCancellation, ANeverStoppedTokenBuildsNanoflannsTree) {
+  // 150k points in a small box, stretched by two far outliers: grids for these radii would need
+  // far too many cells, so the tree answers radius queries and their unsorted order exposes the
+  // tree's structure.
+  PointCloud cloud = test::random_box(150000, 1.0f, 11);
+  cloud.xyz[0] = Vec3f::Constant(100.0f);
+  cloud.xyz[1] = Vec3f::Constant(-100.0f);
+  Points points{cloud.xyz};
+  const ReferenceTree reference(3, points, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  std::stop_source never;
+  const NeighborSearch search(cloud.xyz, never.get_token());
+  const NeighborSearch plain(cloud.xyz);
+  NeighborList got, expected;
+  std::size_t found = 0;
+  for (std::size_t i = 0; i < cloud.size(); i += 997) {
+    const Vec3f& q = cloud.xyz[i];
+    for (float radius : {0.05f, 0.1f}) {
+      search.find(q, Neighborhood::Radius(radius), got, /*sorted=*/false);
+      EXPECT_EQ(got.indices, tree_order(reference, q, radius)) << i;
+      found += got.size();
+    }
+    for (const Neighborhood& hood : {Neighborhood::Knn(10), Neighborhood::Hybrid(3.0f, 5)}) {
+      search.find(q, hood, got);
+      plain.find(q, hood, expected);
+      EXPECT_EQ(got.indices, expected.indices) << i;
+      EXPECT_EQ(got.sq_dists, expected.sq_dists) << i;
+    }
+  }
+  EXPECT_GT(found, 150u * 10);  // the radius lists are long enough to have an order
+}
+
+TEST(NeighborSearchCancellation, AStopAfterTheBuildStillAnswersRadiusQueries) {
+  // The grid for a new radius is not built once stopped; the tree answers with the same set.
+  PointCloud cloud = test::random_box(3000, 1.0f, 5);
+  std::stop_source source;
+  const NeighborSearch search(cloud.xyz, source.get_token());
+  source.request_stop();
+  NeighborList got;
+  for (std::size_t i = 0; i < cloud.size(); i += 101) {
+    search.find(cloud.xyz[i], Neighborhood::Radius(0.1f), got);
+    std::vector<std::uint32_t> expected;
+    for (const auto& [d, j] : brute_force(cloud.xyz, cloud.xyz[i]))
+      if (d < 0.01f) expected.push_back(j);
+    EXPECT_EQ(got.indices, expected) << i;
+  }
 }
 
 }  // namespace

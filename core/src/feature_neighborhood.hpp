@@ -40,9 +40,10 @@ inline void usable_neighbors(const NeighborSearch& search, const PointCloud& clo
 }
 
 inline const NeighborSearch& ensure_search(const PointCloud& cloud, const NeighborSearch* given,
-                                           std::unique_ptr<NeighborSearch>& owned) {
+                                           std::unique_ptr<NeighborSearch>& owned,
+                                           const std::stop_token& stop = {}) {
   if (given) return *given;
-  owned = std::make_unique<NeighborSearch>(cloud.xyz);
+  owned = std::make_unique<NeighborSearch>(cloud.xyz, stop);
   return *owned;
 }
 

@@ -129,7 +129,7 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
     throw std::invalid_argument("FPFH: invalid neighbourhood " + options.neighborhood.describe());
   const std::vector<char> usable = detail::usable_points(cloud, "FPFH");
   std::unique_ptr<NeighborSearch> owned;
-  const NeighborSearch& index = detail::ensure_search(cloud, search, owned);
+  const NeighborSearch& index = detail::ensure_search(cloud, search, owned, options.stop);
 
   const std::size_t n = cloud.size();
   const std::ptrdiff_t blocks = static_cast<std::ptrdiff_t>((n + kBlock - 1) / kBlock);

@@ -12,6 +12,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "primlabel/core/cancellation.hpp"
+
 namespace primlabel {
 
 std::string Neighborhood::describe() const {
@@ -41,6 +43,55 @@ struct CompactPoints {
 using KdTree =
     nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, CompactPoints>,
                                         CompactPoints, 3, std::uint32_t>;
+
+// Points per stop check in the serial loops over the whole cloud (~1 ms of work each).
+constexpr std::size_t kCheckEvery = std::size_t(1) << 16;
+// Subtrees of at most this many points are built by nanoflann in one call (a few ms each).
+constexpr std::size_t kCheckedSubtree = std::size_t(1) << 16;
+
+// nanoflann's KDTreeBaseClass::divideTree for the nodes above kCheckedSubtree points, so the stop
+// token can be checked between subtrees (a 5M-point build is one ~1 s call otherwise). Node
+// allocation order, splits and the permutation of vAcc are exactly nanoflann's, so the tree and
+// every query answer are the same as KdTree::buildIndex() gives.
+KdTree::NodePtr divide_checked(KdTree& tree, std::size_t left, std::size_t right,
+                               KdTree::BoundingBox& bbox, const std::stop_token& stop) {
+  throw_if_stopped(stop, "building the neighbour index");
+  if (right - left <= kCheckedSubtree) return tree.divideTree(tree, left, right, bbox);
+  // right - left > leaf size: the non-leaf branch of divideTree.
+  KdTree::NodePtr node = tree.pool.allocate<KdTree::Node>();
+  KdTree::Offset idx;
+  KdTree::Dimension cutfeat;
+  KdTree::DistanceType cutval;
+  tree.middleSplit_(tree, left, right - left, idx, cutfeat, cutval, bbox);
+  node->node_type.sub.divfeat = cutfeat;
+  KdTree::BoundingBox left_bbox(bbox);
+  left_bbox[cutfeat].high = cutval;
+  node->child1 = divide_checked(tree, left, left + idx, left_bbox, stop);
+  KdTree::BoundingBox right_bbox(bbox);
+  right_bbox[cutfeat].low = cutval;
+  node->child2 = divide_checked(tree, left + idx, right, right_bbox, stop);
+  node->node_type.sub.divlow = left_bbox[cutfeat].high;
+  node->node_type.sub.divhigh = right_bbox[cutfeat].low;
+  for (int i = 0; i < 3; ++i) {
+    bbox[i].low = std::min(left_bbox[i].low, right_bbox[i].low);
+    bbox[i].high = std::max(left_bbox[i].high, right_bbox[i].high);
+  }
+  return node;
+}
+
+// KdTree::buildIndex() with stop checks (the tree must have been made with
+// SkipInitialBuildIndex).
+void build_checked(KdTree& tree, const std::stop_token& stop) {
+  static_assert(kCheckedSubtree > 16, "subtrees handed to nanoflann must not be leaves");
+  tree.m_size = tree.dataset.kdtree_get_point_count();
+  tree.m_size_at_index_build = tree.m_size;
+  tree.init_vind();
+  tree.freeIndex(tree);
+  tree.m_size_at_index_build = tree.m_size;
+  if (tree.m_size == 0) return;
+  tree.computeBoundingBox(tree.root_bbox);
+  tree.root_node = divide_checked(tree, 0, tree.m_size, tree.root_bbox, stop);
+}
 
 // Collects every point strictly inside the radius straight into the caller's NeighborList,
 // translating compact indices back to cloud indices.
@@ -93,13 +144,23 @@ void sort_by_distance(NeighborList& list) {
 // returns exactly the set the tree would.
 class RadiusGrid {
  public:
-  // Returns nullptr when the cloud is too sparse for a grid of this cell size to pay off.
+  // Returns nullptr when the cloud is too sparse for a grid of this cell size to pay off, and
+  // sets `stopped` (and returns nullptr) when `stop` is requested during the build.
   static std::unique_ptr<RadiusGrid> build(const std::vector<Vec3f>& points,
-                                           const std::vector<std::uint32_t>& to_cloud,
-                                           float radius) {
+                                           const std::vector<std::uint32_t>& to_cloud, float radius,
+                                           const std::stop_token& stop, bool& stopped) {
+    stopped = false;
     if (points.empty() || !(radius > 0.0f)) return nullptr;
+    // Each serial pass below is cut into chunks of kCheckEvery points with a stop check between.
+    const auto stop_at = [&](std::size_t i) {
+      if (i % kCheckEvery == 0 && stop.stop_requested()) stopped = true;
+      return stopped;
+    };
     Vec3f lo = points[0], hi = points[0];
-    for (const Vec3f& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (stop_at(i)) return nullptr;
+      lo = lo.cwiseMin(points[i]), hi = hi.cwiseMax(points[i]);
+    }
     std::int64_t dims[3];
     double cells = 1;
     for (int d = 0; d < 3; ++d) {
@@ -116,6 +177,7 @@ class RadiusGrid {
     std::vector<std::uint32_t> cell_of(n);
     grid->starts_.assign(static_cast<std::size_t>(cells) + 1, 0);
     for (std::size_t i = 0; i < n; ++i) {
+      if (stop_at(i)) return nullptr;
       cell_of[i] = static_cast<std::uint32_t>(grid->cell_index(grid->cell_coords(points[i])));
       ++grid->starts_[cell_of[i] + 1];
     }
@@ -123,6 +185,7 @@ class RadiusGrid {
     grid->x_.resize(n), grid->y_.resize(n), grid->z_.resize(n), grid->index_.resize(n);
     std::vector<std::uint32_t> fill(grid->starts_.begin(), grid->starts_.end() - 1);
     for (std::size_t i = 0; i < n; ++i) {  // stable: points keep their order within a cell
+      if (stop_at(i)) return nullptr;
       const std::uint32_t slot = fill[cell_of[i]]++;
       grid->x_[slot] = points[i].x(), grid->y_[slot] = points[i].y(),
       grid->z_[slot] = points[i].z();
@@ -186,6 +249,7 @@ struct NeighborSearch::Impl {
   CompactPoints compact;
   std::vector<std::uint32_t> to_cloud;  // compact index -> cloud index
   std::unique_ptr<KdTree> tree;
+  std::stop_token stop;  // cuts lazy grid builds short
 
   // Radius grids are built on first use for a radius and kept; a radius that does not suit a
   // grid is remembered as such (nullptr) so the tree answers it.
@@ -196,23 +260,36 @@ struct NeighborSearch::Impl {
     std::lock_guard<std::mutex> lock(grids_mutex);
     for (const auto& [r, grid] : grids)
       if (r == radius) return grid.get();
-    grids.emplace_back(radius, RadiusGrid::build(compact.points, to_cloud, radius));
+    bool stopped = false;
+    auto grid = RadiusGrid::build(compact.points, to_cloud, radius, stop, stopped);
+    // Stopped: not remembered (the grid is incomplete); the tree answers until the caller,
+    // which checks the same token, gives up.
+    if (stopped) return nullptr;
+    grids.emplace_back(radius, std::move(grid));
     return grids.back().second.get();
   }
 };
 
-NeighborSearch::NeighborSearch(const std::vector<Vec3f>& points) : impl_(std::make_unique<Impl>()) {
+NeighborSearch::NeighborSearch(const std::vector<Vec3f>& points, std::stop_token stop)
+    : impl_(std::make_unique<Impl>()) {
   if (points.size() > std::numeric_limits<std::uint32_t>::max())
     throw std::invalid_argument("neighbour search: more than 2^32-1 points");
+  impl_->stop = std::move(stop);
+  const std::stop_token& token = impl_->stop;
   impl_->compact.points.reserve(points.size());
   impl_->to_cloud.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
+    if (i % kCheckEvery == 0) throw_if_stopped(token, "building the neighbour index");
     if (!is_finite(points[i])) continue;
     impl_->compact.points.push_back(points[i]);
     impl_->to_cloud.push_back(static_cast<std::uint32_t>(i));
   }
-  impl_->tree =
-      std::make_unique<KdTree>(3, impl_->compact, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  throw_if_stopped(token, "building the neighbour index");
+  impl_->tree = std::make_unique<KdTree>(
+      3, impl_->compact,
+      nanoflann::KDTreeSingleIndexAdaptorParams(
+          16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
+  build_checked(*impl_->tree, token);
 }
 
 NeighborSearch::~NeighborSearch() = default;

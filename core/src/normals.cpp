@@ -59,7 +59,7 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
                                 options.neighborhood.describe());
   std::unique_ptr<NeighborSearch> own_search;
   if (!search) {
-    own_search = std::make_unique<NeighborSearch>(cloud.xyz);
+    own_search = std::make_unique<NeighborSearch>(cloud.xyz, options.stop);
     search = own_search.get();
   }
   const Vec3f viewpoint = options.viewpoint.value_or(cloud.viewpoint.origin);

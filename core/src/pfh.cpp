@@ -51,7 +51,7 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
     throw std::invalid_argument("PFH: invalid neighbourhood " + options.neighborhood.describe());
   const std::vector<char> usable = detail::usable_points(cloud, "PFH");
   std::unique_ptr<NeighborSearch> owned;
-  const NeighborSearch& index = detail::ensure_search(cloud, search, owned);
+  const NeighborSearch& index = detail::ensure_search(cloud, search, owned, options.stop);
 
   const std::size_t n = cloud.size();
   const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(n);

@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
+#include <stop_token>
 
+#include "primlabel/core/cancellation.hpp"
 #include "primlabel/crf/graph.hpp"
 
 namespace primlabel::crf {
@@ -121,6 +124,112 @@ TEST(CrfGraph, Empty) {
   EXPECT_EQ(g.num_nodes(), 0u);
   EXPECT_EQ(g.num_slots(), 0u);
   EXPECT_EQ(g.offsets.size(), 1u);
+}
+
+// ---- Cancellation ------------------------------------------------------------------------------
+
+// A 3000-point patch with a few invalid descriptors and non-finite points (more than one block
+// of every parallel pass).
+struct Patch {
+  std::vector<Vec3f> points;
+  std::vector<float> descriptors;  // dim 2
+};
+
+Patch noisy_patch() {
+  Patch patch;
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int i = 0; i < 3000; ++i) {
+    patch.points.emplace_back(u(rng), u(rng), 0.05f * u(rng));
+    patch.descriptors.push_back(u(rng));
+    patch.descriptors.push_back(u(rng));
+  }
+  for (int i = 5; i < 3000; i += 211) patch.descriptors[2 * i + 1] = std::nanf("");
+  for (int i = 7; i < 3000; i += 307) patch.points[i] = Vec3f::Constant(std::nanf(""));
+  return patch;
+}
+
+// The graph build_graph promises, by brute force: each valid point linked to its nearest valid
+// others (distance, then index), symmetrised, rows sorted.
+std::vector<std::vector<std::uint32_t>> brute_force_rows(const Patch& patch,
+                                                         const Neighborhood& hood) {
+  const std::size_t n = patch.points.size();
+  std::vector<std::uint8_t> valid(n);
+  for (std::size_t i = 0; i < n; ++i)
+    valid[i] = is_finite(patch.points[i]) && descriptor_is_valid(&patch.descriptors[2 * i], 2);
+  std::vector<std::vector<std::uint32_t>> rows(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!valid[i]) continue;
+    std::vector<std::pair<float, std::uint32_t>> others;
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j == i || !valid[j]) continue;
+      const Vec3f d = patch.points[i] - patch.points[j];
+      const float sq = (d.x() * d.x() + d.y() * d.y()) + d.z() * d.z();  // nanoflann's order
+      if (hood.radius > 0.0f && !(sq < hood.radius * hood.radius)) continue;
+      others.emplace_back(sq, static_cast<std::uint32_t>(j));
+    }
+    std::sort(others.begin(), others.end());
+    const std::size_t cap = hood.radius == 0.0f      ? std::size_t(hood.k)
+                            : hood.max_neighbors > 0 ? std::size_t(hood.max_neighbors)
+                                                     : others.size();
+    for (std::size_t r = 0; r < std::min(cap, others.size()); ++r) {
+      rows[i].push_back(others[r].second);
+      rows[others[r].second].push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  for (auto& row : rows) {
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+  }
+  return rows;
+}
+
+TEST(CrfGraphCancellation, AStoppedTokenCancelsTheBuild) {
+  const Patch patch = noisy_patch();
+  std::vector<float> all_valid(patch.descriptors.size(), 1.0f);
+  std::vector<Vec3f> finite = patch.points;
+  for (Vec3f& p : finite)
+    if (!is_finite(p)) p = Vec3f::Zero();
+  const NeighborSearch search(finite);
+  std::stop_source source;
+  source.request_stop();
+  GraphOptions options;
+  options.stop = source.get_token();
+  for (const Neighborhood& hood : {Neighborhood::Knn(8), Neighborhood::Radius(0.05f)}) {
+    options.neighborhood = hood;
+    // Its own index over the valid points, and the shared index.
+    EXPECT_THROW(build_graph(patch.points, patch.descriptors, 2, options), Cancelled);
+    EXPECT_THROW(build_graph(finite, all_valid, 2, options, &search), Cancelled);
+  }
+}
+
+TEST(CrfGraphCancellation, ANeverStoppedTokenGivesTheSameGraph) {
+  const Patch patch = noisy_patch();
+  std::stop_source never;
+  for (const Neighborhood& hood :
+       {Neighborhood::Knn(8), Neighborhood::Radius(0.05f), Neighborhood::Hybrid(0.05f, 6)}) {
+    const auto expected = brute_force_rows(patch, hood);
+    GraphOptions plain;
+    plain.neighborhood = hood;
+    plain.threads = 1;
+    const Graph reference = build_graph(patch.points, patch.descriptors, 2, plain);
+    for (int threads : {1, 3}) {
+      GraphOptions options = plain;
+      options.threads = threads;
+      options.stop = never.get_token();
+      const Graph g = build_graph(patch.points, patch.descriptors, 2, options);
+      expect_well_formed(g);
+      ASSERT_EQ(g.num_nodes(), expected.size());
+      for (std::size_t i = 0; i < expected.size(); ++i)
+        ASSERT_EQ(std::vector<std::uint32_t>(g.neighbors_of(i).begin(), g.neighbors_of(i).end()),
+                  expected[i])
+            << hood.describe() << " node " << i;
+      EXPECT_EQ(g.offsets, reference.offsets);
+      EXPECT_EQ(g.neighbors, reference.neighbors);
+      EXPECT_EQ(g.reverse, reference.reverse);
+      EXPECT_EQ(g.active, reference.active);
+    }
+  }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stop_token>
 #include <thread>
@@ -167,6 +168,39 @@ TEST(PipelineServiceOptions, InferenceHonoursItsStopToken) {
   options.stop = {};
   EXPECT_EQ(crf::infer(model.weights, described.descriptors, graph, options).labels.size(),
             cloud.size());
+}
+
+TEST(PipelineServiceOptions, StoppedTokensCancelTheIndexAndTheGraph) {
+  PointCloud cloud = table_with_box_cloud();
+  const LabelModel model = random_label_model("crf", "1", 7, 0.5f);
+  std::stop_source source;
+  source.request_stop();
+  pipeline::DescribeOptions describe;
+  describe.stop = source.get_token();
+  EXPECT_THROW(pipeline::describe_cloud(cloud, model.features, describe), Cancelled);
+  const auto described = pipeline::describe_cloud(cloud, model.features, 0);
+  crf::GraphOptions graph = model.graph;
+  graph.stop = source.get_token();
+  EXPECT_THROW(pipeline::build_scene_graph(cloud, described, graph), Cancelled);
+}
+
+TEST(PipelineServiceOptions, ANeverStoppedTokenGivesTheSameResult) {
+  const LabelModel model = random_label_model("crf", "1", 7, 0.5f);
+  pipeline::LabelingOptions options;
+  options.want_probabilities = true;
+  options.threads = 1;
+  PointCloud reference_cloud = table_with_box_cloud(0.003f);
+  const auto reference = pipeline::label_cloud(model, reference_cloud, options);
+  std::stop_source never;
+  options.stop = never.get_token();
+  options.threads = 2;
+  PointCloud cloud = table_with_box_cloud(0.003f);
+  const auto result = pipeline::label_cloud(model, cloud, options);
+  EXPECT_EQ(result.labels, reference.labels);
+  ASSERT_EQ(result.probabilities.size(), reference.probabilities.size());
+  EXPECT_EQ(std::memcmp(result.probabilities.data(), reference.probabilities.data(),
+                        sizeof(float) * std::size_t(result.probabilities.size())),
+            0);
 }
 
 }  // namespace

@@ -112,7 +112,7 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
 
   throw_if_stopped(options.stop, "inference");
   float* theta = ws.theta.resize(n * kp);
-  detail::node_scores_padded(model, descriptors, graph, threads, theta);
+  detail::node_scores_padded(model, descriptors, graph, threads, theta, options.stop);
   if (!model.has_edge_terms() || graph.num_slots() == 0) {
     // No coupling: the marginals are the per-node softmax and the MAP is the per-node argmax.
     outputs_from_rows(theta, true, model, graph, options, threads, result);
@@ -120,7 +120,8 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
     return result;
   }
 
-  const std::size_t edges = detail::number_edges(graph, threads, ws.edge_of, ws.block_first_edge);
+  const std::size_t edges =
+      detail::number_edges(graph, threads, ws.edge_of, ws.block_first_edge, options.stop);
   float* edge_terms = ws.edge_terms.resize(edges * kp);
   detail::BpSettings settings;
   settings.max_product = options.max_product;
@@ -133,7 +134,7 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
   detail::BpRun run;
   if (options.method == InferenceMethod::kMeanField) {
     detail::edge_terms_padded(model, descriptors, graph, ws.block_first_edge.data(), threads, false,
-                              edge_terms);
+                              edge_terms, options.stop);
     detail::MeanFieldProblem problem;
     problem.graph = &graph;
     problem.classes = k_count;
@@ -145,7 +146,7 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
     outputs_from_rows(ws.mf.q.data(), false, model, graph, options, threads, result);
   } else {
     detail::edge_terms_padded(model, descriptors, graph, ws.block_first_edge.data(), threads, true,
-                              edge_terms);
+                              edge_terms, options.stop);
     float* phi = ws.phi.resize(n * kp);
     node_potentials_padded(theta, n, k_count, threads, phi);
     detail::FastBpProblem problem;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "../parallel.hpp"
+#include "primlabel/core/cancellation.hpp"
 
 namespace primlabel::crf::detail {
 namespace {
@@ -15,6 +16,9 @@ constexpr long long kNodeBlock = 128;
 constexpr int kEdgeBatch = 128;
 // psi = exp(theta) stays far from float overflow (messages are products of psi and values <= 1).
 constexpr float kMaxEdgeScore = 60.0f;
+// Edges per stop check in the Potts fill (a plain copy per edge).
+constexpr long long kEdgeBlock = 1 << 14;
+constexpr const char* kWhat = "computing the CRF scores";
 
 using ConstRowMap = Eigen::Map<const Eigen::RowVectorXf>;
 
@@ -36,7 +40,7 @@ void check_shapes(const CrfModel& model, std::span<const float> descriptors, con
 }
 
 RowMatrixXf node_scores(const CrfModel& model, std::span<const float> descriptors,
-                        const Graph& graph, int threads) {
+                        const Graph& graph, int threads, const std::stop_token& stop) {
   const long long n = static_cast<long long>(graph.num_nodes());
   const int d = model.descriptor_dim;
   const int k_count = model.num_classes();
@@ -49,6 +53,7 @@ RowMatrixXf node_scores(const CrfModel& model, std::span<const float> descriptor
     RowMatrixXf features(kNodeBlock, d + 1);
 #pragma omp for schedule(dynamic, 8)
     for (long long b = 0; b < blocks; ++b) {
+      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
       const long long first = b * kNodeBlock;
       const long long count = std::min(kNodeBlock, n - first);
       for (long long r = 0; r < count; ++r) {
@@ -63,14 +68,16 @@ RowMatrixXf node_scores(const CrfModel& model, std::span<const float> descriptor
       scores.middleRows(first, count).noalias() = features.topRows(count) * weights_t;
     }
   }
+  throw_if_stopped(stop, kWhat);
   return scores;
 }
 
 RowMatrixXf edge_scores(const CrfModel& model, std::span<const float> descriptors,
-                        const Graph& graph, int threads) {
+                        const Graph& graph, int threads, const std::stop_token& stop) {
   const long long n = static_cast<long long>(graph.num_nodes());
   const int d = model.descriptor_dim;
   const int k_count = model.num_classes();
+  throw_if_stopped(stop, kWhat);
   RowMatrixXf scores = RowMatrixXf::Zero(static_cast<Eigen::Index>(graph.num_slots()), k_count);
   if (!model.has_edge_terms() || graph.num_slots() == 0) return scores;
   const float scale2 = model.feature_scale * model.feature_scale;
@@ -94,6 +101,7 @@ RowMatrixXf edge_scores(const CrfModel& model, std::span<const float> descriptor
     };
 #pragma omp for schedule(dynamic, 4)
     for (long long b = 0; b < blocks; ++b) {
+      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
       const long long last = std::min(n, (b + 1) * kNodeBlock);
       for (long long i = b * kNodeBlock; i < last; ++i) {
         const ConstRowMap xi(descriptors.data() + i * d, d);
@@ -112,6 +120,7 @@ RowMatrixXf edge_scores(const CrfModel& model, std::span<const float> descriptor
       flush();  // batches never span blocks, so they do not depend on the schedule
     }
   }
+  throw_if_stopped(stop, kWhat);
   return scores;
 }
 
@@ -120,7 +129,8 @@ RowMatrixXf edge_scores(const CrfModel& model, std::span<const float> descriptor
 namespace primlabel::crf::detail {
 
 std::size_t number_edges(const Graph& graph, int threads, ScratchBuffer<std::uint32_t>& edge_of,
-                         ScratchBuffer<std::uint32_t>& block_first_edge) {
+                         ScratchBuffer<std::uint32_t>& block_first_edge,
+                         const std::stop_token& stop) {
   const long long n = static_cast<long long>(graph.num_nodes());
   const long long blocks = (n + kNodeBlock - 1) / kNodeBlock;
   std::uint32_t* first = block_first_edge.resize(blocks + 1);
@@ -131,16 +141,19 @@ std::size_t number_edges(const Graph& graph, int threads, ScratchBuffer<std::uin
   // Fixed node blocks and a serial prefix sum: the numbering never depends on the threads.
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (long long b = 0; b < blocks; ++b) {
+    if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
     std::uint32_t count = 0;
     const long long last = std::min(n, (b + 1) * kNodeBlock);
     for (long long i = b * kNodeBlock; i < last; ++i)
       for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p) count += neighbors[p] > i;
     first[b + 1] = count;
   }
+  throw_if_stopped(stop, kWhat);
   first[0] = 0;
   for (long long b = 0; b < blocks; ++b) first[b + 1] += first[b];
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (long long b = 0; b < blocks; ++b) {
+    if (stop.stop_requested()) continue;
     std::uint32_t e = first[b];
     const long long last = std::min(n, (b + 1) * kNodeBlock);
     for (long long i = b * kNodeBlock; i < last; ++i)
@@ -151,11 +164,12 @@ std::size_t number_edges(const Graph& graph, int threads, ScratchBuffer<std::uin
           ++e;
         }
   }
+  throw_if_stopped(stop, kWhat);
   return first[blocks];
 }
 
 void node_scores_padded(const CrfModel& model, std::span<const float> descriptors,
-                        const Graph& graph, int threads, float* out) {
+                        const Graph& graph, int threads, float* out, const std::stop_token& stop) {
   const long long n = static_cast<long long>(graph.num_nodes());
   const int d = model.descriptor_dim;
   const int k_count = model.num_classes();
@@ -169,6 +183,7 @@ void node_scores_padded(const CrfModel& model, std::span<const float> descriptor
     RowMatrixXf scores(kNodeBlock, k_count);
 #pragma omp for schedule(static)
     for (long long b = 0; b < blocks; ++b) {
+      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
       const long long first = b * kNodeBlock;
       const long long count = std::min(kNodeBlock, n - first);
       for (long long r = 0; r < count; ++r) {
@@ -188,11 +203,12 @@ void node_scores_padded(const CrfModel& model, std::span<const float> descriptor
       }
     }
   }
+  throw_if_stopped(stop, kWhat);
 }
 
 void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors,
                        const Graph& graph, const std::uint32_t* block_first_edge, int threads,
-                       bool potentials_minus_one, float* out) {
+                       bool potentials_minus_one, float* out, const std::stop_token& stop) {
   const long long n = static_cast<long long>(graph.num_nodes());
   const int d = model.descriptor_dim;
   const int k_count = model.num_classes();
@@ -208,10 +224,16 @@ void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors
       row[std::size_t(k)] =
           potentials_minus_one ? std::exp(std::min(theta, kMaxEdgeScore)) - 1.0f : theta;
     }
-    const std::size_t edges = block_first_edge[blocks];
+    const long long edges = static_cast<long long>(block_first_edge[blocks]);
+    const long long edge_blocks = (edges + kEdgeBlock - 1) / kEdgeBlock;
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (long long e = 0; e < static_cast<long long>(edges); ++e)
-      std::copy(row.begin(), row.end(), out + std::size_t(e) * kp);
+    for (long long eb = 0; eb < edge_blocks; ++eb) {
+      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
+      const long long last = std::min(edges, (eb + 1) * kEdgeBlock);
+      for (long long e = eb * kEdgeBlock; e < last; ++e)
+        std::copy(row.begin(), row.end(), out + std::size_t(e) * kp);
+    }
+    throw_if_stopped(stop, kWhat);
     return;
   }
 #pragma omp parallel num_threads(threads)
@@ -238,6 +260,7 @@ void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors
     };
 #pragma omp for schedule(static)
     for (long long b = 0; b < blocks; ++b) {
+      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
       batch_first = block_first_edge[b];
       const long long last = std::min(n, (b + 1) * kNodeBlock);
       for (long long i = b * kNodeBlock; i < last; ++i) {
@@ -254,6 +277,7 @@ void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors
       flush();  // batches never span blocks, so they do not depend on the schedule
     }
   }
+  throw_if_stopped(stop, kWhat);
 }
 
 }  // namespace primlabel::crf::detail

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <stop_token>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -22,14 +23,17 @@ namespace primlabel::crf::detail {
 using RowMatrixXf = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
+// The score functions below check `stop` once per block of nodes (or edges), skip the remaining
+// blocks once it is requested and then throw primlabel::Cancelled; an empty token never stops.
+
 // theta_i(k) for every node: num_nodes x K; rows of inactive nodes are zero.
 RowMatrixXf node_scores(const CrfModel& model, std::span<const float> descriptors,
-                        const Graph& graph, int threads);
+                        const Graph& graph, int threads, const std::stop_token& stop = {});
 
 // theta_ij(k, k) for every directed slot: num_slots x K (both directions of an edge hold the same
 // row). Zero when the model has no edge terms.
 RowMatrixXf edge_scores(const CrfModel& model, std::span<const float> descriptors,
-                        const Graph& graph, int threads);
+                        const Graph& graph, int threads, const std::stop_token& stop = {});
 
 // ---- Padded layouts of the inference fast path ------------------------------------------------
 // Rows of K classes are stored with a stride padded to a multiple of 4 floats, so the per-class
@@ -68,17 +72,19 @@ class ScratchBuffer {
 // Undirected edge numbering: edge e is owned by the slot p of its lower endpoint i (neighbors[p]
 // > i), numbered in node order; edge_of[p] = edge_of[reverse[p]] = e. Returns num_edges().
 std::size_t number_edges(const Graph& graph, int threads, ScratchBuffer<std::uint32_t>& edge_of,
-                         ScratchBuffer<std::uint32_t>& block_first_edge);
+                         ScratchBuffer<std::uint32_t>& block_first_edge,
+                         const std::stop_token& stop = {});
 
 // theta_i(k) for every node into `out` (num_nodes x padded K, pads 0; inactive rows 0).
 void node_scores_padded(const CrfModel& model, std::span<const float> descriptors,
-                        const Graph& graph, int threads, float* out);
+                        const Graph& graph, int threads, float* out,
+                        const std::stop_token& stop = {});
 
 // theta_ij(k, k) per undirected edge (numbered by number_edges) into `out` (num_edges x padded K,
 // pads 0), or psi_ij(k) - 1 = exp(min(theta, 60)) - 1 when `potentials_minus_one`.
 void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors,
                        const Graph& graph, const std::uint32_t* block_first_edge, int threads,
-                       bool potentials_minus_one, float* out);
+                       bool potentials_minus_one, float* out, const std::stop_token& stop = {});
 
 // Products of tiny values would otherwise run into subnormals, which are ~100x slower on x86;
 // flushing them to zero changes nothing that matters next to a maximum of 1.

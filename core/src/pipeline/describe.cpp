@@ -32,8 +32,8 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
     throw std::invalid_argument("the cloud has no normal per point to keep");
   throw_if_stopped(options.stop, "describing the cloud");
   DescribedCloud out;
-  out.search = std::make_unique<NeighborSearch>(cloud.xyz);
-  throw_if_stopped(options.stop, "describing the cloud");
+  // The index build checks the token itself (a 5M-point k-d tree takes about a second).
+  out.search = std::make_unique<NeighborSearch>(cloud.xyz, options.stop);
 
   if (!options.use_cloud_normals) {
     const auto start = std::chrono::steady_clock::now();

@@ -60,6 +60,7 @@ LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& 
   const auto start = std::chrono::steady_clock::now();
   crf::GraphOptions graph_options = model.graph;
   graph_options.threads = options.threads;
+  graph_options.stop = options.stop;
   // A node-only model ignores edges, so its graph needs none (only the active mask).
   if (model.kind == ModelKind::kNodeOnly) graph_options.neighborhood = Neighborhood::Knn(1);
   const crf::Graph graph = build_scene_graph(cloud, described, graph_options);

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <stop_token>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,12 @@ struct NeighborList {
 class NeighborSearch {
  public:
   // Indexes the finite points of `points`; the vector must outlive the search object.
-  explicit NeighborSearch(const std::vector<Vec3f>& points);
+  // `stop` is checked while the k-d tree is built (between subtrees of at most 64k points; the
+  // tree is the same as an unchecked build) and the constructor then throws primlabel::Cancelled.
+  // It is also checked while a radius grid is built on first use of a radius: a build cut short
+  // is not kept and the k-d tree answers instead (the same neighbours; unsorted lists may come
+  // in another order), since the caller is about to give up anyway.
+  explicit NeighborSearch(const std::vector<Vec3f>& points, std::stop_token stop = {});
   ~NeighborSearch();
   NeighborSearch(const NeighborSearch&) = delete;
   NeighborSearch& operator=(const NeighborSearch&) = delete;

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <stop_token>
 #include <utility>
 #include <vector>
 
@@ -40,6 +41,9 @@ struct GraphOptions {
   // nearest others; Radius(r) / Hybrid(r, m) to the others within r (the m nearest of them).
   Neighborhood neighborhood = Neighborhood::Knn(8);
   int threads = 0;  // 0 = OpenMP default; the graph is identical for any value
+  // Checked per block of points while the graph (and its own neighbour index, when one is
+  // needed) is built; build_graph then throws primlabel::Cancelled.
+  std::stop_token stop;
 };
 
 // A row of `dim` values is a valid descriptor when every value is finite (features.hpp marks
@@ -51,7 +55,8 @@ std::vector<std::uint8_t> valid_descriptor_mask(std::span<const float> descripto
 // descriptor, then symmetrises (union: i~j when either finds the other). `descriptors` is
 // row-major points.size() x dim. `search` may be passed to reuse an index built on `points`; it
 // is used only when every finite point has a valid descriptor (otherwise an index over the valid
-// points is built), so the graph never depends on whether it was passed.
+// points is built), so the graph never depends on whether it was passed. Throws
+// primlabel::Cancelled when options.stop is requested.
 Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descriptors, int dim,
                   const GraphOptions& options = {}, const NeighborSearch* search = nullptr);
 
