@@ -244,10 +244,10 @@ int main(int argc, char** argv) {
       try {
         pipeline::label_cloud(model, copy, options);
         std::printf("cancel  in-process after %5d ms: finished before the stop\n", after_ms);
-      } catch (const pipeline::Cancelled&) {
+      } catch (const pipeline::Cancelled& e) {
         local_stop_ms.push_back(ms_since(requested));
-        std::printf("cancel  in-process after %5d ms: stopped %6.1f ms after the request\n",
-                    after_ms, local_stop_ms.back());
+        std::printf("cancel  in-process after %5d ms: stopped %6.1f ms after the request (%s)\n",
+                    after_ms, local_stop_ms.back(), e.what());
       }
       std::fflush(stdout);
     }
