@@ -138,8 +138,10 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
   // and tree order is itself deterministic.
   const bool sorted = false;
 
-  std::vector<float> spfh(n * kFpfhSize, 0.0f);
-  std::vector<double> spfh_sums(n * 3, 0.0);  // per sub-histogram, for the normalisation
+  std::vector<float> spfh;
+  std::vector<double> spfh_sums;  // per sub-histogram, for the normalisation
+  detail::assign_checked(spfh, n * kFpfhSize, 0.0f, options.stop, "FPFH");
+  detail::assign_checked(spfh_sums, n * 3, 0.0, options.stop, "FPFH");
   NeighborCache cache(n, options.neighbor_cache_bytes);
   detail::ProgressCounter progress(options.progress, 2 * n);
 #pragma omp parallel num_threads(threads)
@@ -165,7 +167,8 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
 
   throw_if_stopped(options.stop, "FPFH");
 
-  std::vector<float> fpfh(n * kFpfhSize, 0.0f);
+  std::vector<float> fpfh;
+  detail::assign_checked(fpfh, n * kFpfhSize, 0.0f, options.stop, "FPFH");
   std::size_t computed = 0, isolated = 0;
 #pragma omp parallel num_threads(threads) reduction(+ : computed, isolated)
   {

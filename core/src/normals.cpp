@@ -64,8 +64,9 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
   }
   const Vec3f viewpoint = options.viewpoint.value_or(cloud.viewpoint.origin);
   const std::size_t n = cloud.size();
-  cloud.normals.assign(n, Vec3f::Constant(kNaN));
-  cloud.curvature.assign(n, kNaN);
+  detail::assign_checked(cloud.normals, n, Vec3f(Vec3f::Constant(kNaN)), options.stop,
+                         "normal estimation");
+  detail::assign_checked(cloud.curvature, n, kNaN, options.stop, "normal estimation");
 
   std::size_t estimated = 0, too_few = 0, invalid_input = 0;
   detail::ProgressCounter progress(options.progress, n);

@@ -55,7 +55,8 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
 
   const std::size_t n = cloud.size();
   const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(n);
-  std::vector<float> pfh(n * kPfhSize, 0.0f);
+  std::vector<float> pfh;
+  detail::assign_checked(pfh, n * kPfhSize, 0.0f, options.stop, "PFH");
   std::size_t computed = 0, isolated = 0;
   detail::ProgressCounter progress(options.progress, n);
 #pragma omp parallel num_threads(detail::resolve_threads(options.threads)) \
