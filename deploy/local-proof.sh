@@ -187,7 +187,7 @@ if [[ -z "$MODELS" ]]; then
   MODELS=$WORK/models
   mkdir -p "$MODELS/tabletop/1"
   log "training a small node-only model into $MODELS"
-  nice "$BIN/primlabel-train" --synth-train 1 --synth-val 0 --kind node --iterations 30 \
+  "$BIN/primlabel-train" --synth-train 1 --synth-val 0 --kind node --iterations 30 \
     --name tabletop -q -o "$MODELS/tabletop/1/model.plm" >"$WORK/train.log" 2>&1 ||
     die "primlabel-train failed"
 fi
@@ -299,7 +299,7 @@ record() {  # record PASS|FAIL text
 # ---- (a) + (b): the load generator through nginx ----
 log "primlabel-loadgen: $LOADGEN_REQUESTS Label calls through nginx"
 set +e
-nice "$BIN/primlabel-loadgen" --server "$PROXY" --synth 3 --max-points 5000 --concurrency 3 \
+"$BIN/primlabel-loadgen" --server "$PROXY" --synth 3 --max-points 5000 --concurrency 3 \
   --requests "$LOADGEN_REQUESTS" --duration 0 --max-duration 120 --format json \
   >"$WORK/loadgen.json" 2>"$WORK/loadgen.log"
 loadgen_status=$?
@@ -342,7 +342,7 @@ for i in $(seq "$UPLOAD_SCANS"); do
 done
 victim_pid=${SERVER_PIDS[$((VICTIM - 1))]}
 log "primlabel-upload: $UPLOAD_SCANS scans through nginx; replica $VICTIM (pid $victim_pid) is killed mid-run"
-nice "$BIN/primlabel-upload" --server "$PROXY" --spool "$WORK/spool" -o "$WORK/out" --workers 2 \
+"$BIN/primlabel-upload" --server "$PROXY" --spool "$WORK/spool" -o "$WORK/out" --workers 2 \
   --backoff-max 1 --timeout 90 --status-interval 0 "$WORK"/scans/*.pcd \
   >"$WORK/upload.out" 2>"$WORK/upload.log" &
 upload_pid=$!
