@@ -11,8 +11,9 @@
 #   (c) primlabel-upload, through nginx, loses no scan when one replica is killed (SIGKILL) while
 #       it labels one of them: every scan has exactly one labeled output and the spool is empty.
 #
-#   deploy/local-proof.sh [--build-dir DIR] [--hold SECONDS]
+#   deploy/local-proof.sh [BUILD_DIR | --build-dir BUILD_DIR] [--hold SECONDS]
 #
+# BUILD_DIR (default: the repository's build) holds bin/primlabel-server and the other tools.
 # --hold keeps the topology up for SECONDS after the checks (the ports are logged).
 # Exit status: 0 every check passed, 1 a check failed or the topology did not come up,
 # 2 bad usage, 77 nginx, Prometheus or python3 is not installed (CTest reports a skip).
@@ -38,7 +39,8 @@ while [[ $# -gt 0 ]]; do
     --build-dir) BUILD_DIR=${2:?--build-dir needs a directory}; shift 2 ;;
     --hold) HOLD_SECONDS=${2:?--hold needs seconds}; shift 2 ;;
     -h | --help) usage; exit 0 ;;
-    *) usage >&2; exit 2 ;;
+    -*) usage >&2; exit 2 ;;
+    *) BUILD_DIR=$1; shift ;;
   esac
 done
 BIN=${PRIMLABEL_BIN_DIR:-$BUILD_DIR/bin}
