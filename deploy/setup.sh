@@ -70,8 +70,7 @@ default_model() {
     return
   fi
   mkdir -p "$(dirname "$model")"
-  "$BUILD_DIR/bin/primlabel-train" --sensor lms400 --kind crf --name tabletop-lms400 \
-    --curve "$(dirname "$model")/training_curve.csv" -o "$model.tmp"
+  "$BUILD_DIR/bin/primlabel-train" --sensor lms400 --kind crf --name tabletop-lms400 -o "$model.tmp"
   mv "$model.tmp" "$model"
   log "wrote the default model $model"
 }
