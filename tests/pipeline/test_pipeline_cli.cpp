@@ -72,6 +72,19 @@ TEST_F(PipelineCli, TrainedModelLoadsAndLabelsWithJsonScores) {
   EXPECT_FALSE(model.class_ids().empty());
 }
 
+TEST_F(PipelineCli, SvmModelTrainsAndEvaluates) {
+  const std::string svm = (*dir_ / "svm.plm").string();
+  const Result trained = run(test::binary("primlabel-train") +
+                             " --synth-train 1 --synth-val 0 --kind svm --svm-max-points 1000 "
+                             "--threads 2 -q -o " +
+                             svm);
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  EXPECT_EQ(load_model(svm).kind, ModelKind::kSvm);
+  const Result r = run(eval() + " --model " + svm + " --json -q --threads 2 " + scene_path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("\"accuracy\":0."), std::string::npos) << r.output;
+}
+
 TEST_F(PipelineCli, WritesPredictedLabelsAndHistogramWithoutTruth) {
   const std::string out = (*dir_ / "labeled.pcd").string();
   const Result r = run(eval() + " --model " + zero_model_path() + " --no-truth -q --out " + out +
@@ -105,7 +118,7 @@ TEST_F(PipelineCli, BadUsageExitsTwo) {
         eval() + " --table1 --model m.plm",
         test::binary("primlabel-train") + " --kind nonsense -o m.plm",
         test::binary("primlabel-train") + " --synth-train 1",
-        test::binary("primlabel-train") + " --kind svm -o m.plm",
+        test::binary("primlabel-train") + " --kind svm --curve c.csv -o m.plm",
         test::binary("primlabel-train") + " --train a.pcd --synth-train 2 -o m.plm"}) {
     const Result r = run(command);
     EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;

@@ -1,5 +1,6 @@
 // Labeling a cloud with a trained model: describe with the model's settings, build its graph,
-// infer (CRF or node-only), optionally restricted to the table-top.
+// infer (CRF or node-only) or classify point by point (SVM), optionally restricted to the
+// table-top.
 
 #include <chrono>
 #include <cmath>
@@ -8,6 +9,7 @@
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/pipeline/svm_model.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
 
 namespace primlabel::pipeline {
@@ -24,6 +26,11 @@ LabelingResult label_all_points(const LabelModel& model, PointCloud& cloud,
   result.class_ids = model.class_ids();
   DescribedCloud described = describe_cloud(cloud, model.features, options.threads);
   result.feature_seconds = described.normal_seconds + described.feature_seconds;
+  if (model.kind == ModelKind::kSvm) {  // point by point: no graph
+    LabelingResult svm = label_described_with_svm(model, described, options);
+    svm.feature_seconds = result.feature_seconds;
+    return svm;
+  }
 
   const auto start = std::chrono::steady_clock::now();
   crf::GraphOptions graph_options = model.graph;
@@ -48,9 +55,6 @@ LabelingResult label_all_points(const LabelModel& model, PointCloud& cloud,
 
 LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
                            const LabelingOptions& options) {
-  if (model.kind == ModelKind::kSvm)
-    throw ModelError(
-        "SVM models cannot be applied yet: SvmClassifier has no libsvm text deserialisation");
   if (!options.tabletop_only) return label_all_points(model, cloud, options);
 
   // Table-top only: label the sub-cloud of table and object points, scatter back.

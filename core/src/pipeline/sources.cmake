@@ -4,6 +4,7 @@ target_sources(primlabel_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/describe.cpp
   ${CMAKE_CURRENT_LIST_DIR}/label_cloud.cpp
   ${CMAKE_CURRENT_LIST_DIR}/training.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/svm_model.cpp
   ${CMAKE_CURRENT_LIST_DIR}/curve_plot.cpp
   ${CMAKE_CURRENT_LIST_DIR}/table1.cpp
 )

@@ -53,8 +53,8 @@ struct LabelingResult {
 };
 
 // Labels every point with the model's own feature, graph and inference settings. Points with
-// non-finite coordinates or no descriptor get class 0. Throws ModelError for an SVM model (its
-// libsvm text cannot be loaded into SvmClassifier yet).
+// non-finite coordinates or no descriptor get class 0. Throws ModelError when an SVM model's
+// libsvm text does not load.
 LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
                            const LabelingOptions& options = {});
 
