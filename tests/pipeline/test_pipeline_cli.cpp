@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "png_decode.hpp"
 #include "primlabel/core/features.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/labeled_cloud.hpp"
@@ -95,6 +96,16 @@ TEST_F(PipelineCli, WritesPredictedLabelsAndHistogramWithoutTruth) {
   EXPECT_TRUE(labeled.has_labels());
 }
 
+TEST_F(PipelineCli, WritesTheConfusionMatrixAsPng) {
+  const std::string png = (*dir_ / "confusion.png").string();
+  const Result r = run(eval() + " --model " + zero_model_path() + " -q --confusion-png " + png +
+                       " " + scene_path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test::Decoded decoded = test::decode_png(png);
+  EXPECT_GT(decoded.width, 200);
+  EXPECT_GT(decoded.distinct_colors(), 4u);
+}
+
 TEST_F(PipelineCli, MissingFileFailsWithOneLine) {
   const Result r = run(eval() + " --model " + zero_model_path() + " -q /nonexistent/scene.pcd");
   EXPECT_EQ(r.exit_code, 1);
@@ -115,7 +126,9 @@ TEST_F(PipelineCli, CorruptModelFailsWithOneLine) {
 TEST_F(PipelineCli, BadUsageExitsTwo) {
   for (const std::string& command :
        {eval() + " --model", eval() + " --bogus-flag x.pcd", eval() + " x.pcd",
-        eval() + " --table1 --model m.plm",
+        eval() + " --table1 --model m.plm", eval() + " --fig4 out --model m.plm",
+        eval() + " --fig4-scenes 2 --table1", eval() + " --fig4 out --table1",
+        eval() + " --model m.plm --no-truth --confusion-png c.png x.pcd",
         test::binary("primlabel-train") + " --kind nonsense -o m.plm",
         test::binary("primlabel-train") + " --synth-train 1",
         test::binary("primlabel-train") + " --kind svm --curve c.csv -o m.plm",
