@@ -6,10 +6,13 @@
 //   primlabel-eval --model table.plm --confusion-png confusion.png a.pcd b.pcd   # over all files
 //   primlabel-eval --table1 [--json]
 //   primlabel-eval --fig4 out/ [--fig4-scenes 3]                    # the paper's Fig. 4
+//   primlabel-eval --model kinect.plm --mosd-report out/ ../shared/data/mosd/*.pcd
 
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "cli_common.hpp"
@@ -18,6 +21,7 @@
 #include "primlabel/pipeline/confusion_plot.hpp"
 #include "primlabel/pipeline/fig4.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/pipeline/mosd_report.hpp"
 #include "primlabel/pipeline/table1.hpp"
 #include "primlabel/synth/labeled_cloud.hpp"
 
@@ -26,7 +30,7 @@ namespace {
 using namespace primlabel;
 
 struct Arguments {
-  std::string model, classes, out, confusion_png, fig4_dir;
+  std::string model, classes, out, confusion_png, fig4_dir, mosd_dir;
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
   bool table1 = false, no_pfh = false, no_svm = false;
@@ -161,6 +165,34 @@ int table1(const Arguments& args) {
   return cli::kExitOk;
 }
 
+int mosd_report(const Arguments& args) {
+  const LabelModel model = load_model(args.model);
+  std::error_code ec;
+  std::filesystem::create_directories(args.mosd_dir, ec);
+  if (ec) throw std::runtime_error(args.mosd_dir + ": cannot be created (" + ec.message() + ")");
+  pipeline::LabelingOptions options;
+  options.threads = args.threads;
+  options.tabletop_only = args.tabletop_only;
+  std::vector<pipeline::MosdSceneReport> scenes;
+  for (const std::string& path : args.files) {
+    const std::string png = (std::filesystem::path(args.mosd_dir) /
+                             (std::filesystem::path(path).stem().string() + "_labels.png"))
+                                .string();
+    scenes.push_back(pipeline::report_mosd_scene(model, path, png, options));
+    if (!args.quiet)
+      std::fprintf(stderr, "%s: %.2f%% of %llu table points plane, wrote %s\n", path.c_str(),
+                   100.0 * scenes.back().plane_share(),
+                   static_cast<unsigned long long>(scenes.back().table_points), png.c_str());
+  }
+  const pipeline::MosdReport report = pipeline::summarize_mosd(std::move(scenes));
+  const std::string json = pipeline::mosd_report_json(report);
+  const std::string json_path =
+      (std::filesystem::path(args.mosd_dir) / "mosd_report.json").string();
+  std::ofstream(json_path) << json;
+  std::fputs((args.json ? json : pipeline::mosd_report_text(report)).c_str(), stdout);
+  return cli::kExitOk;
+}
+
 int fig4(const Arguments& args) {
   pipeline::Fig4Options options;
   options.scenes = args.fig4_scenes;
@@ -205,10 +237,18 @@ int main(int argc, char** argv) {
                    "the files' labels are no primitive classes (e.g. segment ids): print the "
                    "predicted label histogram");
   app.add_option("--classes", args.classes, "class map of the files' labels (id name per line)");
-  app.add_option("--out", args.out, "write the predicted labels (one input file)");
+  auto* out = app.add_option("--out", args.out, "write the predicted labels (one input file)");
+  auto* mosd =
+      app.add_option("--mosd-report", args.mosd_dir,
+                     "mOSD scenes (label 1-9 table): share of table points labeled plane, and a "
+                     "labeled PNG per scene, into DIR (with mosd_report.json)")
+          ->needs(model)
+          ->excludes(no_truth)
+          ->excludes(out);
   app.add_option("--confusion-png", args.confusion_png,
                  "confusion matrix over all scored files as PNG (rows true, columns predicted)")
-      ->excludes(no_truth);
+      ->excludes(no_truth)
+      ->excludes(mosd);
   app.add_flag("--tabletop-only", args.tabletop_only, "label only the table and the objects on it");
   auto* t1 = app.add_flag("--table1", args.table1,
                           "re-measure the paper's Table I on synthetic LMS400 scenes");
@@ -257,6 +297,7 @@ int main(int argc, char** argv) {
   try {
     if (args.table1) return table1(args);
     if (!args.fig4_dir.empty()) return fig4(args);
+    if (!args.mosd_dir.empty()) return mosd_report(args);
     return evaluate_files(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "primlabel-eval: error: %s\n", e.what());

@@ -129,6 +129,8 @@ TEST_F(PipelineCli, BadUsageExitsTwo) {
         eval() + " --table1 --model m.plm", eval() + " --fig4 out --model m.plm",
         eval() + " --fig4-scenes 2 --table1", eval() + " --fig4 out --table1",
         eval() + " --model m.plm --no-truth --confusion-png c.png x.pcd",
+        eval() + " --mosd-report out x.pcd", eval() + " --model m.plm --mosd-report out",
+        eval() + " --model m.plm --mosd-report out --confusion-png c.png x.pcd",
         test::binary("primlabel-train") + " --kind nonsense -o m.plm",
         test::binary("primlabel-train") + " --synth-train 1",
         test::binary("primlabel-train") + " --kind svm --curve c.csv -o m.plm",

@@ -8,6 +8,7 @@ target_sources(primlabel_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/curve_plot.cpp
   ${CMAKE_CURRENT_LIST_DIR}/confusion_plot.cpp
   ${CMAKE_CURRENT_LIST_DIR}/fig4.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/mosd_report.cpp
   ${CMAKE_CURRENT_LIST_DIR}/table1.cpp
 )
 
