@@ -34,7 +34,7 @@ struct Arguments {
   float noise = 40.0f;
   std::vector<int> threads = {1, 2};
   int repeat = 5;
-  std::string model = "prototype";  // prototype | trained
+  std::string model = "prototype";  // prototype | potts | trained
   std::vector<std::string> methods = {"bp-sum", "bp-max", "mean-field", "node-only"};
 };
 
@@ -87,8 +87,10 @@ int main(int argc, char** argv) {
   app.add_option("--noise", args.noise, "descriptor noise (prototype values are in [0, 100])");
   app.add_option("--threads", args.threads, "thread counts to measure")->delimiter(',');
   app.add_option("--repeat", args.repeat, "timed runs per case (the median is reported)");
-  app.add_option("--model", args.model, "prototype (hand-made) or trained (pseudo-likelihood)")
-      ->check(CLI::IsMember({"prototype", "trained"}));
+  app.add_option("--model", args.model,
+                 "prototype (hand-made, feature-dependent couplings), potts (one coupling, as "
+                 "piecewise training makes) or trained (pseudo-likelihood)")
+      ->check(CLI::IsMember({"prototype", "potts", "trained"}));
   app.add_option("--methods", args.methods, "bp-sum,bp-max,mean-field,node-only")->delimiter(',');
   CLI11_PARSE(app, argc, argv);
 
@@ -113,10 +115,14 @@ int main(int argc, char** argv) {
     std::vector<std::uint32_t> ids(spec.num_classes);
     for (int k = 0; k < spec.num_classes; ++k) ids[k] = static_cast<std::uint32_t>(k + 1);
     TrainingOptions options;
+    options.objective = TrainingObjective::kPseudoLikelihood;
     options.max_iterations = 60;
     const auto start = std::chrono::steady_clock::now();
     model = train_crf(training, {}, ids, options).model;
     train_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  } else if (args.model == "potts") {
+    // What piecewise training makes (the default models): node weights plus one coupling.
+    model = testing::prototype_model(spec, 4.0f, 0.25f);
   } else {
     // Nearest-prototype node weights, and edge weights with a bias plus random feature terms, so
     // psi differs from edge to edge as with a trained model.

@@ -5,6 +5,9 @@
 #   deploy/setup.sh test    install + build + the whole test suite (CTest)
 #   deploy/setup.sh build   install + build only
 #   deploy/setup.sh deps    install only
+#   deploy/setup.sh default-model [DIR]
+#                           install + build + the default model into DIR (a model repository,
+#                           default build/models): DIR/tabletop-lms400/1/model.plm
 #
 # Environment: BUILD_DIR (default build), BUILD_TYPE (Release), JOBS (nproc),
 #              PRIMLABEL_WITH_PCL=1 also installs libpcl-dev so benchmarks compare against PCL,
@@ -23,6 +26,7 @@ PACKAGES=(
   libprotobuf-dev protobuf-compiler liblbfgspp-dev libsvm-dev
   libgrpc++-dev protobuf-compiler-grpc
   libgtest-dev
+  python3-yaml nginx prometheus
 )
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev)
 
@@ -51,6 +55,22 @@ build() {
   cmake --build "$BUILD_DIR" -j "$JOBS"
 }
 
+# The default model: CRF + FPFH from 8 synthetic LMS400 table scenes (fixed seeds), so the same
+# commands make the same model. Kept when it exists.
+default_model() {
+  local repo=${1:-$BUILD_DIR/models}
+  local model="$repo/tabletop-lms400/1/model.plm"
+  if [[ -f "$model" ]]; then
+    log "default model present: $model"
+    return
+  fi
+  mkdir -p "$(dirname "$model")"
+  "$BUILD_DIR/bin/primlabel-train" --sensor lms400 --kind crf --name tabletop-lms400 \
+    --curve "$(dirname "$model")/training_curve.csv" -o "$model.tmp"
+  mv "$model.tmp" "$model"
+  log "wrote the default model $model"
+}
+
 run_main_job() {
   local out="$BUILD_DIR/out"
   mkdir -p "$out"
@@ -65,6 +85,7 @@ run_tests() {
 
 case "${1:-}" in
   deps) install_packages ;;
+  default-model) install_packages; build; default_model "${2:-}" ;;
   build) install_packages; build ;;
   run) install_packages; build; run_main_job ;;
   test) install_packages; build; run_tests ;;

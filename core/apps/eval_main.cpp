@@ -34,7 +34,7 @@ struct Arguments {
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
   bool table1 = false, no_pfh = false, no_svm = false;
-  int table1_train = 3, table1_test = 2, pfh_max_neighbors = 40, threads = 0, fig4_scenes = 3;
+  int table1_train = 8, table1_test = 4, pfh_max_neighbors = 40, threads = 0, fig4_scenes = 3;
 };
 
 std::string class_name(std::uint32_t id) {
@@ -252,10 +252,10 @@ int main(int argc, char** argv) {
   app.add_flag("--tabletop-only", args.tabletop_only, "label only the table and the objects on it");
   auto* t1 = app.add_flag("--table1", args.table1,
                           "re-measure the paper's Table I on synthetic LMS400 scenes");
-  app.add_option("--table1-train", args.table1_train, "Table I: training scenes (default 3)")
+  app.add_option("--table1-train", args.table1_train, "Table I: training scenes (default 8)")
       ->check(CLI::PositiveNumber)
       ->needs(t1);
-  app.add_option("--table1-test", args.table1_test, "Table I: test scenes (default 2)")
+  app.add_option("--table1-test", args.table1_test, "Table I: test scenes (default 4)")
       ->check(CLI::PositiveNumber)
       ->needs(t1);
   app.add_flag("--no-pfh", args.no_pfh, "Table I: FPFH rows only")->needs(t1);

@@ -21,10 +21,10 @@ namespace {
 using namespace primlabel;
 
 struct Arguments {
-  int synth_train = 3, synth_val = 1, iterations = 100, graph_k = 8, threads = 0;
-  std::string sensor = "lms400", kind = "crf", objective = "pl", descriptor = "fpfh";
-  std::string fpfh_variant = "pcl";
-  double label_radius = synth::kDefaultLabelRadius, l2 = 1e-5, svm_c = 10.0, svm_gamma = 0.0;
+  int synth_train = 8, synth_val = 1, iterations = 200, graph_k = 8, threads = 0;
+  std::string sensor = "lms400", kind = "crf", objective = "piecewise", descriptor = "fpfh";
+  std::string fpfh_variant = "paper";
+  double label_radius = synth::kDefaultLabelRadius, l2 = 1e-6, svm_c = 10.0, svm_gamma = 0.0;
   std::size_t svm_max_points = 20000;
   float feature_radius = 0.025f, normal_radius = 0.01f;
   std::vector<std::string> train_files, val_files;
@@ -105,7 +105,8 @@ int run(const Arguments& args) {
   options.svm.gamma = args.svm_gamma;
   options.svm.max_training_points = args.svm_max_points;
   options.objective = args.objective == "bethe" ? crf::TrainingObjective::kBetheBp
-                                                : crf::TrainingObjective::kPseudoLikelihood;
+                      : args.objective == "pl"  ? crf::TrainingObjective::kPseudoLikelihood
+                                                : crf::TrainingObjective::kPiecewise;
   options.l2 = args.l2;
   options.iterations = args.iterations;
   options.threads = args.threads;
@@ -158,7 +159,7 @@ int main(int argc, char** argv) {
   app.name("primlabel-train");
   Arguments args;
   auto* synth_train =
-      app.add_option("--synth-train", args.synth_train, "synthetic training scenes (default 3)")
+      app.add_option("--synth-train", args.synth_train, "synthetic training scenes (default 8)")
           ->check(CLI::PositiveNumber);
   auto* synth_val =
       app.add_option("--synth-val", args.synth_val, "synthetic validation scenes (default 1)")
@@ -183,16 +184,18 @@ int main(int argc, char** argv) {
   app.add_option("--svm-max-points", args.svm_max_points,
                  "SVM: train on at most this many points, a seeded subsample (default 20000)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--objective", args.objective, "CRF objective: pl (pseudo-likelihood) or bethe")
-      ->check(CLI::IsMember({"pl", "bethe"}));
+  app.add_option("--objective", args.objective,
+                 "CRF objective: piecewise (default: node factors, then a validated coupling), "
+                 "pl (pseudo-likelihood) or bethe (loopy BP)")
+      ->check(CLI::IsMember({"piecewise", "pl", "bethe"}));
   app.add_option("--descriptor", args.descriptor, "fpfh or pfh")
       ->check(CLI::IsMember({"fpfh", "pfh"}));
   app.add_option("--fpfh-variant", args.fpfh_variant,
-                 "pcl (as PCL) or paper (also the point's own SPFH, as Open3D)")
+                 "paper (default: also the point's own SPFH, as Open3D) or pcl (as PCL)")
       ->check(CLI::IsMember({"pcl", "paper"}));
-  app.add_option("--l2", args.l2, "L2 regularisation (default 1e-5)")
+  app.add_option("--l2", args.l2, "L2 regularisation (default 1e-6)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--iterations", args.iterations, "L-BFGS iterations (default 100)")
+  app.add_option("--iterations", args.iterations, "L-BFGS iterations (default 200)")
       ->check(CLI::PositiveNumber);
   app.add_option("--feature-radius", args.feature_radius, "descriptor radius (m, default 0.025)")
       ->check(CLI::PositiveNumber);

@@ -14,6 +14,7 @@
 #include "feature_neighborhood.hpp"
 #include "pair_bins_batch.hpp"
 #include "parallel.hpp"
+#include "primlabel/core/cancellation.hpp"
 #include "primlabel/core/features.hpp"
 
 namespace primlabel {
@@ -147,6 +148,7 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
     SpfhScratch scratch;
 #pragma omp for schedule(dynamic, 1)
     for (std::ptrdiff_t block = 0; block < blocks; ++block) {
+      if (options.stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
       const std::size_t first = block * kBlock, last = std::min(n, first + kBlock);
       for (std::size_t p = first; p < last; ++p) {
         if (!usable[p]) continue;
@@ -161,6 +163,8 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
     }
   }
 
+  throw_if_stopped(options.stop, "FPFH");
+
   std::vector<float> fpfh(n * kFpfhSize, 0.0f);
   std::size_t computed = 0, isolated = 0;
 #pragma omp parallel num_threads(threads) reduction(+ : computed, isolated)
@@ -168,6 +172,7 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
     NeighborList neighbors;
 #pragma omp for schedule(dynamic, 1)
     for (std::ptrdiff_t block = 0; block < blocks; ++block) {
+      if (options.stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
       const std::size_t first = block * kBlock, last = std::min(n, first + kBlock);
       for (std::size_t p = first; p < last; ++p) {
         float* out = &fpfh[p * kFpfhSize];
@@ -190,6 +195,7 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
       progress.add(last - first);
     }
   }
+  throw_if_stopped(options.stop, "FPFH");
   progress.finish();
   if (stats) *stats = FeatureStats{computed, isolated, n - computed - isolated};
   return fpfh;

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "parallel.hpp"
+#include "primlabel/core/cancellation.hpp"
 
 namespace primlabel {
 
@@ -74,8 +75,11 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
 #pragma omp parallel num_threads(threads) reduction(+ : estimated, too_few, invalid_input)
   {
     NeighborList neighbors;
+    bool stopped = false;  // per thread: once cancelled, the remaining points are skipped
 #pragma omp for schedule(dynamic, 512)
     for (std::ptrdiff_t i = 0; i < count; ++i) {
+      if ((i & 255) == 0) stopped = stopped || options.stop.stop_requested();
+      if (stopped) continue;
       const Vec3f& p = cloud.xyz[i];
       if (!is_finite(p)) {
         ++invalid_input;
@@ -96,6 +100,7 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
       if ((i & 255) == 255) progress.add(256);
     }
   }
+  throw_if_stopped(options.stop, "normal estimation");
   progress.finish();
   return NormalStats{estimated, too_few, invalid_input};
 }

@@ -8,6 +8,7 @@
 #include "feature_neighborhood.hpp"
 #include "pair_bins_batch.hpp"
 #include "parallel.hpp"
+#include "primlabel/core/cancellation.hpp"
 #include "primlabel/core/features.hpp"
 
 namespace primlabel {
@@ -62,8 +63,11 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
   {
     NeighborList neighbors;
     PfhScratch scratch;
+    bool stopped = false;  // per thread: once cancelled, the remaining points are skipped
 #pragma omp for schedule(dynamic, 64)
     for (std::ptrdiff_t p = 0; p < count; ++p) {
+      if ((p & 63) == 0) stopped = stopped || options.stop.stop_requested();
+      if (stopped) continue;
       float* out = &pfh[p * kPfhSize];
       if (!usable[p]) {
         std::fill(out, out + kPfhSize, std::numeric_limits<float>::quiet_NaN());
@@ -80,6 +84,7 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
       if ((p & 63) == 63) progress.add(64);
     }
   }
+  throw_if_stopped(options.stop, "PFH");
   progress.finish();
   if (stats) *stats = FeatureStats{computed, isolated, n - computed - isolated};
   return pfh;

@@ -124,6 +124,43 @@ TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRo
   EXPECT_EQ(pipeline::label_cloud(loaded, again, options).labels, with_two.labels);
 }
 
+// The default CRF training is piecewise: node factors alone, then the one Potts coupling that
+// labels the validation scene best, never worse there than no coupling (node-only).
+TEST(PipelineLabeling, PiecewiseCrfTrainingKeepsTheCouplingThatValidatesBest) {
+  const crf::GraphOptions graph;
+  const FeatureSettings features;
+  std::vector<std::uint32_t> every_class;
+  for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
+  std::vector<SceneData> train, validation;
+  train.push_back(pipeline::prepare_scene(
+      pipeline::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
+      features, graph, every_class, 2));
+  validation.push_back(pipeline::prepare_scene(
+      pipeline::synthetic_scene(synth::SceneSet::kVal, 0, synth::SensorKind::kLms400), "val",
+      features, graph, every_class, 2));
+  const auto class_ids = pipeline::classes_present(train);
+  pipeline::assign_labels(train[0], class_ids);
+  pipeline::assign_labels(validation[0], class_ids);
+  pipeline::ModelTrainingOptions options;
+  options.iterations = 60;
+  options.threads = 2;
+  ASSERT_EQ(options.objective, crf::TrainingObjective::kPiecewise);
+  const auto trained =
+      pipeline::train_label_model(train, validation, class_ids, features, graph, options);
+  const LabelModel& crf = trained.model;
+  EXPECT_EQ(crf.kind, ModelKind::kCrf);
+  EXPECT_EQ(crf.training.objective.rfind("piecewise", 0), 0u) << crf.training.objective;
+  // A uniform coupling: every class's edge weights are zero but the bias.
+  const Eigen::MatrixXf& v = crf.weights.edge_weights;
+  ASSERT_EQ(v.rows(), crf.weights.node_weights.rows());
+  EXPECT_EQ(v.leftCols(v.cols() - 1).cwiseAbs().maxCoeff(), 0.0f);
+  EXPECT_TRUE((v.col(v.cols() - 1).array() == trained.potts_coupling).all());
+  const double chosen = pipeline::evaluate_scenes(crf, validation, 2).accuracy();
+  EXPECT_DOUBLE_EQ(chosen, crf.validation.accuracy);
+  EXPECT_GE(chosen, pipeline::evaluate_scenes(with_coupling(crf, 0.0f), validation, 2).accuracy());
+  EXPECT_GE(chosen, pipeline::evaluate_scenes(with_coupling(crf, 1.0f), validation, 2).accuracy());
+}
+
 TEST(PipelineLabeling, UnlabelablePointsGetUnknown) {
   PointCloud cloud = small_scene();
   const float nan = std::numeric_limits<float>::quiet_NaN();

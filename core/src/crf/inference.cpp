@@ -8,6 +8,7 @@
 #include "loopy_bp.hpp"
 #include "mean_field.hpp"
 #include "potentials.hpp"
+#include "primlabel/core/cancellation.hpp"
 
 namespace primlabel::crf {
 
@@ -109,6 +110,7 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
   result.labels.resize(n);
   if (options.compute_marginals) result.marginals.resize(static_cast<Eigen::Index>(n), k_count);
 
+  throw_if_stopped(options.stop, "inference");
   float* theta = ws.theta.resize(n * kp);
   detail::node_scores_padded(model, descriptors, graph, threads, theta);
   if (!model.has_edge_terms() || graph.num_slots() == 0) {
@@ -126,6 +128,8 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
   settings.damping = options.damping;
   settings.tolerance = options.tolerance;
   settings.threads = threads;
+  settings.stop = options.stop;
+  throw_if_stopped(options.stop, "inference");
   detail::BpRun run;
   if (options.method == InferenceMethod::kMeanField) {
     detail::edge_terms_padded(model, descriptors, graph, ws.block_first_edge.data(), threads, false,
@@ -137,6 +141,7 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
     problem.edge_scores = edge_terms;
     problem.edge_of = ws.edge_of.data();
     run = detail::run_mean_field(problem, settings, ws.mf);
+    throw_if_stopped(options.stop, "inference");
     outputs_from_rows(ws.mf.q.data(), false, model, graph, options, threads, result);
   } else {
     detail::edge_terms_padded(model, descriptors, graph, ws.block_first_edge.data(), threads, true,
@@ -150,6 +155,7 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
     problem.psi_minus_one = edge_terms;
     problem.edge_of = ws.edge_of.data();
     run = detail::run_fast_bp(problem, settings, ws.bp);
+    throw_if_stopped(options.stop, "inference");
     detail::fast_bp_outputs(problem, ws.bp, model.class_ids, options.unknown_label, threads,
                             result.labels.data(),
                             options.compute_marginals ? result.marginals.data() : nullptr);

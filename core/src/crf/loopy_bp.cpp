@@ -398,6 +398,7 @@ struct FastIteration {
   float keep;
   float tolerance;
   bool max_product;
+  const std::stop_token& stop;
 };
 
 template <int KP>
@@ -410,8 +411,11 @@ float fast_update_all(const FastIteration& it, int threads) {
   {
     FlushSubnormals flush;
     FastNodeUpdater<KP> updater(it.pr.classes, kp);
+    bool stopped = false;  // per thread: once cancelled, the remaining nodes are skipped
 #pragma omp for schedule(dynamic, 1024)
     for (long long i = 0; i < n; ++i) {
+      if ((i & 1023) == 0) stopped = stopped || it.stop.stop_requested();
+      if (stopped) continue;
       const std::uint32_t begin = g.offsets[i], end = g.offsets[i + 1];
       if (begin == end) continue;
       // A node whose messages and inputs all settled (moved < tolerance last iteration) would
@@ -476,6 +480,7 @@ BpRun run_fast_bp(const FastBpProblem& problem, const BpSettings& settings,
   std::fill_n(moved_a, n, std::uint8_t{1});
   BpRun report;
   for (int iteration = 1; iteration <= settings.max_iterations; ++iteration) {
+    if (settings.stop.stop_requested()) break;
     const FastIteration it{problem,
                            buffers.messages.data(),
                            buffers.next.data(),
@@ -486,7 +491,8 @@ BpRun run_fast_bp(const FastBpProblem& problem, const BpSettings& settings,
                            iteration == 1,
                            iteration == 1 ? 0.0f : settings.damping,
                            settings.tolerance,
-                           settings.max_product};
+                           settings.max_product,
+                           settings.stop};
     const float change = fast_update_dispatch(it, settings.threads);
     std::swap(buffers.messages, buffers.next);
     std::swap(moved_a, moved_b);

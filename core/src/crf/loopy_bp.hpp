@@ -7,6 +7,7 @@
 // double (a node of degree 20 multiplies 20 messages). The message on slot p of row i is
 // m_{i -> neighbors[p]}. The messages persist between runs, so training can warm-start.
 
+#include <stop_token>
 #include <vector>
 
 #include "potentials.hpp"
@@ -22,6 +23,9 @@ struct BpSettings {
   float damping = 0.5f;
   float tolerance = 1e-3f;
   int threads = 1;
+  // Once stopped, the run returns early (between iterations, or skipping the rest of one) with
+  // unusable messages; the caller throws Cancelled.
+  std::stop_token stop;
 };
 
 struct BpRun {

@@ -83,13 +83,17 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, MeanFieldBuffe
   std::fill_n(same, g.num_nodes(), std::uint8_t{1});  // both buffers start equal
   BpRun report;
   for (int iteration = 1; iteration <= settings.max_iterations; ++iteration) {
+    if (settings.stop.stop_requested()) break;
     float max_change = 0.0f;
 #pragma omp parallel num_threads(settings.threads) reduction(max : max_change)
     {
       FlushSubnormals flush;
       MeanFieldUpdater<KP> updater(pr.classes, kp);
+      bool stopped = false;  // per thread: once cancelled, the remaining nodes are skipped
 #pragma omp for schedule(dynamic, 1024)
       for (long long i = 0; i < n; ++i) {
+        if ((i & 1023) == 0) stopped = stopped || settings.stop.stop_requested();
+        if (stopped) continue;
         if (g.offsets[i] == g.offsets[i + 1]) continue;  // no neighbours: q is final
         // Skip a node whose q and neighbours' q all settled last iteration (decided from the
         // previous iteration alone: thread-count independent).

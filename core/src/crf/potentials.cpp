@@ -200,6 +200,20 @@ void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors
   const float scale2 = model.feature_scale * model.feature_scale;
   const Eigen::MatrixXf weights_t = model.edge_weights.transpose();  // (d + 1) x K
   const long long blocks = (n + kNodeBlock - 1) / kNodeBlock;
+  if (weights_t.topRows(d).isZero(0.0f)) {
+    // A Potts coupling (only the bias): the same row for every edge, no feature products.
+    std::vector<float> row(std::size_t(kp), 0.0f);
+    for (int k = 0; k < k_count; ++k) {
+      const float theta = weights_t(d, k);
+      row[std::size_t(k)] =
+          potentials_minus_one ? std::exp(std::min(theta, kMaxEdgeScore)) - 1.0f : theta;
+    }
+    const std::size_t edges = block_first_edge[blocks];
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long e = 0; e < static_cast<long long>(edges); ++e)
+      std::copy(row.begin(), row.end(), out + std::size_t(e) * kp);
+    return;
+  }
 #pragma omp parallel num_threads(threads)
   {
     RowMatrixXf features(kEdgeBatch, d + 1);

@@ -188,7 +188,8 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
   detail::ParameterShape shape;
   shape.classes = classes;
   shape.dim = dim;
-  shape.edges = options.objective != TrainingObjective::kNodeOnly;
+  shape.edges = options.objective != TrainingObjective::kNodeOnly &&
+                options.objective != TrainingObjective::kPiecewise;
 
   std::vector<detail::PreparedScene> scenes =
       detail::prepare_scenes(training, options.feature_scale);

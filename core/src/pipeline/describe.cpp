@@ -17,25 +17,40 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings, int threads) {
+  DescribeOptions options;
+  options.threads = threads;
+  return describe_cloud(cloud, settings, options);
+}
+
+DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings,
+                              const DescribeOptions& options) {
   if (settings.voxel_size > 0.0f)
-    throw std::invalid_argument("voxel downsampling before features is not supported yet");
+    throw std::invalid_argument("describe_cloud does not downsample: label_cloud does");
   if (!settings.normals.valid() || !settings.features.valid())
     throw std::invalid_argument("invalid normal or feature neighbourhood");
+  if (options.use_cloud_normals && cloud.normals.size() != cloud.size())
+    throw std::invalid_argument("the cloud has no normal per point to keep");
+  throw_if_stopped(options.stop, "describing the cloud");
   DescribedCloud out;
   out.search = std::make_unique<NeighborSearch>(cloud.xyz);
+  throw_if_stopped(options.stop, "describing the cloud");
 
-  auto start = std::chrono::steady_clock::now();
-  NormalOptions normal_options;
-  normal_options.neighborhood = settings.normals;
-  normal_options.threads = threads;
-  estimate_normals(cloud, normal_options, out.search.get());
-  out.normal_seconds = seconds_since(start);
+  if (!options.use_cloud_normals) {
+    const auto start = std::chrono::steady_clock::now();
+    NormalOptions normal_options;
+    normal_options.neighborhood = settings.normals;
+    normal_options.threads = options.threads;
+    normal_options.stop = options.stop;
+    estimate_normals(cloud, normal_options, out.search.get());
+    out.normal_seconds = seconds_since(start);
+  }
 
-  start = std::chrono::steady_clock::now();
+  const auto start = std::chrono::steady_clock::now();
   FeatureOptions feature_options;
   feature_options.neighborhood = settings.features;
   feature_options.fpfh_variant = settings.fpfh_variant;
-  feature_options.threads = threads;
+  feature_options.threads = options.threads;
+  feature_options.stop = options.stop;
   const bool fpfh = settings.descriptor == DescriptorKind::kFpfh;
   out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, nullptr, out.search.get())
                          : compute_pfh(cloud, feature_options, nullptr, out.search.get());

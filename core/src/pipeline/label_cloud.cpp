@@ -1,35 +1,66 @@
-// Labeling a cloud with a trained model: describe with the model's settings, build its graph,
-// infer (CRF or node-only) or classify point by point (SVM), optionally restricted to the
-// table-top.
+// Labeling a cloud with a trained model: optionally downsample to voxels, optionally restrict to
+// the table-top, describe with the model's settings (or allowed overrides), build its graph,
+// infer (CRF or node-only) or classify point by point (SVM), and carry the results back to every
+// input point.
 
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/svm_model.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
+#include "primlabel/tabletop/voxel_grid.hpp"
 
 namespace primlabel::pipeline {
 
 namespace {
 
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-LabelingResult label_all_points(const LabelModel& model, PointCloud& cloud,
-                                const LabelingOptions& options) {
+// The model's feature settings with the request's radius overrides applied (a radius keeps the
+// model's neighbour cap when the model already used a radius).
+FeatureSettings effective_features(const LabelModel& model, const LabelingOptions& options) {
+  FeatureSettings settings = model.features;
+  settings.voxel_size = 0.0f;  // label_cloud downsamples itself
+  const bool overrides = options.normal_radius > 0.0f || options.feature_radius > 0.0f;
+  if (overrides && !model.features.radii_overridable)
+    throw std::invalid_argument("model '" + model.name + "' does not allow radius overrides");
+  auto override_radius = [](Neighborhood& neighborhood, float radius) {
+    if (!(radius > 0.0f)) return;
+    const int cap = neighborhood.radius > 0.0f ? neighborhood.max_neighbors : 0;
+    neighborhood = Neighborhood{radius, 0, cap};
+  };
+  override_radius(settings.normals, options.normal_radius);
+  override_radius(settings.features, options.feature_radius);
+  return settings;
+}
+
+LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& features,
+                                PointCloud& cloud, const LabelingOptions& options) {
   LabelingResult result;
   result.class_ids = model.class_ids();
-  DescribedCloud described = describe_cloud(cloud, model.features, options.threads);
+  DescribeOptions describe_options;
+  describe_options.threads = options.threads;
+  describe_options.use_cloud_normals = options.use_cloud_normals;
+  describe_options.stop = options.stop;
+  DescribedCloud described = describe_cloud(cloud, features, describe_options);
+  result.normal_seconds = described.normal_seconds;
+  result.descriptor_seconds = described.feature_seconds;
   result.feature_seconds = described.normal_seconds + described.feature_seconds;
+  result.described_points = cloud.size();
+  throw_if_stopped(options.stop, "labeling");
   if (model.kind == ModelKind::kSvm) {  // point by point: no graph
-    LabelingResult svm = label_described_with_svm(model, described, options);
-    svm.feature_seconds = result.feature_seconds;
-    return svm;
+    classify_with_svm(model, std::move(described), options, result);
+    return result;
   }
 
   const auto start = std::chrono::steady_clock::now();
@@ -38,26 +69,64 @@ LabelingResult label_all_points(const LabelModel& model, PointCloud& cloud,
   // A node-only model ignores edges, so its graph needs none (only the active mask).
   if (model.kind == ModelKind::kNodeOnly) graph_options.neighborhood = Neighborhood::Knn(1);
   const crf::Graph graph = build_scene_graph(cloud, described, graph_options);
+  throw_if_stopped(options.stop, "labeling");
   crf::InferenceOptions inference = model.inference;
   inference.threads = options.threads;
   inference.unknown_label = class_id(PrimitiveClass::kUnknown);
   inference.compute_marginals = options.want_probabilities;
+  inference.stop = options.stop;
   crf::InferenceResult inferred = infer(model.weights, described.descriptors, graph, inference);
   result.inference_seconds = seconds_since(start);
 
   result.labels = std::move(inferred.labels);
   if (options.want_probabilities) result.probabilities = std::move(inferred.marginals);
+  if (options.want_descriptors) {
+    result.descriptors = std::move(described.descriptors);
+    result.descriptor_dim = described.descriptor_dim;
+  }
   result.labeled_points = graph.num_active();
   return result;
 }
 
-}  // namespace
+// An empty result for `points` points: every label unknown, NaN rows where asked.
+LabelingResult unknown_result(std::size_t points, const LabelingResult& like,
+                              const LabelingOptions& options) {
+  LabelingResult result;
+  result.class_ids = like.class_ids;
+  result.labeled_points = like.labeled_points;
+  result.described_points = like.described_points;
+  result.prefilter_seconds = like.prefilter_seconds;
+  result.normal_seconds = like.normal_seconds;
+  result.descriptor_seconds = like.descriptor_seconds;
+  result.feature_seconds = like.feature_seconds;
+  result.inference_seconds = like.inference_seconds;
+  result.labels.assign(points, class_id(PrimitiveClass::kUnknown));
+  if (options.want_probabilities)
+    result.probabilities =
+        Eigen::MatrixXf::Constant(Eigen::Index(points), Eigen::Index(like.class_ids.size()), kNaN);
+  if (options.want_descriptors) {
+    result.descriptor_dim = like.descriptor_dim;
+    result.descriptors.assign(points * std::size_t(like.descriptor_dim), kNaN);
+  }
+  return result;
+}
 
-LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
-                           const LabelingOptions& options) {
-  if (!options.tabletop_only) return label_all_points(model, cloud, options);
+// Copies the results of part point `from` to point `to` of the whole.
+void copy_point(const LabelingResult& part, std::size_t from, LabelingResult& whole,
+                std::size_t to) {
+  whole.labels[to] = part.labels[from];
+  if (part.probabilities.size() > 0)
+    whole.probabilities.row(Eigen::Index(to)) = part.probabilities.row(Eigen::Index(from));
+  if (!part.descriptors.empty()) {
+    const std::size_t d = std::size_t(part.descriptor_dim);
+    std::copy_n(part.descriptors.begin() + from * d, d, whole.descriptors.begin() + to * d);
+  }
+}
 
-  // Table-top only: label the sub-cloud of table and object points, scatter back.
+// Table-top only: label the sub-cloud of table and object points, scatter back.
+LabelingResult label_tabletop(const LabelModel& model, const FeatureSettings& features,
+                              PointCloud& cloud, const LabelingOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   tabletop::TabletopOptions tabletop_options;
   tabletop_options.threads = options.threads;
   const tabletop::TabletopResult segmented = tabletop::segment_tabletop(cloud, tabletop_options);
@@ -69,29 +138,106 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
   sub.resize_unorganized(source_index.size());
   sub.viewpoint = cloud.viewpoint;
   for (std::size_t j = 0; j < source_index.size(); ++j) sub.xyz[j] = cloud.xyz[source_index[j]];
+  if (options.use_cloud_normals) {
+    sub.normals.resize(source_index.size());
+    for (std::size_t j = 0; j < source_index.size(); ++j)
+      sub.normals[j] = cloud.normals[source_index[j]];
+  }
+  const double prefilter_seconds = seconds_since(start);
+  throw_if_stopped(options.stop, "labeling");
 
-  LabelingResult partial = label_all_points(model, sub, options);
-  LabelingResult result;
-  result.class_ids = partial.class_ids;
-  result.labeled_points = partial.labeled_points;
-  result.feature_seconds = partial.feature_seconds;
-  result.inference_seconds = partial.inference_seconds;
-  result.labels.assign(cloud.size(), class_id(PrimitiveClass::kUnknown));
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  cloud.normals.assign(cloud.size(), Vec3f::Constant(nan));
-  cloud.curvature.assign(cloud.size(), nan);
-  if (options.want_probabilities)
-    result.probabilities = Eigen::MatrixXf::Constant(Eigen::Index(cloud.size()),
-                                                     Eigen::Index(result.class_ids.size()), nan);
+  const LabelingResult partial = label_all_points(model, features, sub, options);
+  LabelingResult result = unknown_result(cloud.size(), partial, options);
+  result.prefilter_seconds = prefilter_seconds;
+  if (!options.use_cloud_normals) {
+    cloud.normals.assign(cloud.size(), Vec3f::Constant(kNaN));
+    cloud.curvature.assign(cloud.size(), kNaN);
+  }
   for (std::size_t j = 0; j < source_index.size(); ++j) {
     const std::size_t i = source_index[j];
-    result.labels[i] = partial.labels[j];
-    cloud.normals[i] = sub.normals[j];
-    cloud.curvature[i] = sub.curvature[j];
-    if (options.want_probabilities)
-      result.probabilities.row(Eigen::Index(i)) = partial.probabilities.row(Eigen::Index(j));
+    copy_point(partial, j, result, i);
+    if (!options.use_cloud_normals) {
+      cloud.normals[i] = sub.normals[j];
+      cloud.curvature[i] = sub.curvature[j];
+    }
   }
   return result;
+}
+
+LabelingResult label_points(const LabelModel& model, const FeatureSettings& features,
+                            PointCloud& cloud, const LabelingOptions& options) {
+  return options.tabletop_only ? label_tabletop(model, features, cloud, options)
+                               : label_all_points(model, features, cloud, options);
+}
+
+// Voxel centroids, with the mean of the members' normals (normalised) when the cloud's own
+// normals are used.
+PointCloud voxel_cloud(const PointCloud& cloud, const tabletop::VoxelGrid& grid,
+                       bool with_normals) {
+  PointCloud voxels;
+  voxels.resize_unorganized(grid.centroids.size());
+  voxels.xyz = grid.centroids;
+  voxels.viewpoint = cloud.viewpoint;
+  if (!with_normals) return voxels;
+  voxels.normals.assign(grid.centroids.size(), Vec3f::Constant(kNaN));
+  for (std::size_t v = 0; v < grid.centroids.size(); ++v) {
+    Vec3f sum = Vec3f::Zero();
+    for (std::uint32_t m = grid.member_offsets[v]; m < grid.member_offsets[v + 1]; ++m) {
+      const Vec3f& n = cloud.normals[grid.members[m]];
+      if (is_finite(n)) sum += n;
+    }
+    if (sum.norm() > 0.0f) voxels.normals[v] = sum.normalized();
+  }
+  return voxels;
+}
+
+LabelingResult label_voxels(const LabelModel& model, const FeatureSettings& features,
+                            PointCloud& cloud, float voxel_size, const LabelingOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const tabletop::VoxelGrid grid =
+      tabletop::voxel_downsample(cloud.xyz, tabletop::finite_indices(cloud.xyz), voxel_size);
+  PointCloud voxels = voxel_cloud(cloud, grid, options.use_cloud_normals);
+  const double voxel_seconds = seconds_since(start);
+  throw_if_stopped(options.stop, "labeling");
+
+  const LabelingResult partial = label_points(model, features, voxels, options);
+  LabelingResult result = unknown_result(cloud.size(), partial, options);
+  result.prefilter_seconds = partial.prefilter_seconds + voxel_seconds;
+  result.labeled_points = 0;
+  if (!options.use_cloud_normals) {
+    cloud.normals.assign(cloud.size(), Vec3f::Constant(kNaN));
+    cloud.curvature.assign(cloud.size(), kNaN);
+  }
+  const std::uint32_t unknown = class_id(PrimitiveClass::kUnknown);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const std::uint32_t v = grid.voxel_of_point[i];
+    if (v == tabletop::kNoVoxel) continue;
+    copy_point(partial, v, result, i);
+    if (partial.labels[v] != unknown) ++result.labeled_points;
+    if (!options.use_cloud_normals) {
+      cloud.normals[i] = voxels.normals[v];
+      cloud.curvature[i] = voxels.curvature[v];
+    }
+  }
+  return result;
+}
+
+}  // namespace
+
+LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
+                           const LabelingOptions& options) {
+  if (options.use_cloud_normals && cloud.normals.size() != cloud.size())
+    throw std::invalid_argument("use_cloud_normals: the cloud has " +
+                                std::to_string(cloud.normals.size()) + " normals for " +
+                                std::to_string(cloud.size()) + " points");
+  if (!(options.voxel_size >= 0.0f) || !std::isfinite(options.voxel_size))
+    throw std::invalid_argument("voxel size must be finite and >= 0");
+  const FeatureSettings features = effective_features(model, options);
+  const float voxel_size =
+      options.voxel_size > 0.0f ? options.voxel_size : model.features.voxel_size;
+  throw_if_stopped(options.stop, "labeling");
+  if (voxel_size > 0.0f) return label_voxels(model, features, cloud, voxel_size, options);
+  return label_points(model, features, cloud, options);
 }
 
 }  // namespace primlabel::pipeline

@@ -53,7 +53,7 @@ Calibration calibrate_edge_scale(LabelModel& model, std::span<const SceneData> s
 // from a short grid on the calibration scenes.
 Calibration calibrate_potts_coupling(LabelModel& model, std::span<const SceneData> scenes,
                                      int threads) {
-  static constexpr float kCouplings[] = {0.0f, 0.25f, 1.0f, 2.0f};
+  static constexpr float kCouplings[] = {0.0f, 0.05f, 0.1f, 0.25f, 1.0f};
   crf::CrfModel& w = model.weights;
   float best_coupling = 0.0f;
   double best_accuracy = -1.0;
@@ -70,7 +70,14 @@ Calibration calibrate_potts_coupling(LabelModel& model, std::span<const SceneDat
 
 const char* objective_name(ModelKind kind, crf::TrainingObjective objective) {
   if (kind == ModelKind::kNodeOnly) return "node-only";
-  return objective == crf::TrainingObjective::kBetheBp ? "bethe" : "pseudo-likelihood";
+  switch (objective) {
+    case crf::TrainingObjective::kBetheBp:
+      return "bethe";
+    case crf::TrainingObjective::kPseudoLikelihood:
+      return "pseudo-likelihood";
+    default:
+      return "piecewise";
+  }
 }
 }  // namespace
 
@@ -211,8 +218,15 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
   summary.iterations = std::uint32_t(out.details.iterations);
   summary.seconds = out.seconds;
 
-  if (options.kind == ModelKind::kCrf && options.calibrate_edges) {
-    const std::span<const SceneData> calibration = validation.empty() ? training : validation;
+  const std::span<const SceneData> calibration = validation.empty() ? training : validation;
+  if (options.kind == ModelKind::kCrf &&
+      training_options.objective == crf::TrainingObjective::kPiecewise) {
+    // Node factors trained alone; the coupling is the one edge factor, chosen on validation.
+    const Calibration coupling = calibrate_potts_coupling(m, calibration, options.threads);
+    out.potts_coupling = coupling.value;
+    out.edge_scale = 0.0f;
+    summary.objective = "piecewise: node-only + Potts coupling " + std::to_string(coupling.value);
+  } else if (options.kind == ModelKind::kCrf && options.calibrate_edges) {
     const Calibration pl = calibrate_edge_scale(m, calibration, options.threads);
     out.edge_scale = pl.value;
     // The alternative: node terms trained alone plus one Potts coupling for every class.

@@ -66,6 +66,7 @@ PointCloud scan_kinect(const Scene& scene, const KinectOptions& options, double 
   }
 
   PointCloud cloud;
+  detail::label_unseen_creases_as_surface(returns, label_radius);
   detail::store_returns(returns, cloud);
   cloud.width = static_cast<std::uint32_t>(options.width);
   cloud.height = static_cast<std::uint32_t>(options.height);

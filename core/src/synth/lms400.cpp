@@ -92,6 +92,7 @@ PointCloud scan_lms400(const Scene& scene, const Lms400Options& options, double 
   std::vector<detail::Return> returns;
   for (auto& line : line_returns) returns.insert(returns.end(), line.begin(), line.end());
   PointCloud cloud;
+  detail::label_unseen_creases_as_surface(returns, label_radius);
   detail::store_returns(returns, cloud);
   cloud.width = static_cast<std::uint32_t>(cloud.size());
   cloud.height = 1;

@@ -14,6 +14,11 @@ struct Return {
   std::uint32_t label = 0;
   std::uint32_t rgba = 0;
   float object = -1;
+  // For the observability pass: where the ray really hit, on which part, and that part's own
+  // class (what the label falls back to when no crease is seen).
+  Vec3f surface_xyz = Vec3f::Constant(NAN);
+  int part = -1;
+  std::uint32_t surface_label = 0;
 };
 
 inline Return make_return(const Scene& scene, const SceneHit& hit, const Vec3d& true_point,
@@ -21,6 +26,11 @@ inline Return make_return(const Scene& scene, const SceneHit& hit, const Vec3d& 
   Return r;
   r.xyz = measured_point.cast<float>();
   r.label = class_id(ground_truth(scene, hit.object, hit.part, true_point, label_radius));
+  r.surface_xyz = true_point.cast<float>();
+  r.part = hit.part;
+  const SceneObject& owner = scene.objects[hit.object];
+  r.surface_label =
+      class_id(owner.shape->surface_class(hit.part, owner.local_from_world * true_point));
   // Lambert shading from a light above and in front of the table makes rgb renders readable.
   const Vec3d light = Vec3d(0.3, -0.5, 1.0).normalized();
   const double shade = 0.45 + 0.55 * std::max(0.0, hit.normal.dot(light));
@@ -32,6 +42,14 @@ inline Return make_return(const Scene& scene, const SceneHit& hit, const Vec3d& 
   r.object = static_cast<float>(hit.object);
   return r;
 }
+
+// A crease or rim label says that the descriptor's support (radius r) straddles two surfaces. When
+// the scan holds (almost) no points of the other surface within r - it faces away from the
+// sensor, is seen at grazing incidence or lies in shadow - no descriptor can see that crease, so
+// the point keeps the class of its own surface. "Almost none": fewer than
+// kObservedCreaseFraction of the scanned points within r lie on another (object, part).
+inline constexpr double kObservedCreaseFraction = 0.05;
+void label_unseen_creases_as_surface(std::vector<Return>& returns, double label_radius);
 
 inline void store_returns(const std::vector<Return>& returns, PointCloud& cloud) {
   cloud.xyz.resize(returns.size());

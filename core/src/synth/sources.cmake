@@ -6,6 +6,7 @@ target_sources(primlabel_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/shapes.cpp
   ${CMAKE_CURRENT_LIST_DIR}/scene.cpp
   ${CMAKE_CURRENT_LIST_DIR}/ground_truth.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/observed_creases.cpp
   ${CMAKE_CURRENT_LIST_DIR}/lms400.cpp
   ${CMAKE_CURRENT_LIST_DIR}/kinect.cpp
   ${CMAKE_CURRENT_LIST_DIR}/generate.cpp

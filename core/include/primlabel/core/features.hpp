@@ -9,6 +9,7 @@
 // bin 0).
 
 #include <cstddef>
+#include <stop_token>
 #include <vector>
 
 #include "primlabel/core/neighbor_search.hpp"
@@ -35,6 +36,8 @@ struct FeatureOptions {
   // neighbour); points beyond it are searched twice. Results do not depend on it.
   std::size_t neighbor_cache_bytes = std::size_t(1) << 30;
   ProgressFn progress;
+  // Once stopped, the remaining blocks of points are skipped and the function throws Cancelled.
+  std::stop_token stop;
 };
 
 struct FeatureStats {

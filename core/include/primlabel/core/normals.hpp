@@ -4,6 +4,7 @@
 // lambda0 / (lambda0 + lambda1 + lambda2). Matches PCL's NormalEstimation.
 
 #include <optional>
+#include <stop_token>
 
 #include "primlabel/core/neighbor_search.hpp"
 #include "primlabel/core/point_cloud.hpp"
@@ -17,6 +18,8 @@ struct NormalOptions {
   std::optional<Vec3f> viewpoint;
   int threads = 0;  // 0 = OpenMP default
   ProgressFn progress;
+  // Once stopped, the remaining points are skipped and estimate_normals throws Cancelled.
+  std::stop_token stop;
 };
 
 struct NormalStats {

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <stop_token>
 #include <vector>
 
 #include "primlabel/crf/graph.hpp"
@@ -42,6 +43,9 @@ struct InferenceOptions {
   bool compute_marginals = false;
   std::uint32_t unknown_label = 0;  // label of points without a descriptor
   int threads = 0;                  // 0 = OpenMP default; results do not depend on it
+  // Checked between iterations and per block of nodes inside them; once stopped, infer throws
+  // primlabel::Cancelled.
+  std::stop_token stop;
 };
 
 struct InferenceResult {
@@ -80,7 +84,8 @@ class InferenceWorkspace {
 
 // `descriptors` is row-major graph.num_nodes() x model.descriptor_dim. Nodes the graph marks
 // inactive get options.unknown_label. A model without edge terms (or a graph without edges)
-// reduces to the per-node argmax. Throws std::invalid_argument on shape mismatches.
+// reduces to the per-node argmax. Throws std::invalid_argument on shape mismatches and
+// primlabel::Cancelled when options.stop is requested.
 InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
                       const InferenceOptions& options = {});
 // The same, with the caller's buffers (bit-identical results).

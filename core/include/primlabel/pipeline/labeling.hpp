@@ -6,8 +6,10 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <stop_token>
 #include <vector>
 
+#include "primlabel/core/cancellation.hpp"
 #include "primlabel/core/neighbor_search.hpp"
 #include "primlabel/core/point_cloud.hpp"
 #include "primlabel/crf/graph.hpp"
@@ -26,7 +28,20 @@ struct DescribedCloud {
   double normal_seconds = 0, feature_seconds = 0;
 };
 
-// Throws std::invalid_argument for settings this build cannot honour (voxel downsampling).
+// Thrown by describe_cloud and label_cloud when their stop token is requested.
+using Cancelled = primlabel::Cancelled;
+
+struct DescribeOptions {
+  int threads = 0;  // 0 = OpenMP default
+  // Keep cloud.normals (one per point, e.g. from the sensor) instead of estimating them.
+  bool use_cloud_normals = false;
+  std::stop_token stop;  // checked per block of points; throws Cancelled
+};
+
+// Throws std::invalid_argument for settings describe_cloud cannot honour (voxel downsampling:
+// label_cloud does it) or a missing normal per point with use_cloud_normals.
+DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings,
+                              const DescribeOptions& options);
 DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings, int threads = 0);
 
 crf::Graph build_scene_graph(const PointCloud& cloud, const DescribedCloud& described,
@@ -40,21 +55,43 @@ crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& des
 struct LabelingOptions {
   int threads = 0;  // 0 = OpenMP default; the labels do not depend on it
   bool want_probabilities = false;
-  bool tabletop_only = false;  // label only the table and the objects on it; the rest is unknown
+  bool want_descriptors = false;  // LabelingResult.descriptors
+  bool tabletop_only = false;     // label only the table and the objects on it; the rest is unknown
+  // Keep the cloud's own normals (cloud.normals, one per point) instead of estimating them.
+  bool use_cloud_normals = false;
+  // > 0: downsample to voxels of this edge before describing (replaces the model's voxel_size);
+  // every input point gets its voxel's label, probabilities, descriptor and normal.
+  float voxel_size = 0.0f;
+  // > 0: replace the model's normal / feature radius. Only for models whose FeatureSettings
+  // allow it (radii_overridable), else label_cloud throws std::invalid_argument.
+  float normal_radius = 0.0f;
+  float feature_radius = 0.0f;
+  // Checked between stages and per block of points inside them; label_cloud then throws
+  // Cancelled (within a block's time: a few milliseconds).
+  std::stop_token stop;
 };
 
 struct LabelingResult {
   std::vector<std::uint32_t> labels;  // taxonomy class id per point; 0 (unknown) when unlabeled
   Eigen::MatrixXf probabilities;      // points x K (model class order) when asked; NaN rows
   std::vector<std::uint32_t> class_ids;
-  std::size_t labeled_points = 0;  // points that had a descriptor
-  double feature_seconds = 0;      // normals + descriptors
-  double inference_seconds = 0;    // graph + inference
+  // points x descriptor_dim, row-major, when asked; NaN rows = the point had no descriptor.
+  std::vector<float> descriptors;
+  int descriptor_dim = 0;
+  std::size_t labeled_points = 0;    // input points that got a descriptor (through their voxel)
+  std::size_t described_points = 0;  // points described: voxels when downsampling
+  double prefilter_seconds = 0;      // table-top segmentation and voxel downsampling
+  double normal_seconds = 0;         // normal estimation (0 with the cloud's own normals)
+  double descriptor_seconds = 0;     // FPFH / PFH
+  double feature_seconds = 0;        // normals + descriptors
+  double inference_seconds = 0;      // graph + inference
 };
 
-// Labels every point with the model's own feature, graph and inference settings. Points with
-// non-finite coordinates or no descriptor get class 0. Throws ModelError when an SVM model's
-// libsvm text does not load.
+// Labels every point with the model's own feature, graph and inference settings (and the
+// overrides in `options`). Points with non-finite coordinates or no descriptor get class 0.
+// Throws ModelError when an SVM model's libsvm text does not load, std::invalid_argument for
+// overrides the model does not allow or missing normals, and Cancelled when options.stop is
+// requested.
 LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
                            const LabelingOptions& options = {});
 

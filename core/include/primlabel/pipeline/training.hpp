@@ -43,9 +43,9 @@ std::vector<std::uint32_t> classes_present(std::span<const SceneData> scenes);
 
 struct ModelTrainingOptions {
   ModelKind kind = ModelKind::kCrf;
-  crf::TrainingObjective objective = crf::TrainingObjective::kPseudoLikelihood;
-  double l2 = 1e-5;
-  int iterations = 100;
+  crf::TrainingObjective objective = crf::TrainingObjective::kPiecewise;
+  double l2 = 1e-6;
+  int iterations = 200;
   int threads = 0;
   // CRF: scale the learnt couplings down to what labels the validation scenes (or, without them,
   // the training scenes) best, as pseudo-likelihood overestimates them; and keep instead

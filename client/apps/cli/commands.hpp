@@ -1,0 +1,29 @@
+#pragma once
+// The subcommands of `primlabel`; each returns the process exit code (exit_codes.hpp) and
+// prints its one-line errors itself. ClientErrors that end the whole run propagate.
+
+#include <string>
+#include <vector>
+
+#include "primlabel/client/client.hpp"
+
+namespace primlabel::client::tools {
+
+int run_health(Client& client, const std::string& service);
+int run_models(Client& client);
+int run_info(Client& client, const std::string& model, const std::string& version);
+
+struct LabelCommand {
+  std::vector<std::string> inputs;
+  std::string output;
+  bool png = false;
+  bool descriptors = false;
+  bool probabilities = false;
+  bool unary = false;
+  bool quiet = false;
+  LabelOptions options;
+};
+
+int run_label(Client& client, LabelCommand command);
+
+}  // namespace primlabel::client::tools

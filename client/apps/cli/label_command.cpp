@@ -1,0 +1,98 @@
+// primlabel label: read each file, label it on the server, write the labeled cloud (and a PNG).
+// A bad file or a rejected request is reported and the next file goes on; an unreachable server
+// ends the run at once (the remaining files would fail the same way).
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "common/labeled_output.hpp"
+#include "exit_codes.hpp"
+#include "primlabel/core/cloud_io.hpp"
+
+namespace primlabel::client::tools {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string default_name(const fs::path& input) { return input.stem().string() + "_labeled.pcd"; }
+
+// Where the labeled version of `input` goes, per the -o rules in --help.
+std::string output_path(const LabelCommand& command, const fs::path& input) {
+  if (command.output.empty()) return (input.parent_path() / default_name(input)).string();
+  const fs::path out(command.output);
+  if (command.inputs.size() > 1 || fs::is_directory(out))
+    return (out / default_name(input)).string();
+  return out.string();
+}
+
+}  // namespace
+
+int run_label(Client& client, LabelCommand command) {
+  if (command.inputs.size() > 1 && !command.output.empty()) {
+    std::error_code ec;
+    fs::create_directories(command.output, ec);
+    if (ec) {
+      std::fprintf(stderr, "primlabel: %s: cannot create the output directory: %s\n",
+                   command.output.c_str(), ec.message().c_str());
+      return kExitFile;
+    }
+  }
+  command.options.descriptors = command.descriptors;
+  command.options.probabilities = command.probabilities;
+  cli::ProgressPrinter progress(command.quiet);
+  int exit_code = kExitOk;
+  for (const std::string& input : command.inputs) {
+    PointCloud cloud;
+    try {
+      cloud = read_cloud(input);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "primlabel: %s\n", e.what());
+      if (exit_code == kExitOk) exit_code = kExitFile;
+      continue;
+    }
+    LabelOptions options = command.options;
+    if (options.scan_id.empty()) options.scan_id = fs::path(input).stem().string();
+    const auto start = std::chrono::steady_clock::now();
+    LabelResult result;
+    try {
+      if (command.unary) {
+        result = client.label_unary(cloud, options);
+      } else {
+        result = client.label(cloud, options, progress.stage("send " + input));
+      }
+      progress.done();
+    } catch (const ClientError& e) {
+      progress.done();
+      if (exit_code_for(e.code()) == kExitUnavailable) throw;
+      std::fprintf(stderr, "primlabel: %s: %s\n", input.c_str(), e.what());
+      if (exit_code == kExitOk) exit_code = kExitRejected;
+      continue;
+    }
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const std::string out = output_path(command, input);
+    try {
+      const PointCloud labeled = labeled_cloud(std::move(cloud), result);
+      write_cloud(out, labeled);
+      if (command.png)
+        write_label_png(labeled, fs::path(out).replace_extension(".png").string(),
+                        fs::path(input).filename().string() + " - " + result.summary.model() + " " +
+                            result.summary.model_version());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "primlabel: %s\n", e.what());
+      if (exit_code == kExitOk) exit_code = kExitFile;
+      continue;
+    }
+    if (!command.quiet)
+      std::fprintf(stderr, "%s: %zu points -> %s in %.2f s, model %s %s (%s)\n", input.c_str(),
+                   result.size(), out.c_str(), seconds, result.summary.model().c_str(),
+                   result.summary.model_version().c_str(), label_histogram(result.labels).c_str());
+  }
+  return exit_code;
+}
+
+}  // namespace primlabel::client::tools

@@ -1,0 +1,98 @@
+// primlabel: talk to a primlabel server from the shell.
+//
+//   primlabel --server HOST:PORT health
+//   primlabel --server HOST:PORT models
+//   primlabel --server HOST:PORT info MODEL
+//   primlabel --server HOST:PORT label scan.pcd [-o scan_labeled.pcd] [--png] [--descriptors]
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "common/client_flags.hpp"
+#include "exit_codes.hpp"
+
+using namespace primlabel::client;
+using namespace primlabel::client::tools;
+
+int main(int argc, char** argv) {
+  CLI::App app{"primlabel: label point clouds with a primlabel server, list its models, check it.",
+               "primlabel"};
+  app.footer(kExitCodesHelp);
+  app.require_subcommand(1);
+  ConnectionFlags connection;
+  connection.add_to(app);
+  bool quiet = false;
+  app.add_flag("-q,--quiet", quiet, "No progress on stderr");
+
+  std::string health_service;
+  CLI::App* health = app.add_subcommand("health", "Is the server serving? (grpc.health.v1)");
+  health->add_option("--service", health_service, "One service, e.g. primlabel.v1.Labeler");
+
+  CLI::App* models = app.add_subcommand("models", "The models the server serves");
+
+  std::string info_model, info_version;
+  CLI::App* info = app.add_subcommand("info", "One model's classes, features and scores");
+  info->add_option("MODEL", info_model, "Model name")->required();
+  info->add_option("--model-version", info_version, "Version (default: the latest loaded)");
+
+  LabelCommand label_args;
+  CLI::App* label = app.add_subcommand("label", "Label PCD/PLY files and write labeled clouds");
+  label->add_option("FILE", label_args.inputs, "Input .pcd or .ply files")->required();
+  label->add_option("-o,--output", label_args.output,
+                    "Output file (one input) or directory (several); default: "
+                    "<input>_labeled.pcd beside the input");
+  label->add_flag("--png", label_args.png, "Also write a PNG picture beside each output");
+  label->add_flag("--descriptors", label_args.descriptors, "Add the FPFH descriptors (fpfh)");
+  label->add_flag("--probabilities", label_args.probabilities,
+                  "Add the per-class probabilities (probability, columns as `info` lists)");
+  label->add_option("--model", label_args.options.model, "Model (default: the server's)");
+  label->add_option("--model-version", label_args.options.model_version, "Model version");
+  label->add_flag("--tabletop", label_args.options.tabletop_only,
+                  "Label only the table and the objects on it");
+  label->add_option("--voxel-size", label_args.options.voxel_size, "Downsample first (m)");
+  label->add_option("--chunk-points", label_args.options.chunk_points, "Points per message")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  label->add_flag("--unary", label_args.unary, "One message (LabelCloud) instead of a stream");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "primlabel: %s (see --help)\n", e.what());
+    return kExitUsage;
+  }
+
+  ClientOptions options;
+  try {
+    options = connection.options();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "primlabel: %s\n", e.what());
+    return kExitFile;
+  }
+  std::unique_ptr<Client> client;
+  try {
+    client = std::make_unique<Client>(options);
+  } catch (const ClientError& e) {  // unreadable TLS files
+    std::fprintf(stderr, "primlabel: %s\n", e.what());
+    return kExitFile;
+  }
+  try {
+    if (*health) return run_health(*client, health_service);
+    if (*models) return run_models(*client);
+    if (*info) return run_info(*client, info_model, info_version);
+    label_args.quiet = quiet;
+    return run_label(*client, label_args);
+  } catch (const ClientError& e) {
+    std::fprintf(stderr, "primlabel: %s\n", e.what());
+    return exit_code_for(e.code());
+  }
+}

@@ -1,0 +1,55 @@
+#include "labeled_output.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+
+#include "primlabel/core/taxonomy.hpp"
+#include "primlabel/render/colorize.hpp"
+#include "primlabel/render/render.hpp"
+
+namespace primlabel::client::tools {
+
+PointCloud labeled_cloud(PointCloud cloud, const LabelResult& result) {
+  cloud.labels = result.labels;
+  if (result.descriptor_dim > 0) {
+    // 33 columns are PCL's FPFHSignature33; other widths (PFH) keep a neutral name.
+    const std::string name = result.descriptor_dim == 33    ? "fpfh"
+                             : result.descriptor_dim == 125 ? "pfh"
+                                                            : "descriptor";
+    cloud.set_field(name, result.descriptor_dim).values = result.descriptors;
+  }
+  if (!result.probabilities.empty() && !result.labels.empty()) {
+    const int classes = static_cast<int>(result.probabilities.size() / result.labels.size());
+    cloud.set_field("probability", classes).values = result.probabilities;
+  }
+  return cloud;
+}
+
+void write_label_png(const PointCloud& cloud, const std::string& path, const std::string& title) {
+  const Coloring coloring = color_by_class(cloud, ClassMap::taxonomy());
+  RenderOptions options;
+  options.title = title;
+  options.legend = coloring.legend;
+  render_png(cloud, coloring.rgb, options, path);
+}
+
+std::string label_histogram(const std::vector<std::uint32_t>& labels, int max) {
+  std::map<std::uint32_t, std::size_t> counts;
+  for (auto l : labels) ++counts[l];
+  std::vector<std::pair<std::size_t, std::uint32_t>> order;
+  for (auto [id, n] : counts) order.emplace_back(n, id);
+  std::sort(order.rbegin(), order.rend());
+  std::string text;
+  for (int i = 0; i < static_cast<int>(order.size()) && i < max; ++i) {
+    const auto cls = class_from_id(order[i].second);
+    const std::string class_name =
+        cls ? std::string(name(*cls)) : "label " + std::to_string(order[i].second);
+    char share[32];
+    std::snprintf(share, sizeof share, " %.0f%%", 100.0 * order[i].first / labels.size());
+    text += (text.empty() ? "" : ", ") + class_name + share;
+  }
+  return text;
+}
+
+}  // namespace primlabel::client::tools

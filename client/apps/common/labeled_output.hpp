@@ -1,0 +1,23 @@
+#pragma once
+// A labeled cloud as the tools write it: the input points with `label` set to the taxonomy id,
+// plus `fpfh` (or `descriptor`) and `probability` fields when the result carries them, and a PNG
+// picture coloured by class.
+
+#include <string>
+
+#include "primlabel/client/client.hpp"
+#include "primlabel/core/point_cloud.hpp"
+
+namespace primlabel::client::tools {
+
+// The input cloud with the result's labels (replacing any label field it had), descriptors and
+// probabilities as float fields.
+PointCloud labeled_cloud(PointCloud input, const LabelResult& result);
+
+// Renders `cloud` coloured by its labels with the taxonomy's colours and a legend.
+void write_label_png(const PointCloud& cloud, const std::string& path, const std::string& title);
+
+// "plane 61%, cylinder-convex 20%, ..." from the labels (largest first, at most `max` classes).
+std::string label_histogram(const std::vector<std::uint32_t>& labels, int max = 4);
+
+}  // namespace primlabel::client::tools

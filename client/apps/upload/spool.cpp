@@ -1,0 +1,198 @@
+#include "spool.hpp"
+
+#include <fcntl.h>
+#include <openssl/sha.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+
+namespace primlabel::client::upload {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kScans = "scans";
+constexpr const char* kTemp = "tmp";
+constexpr const char* kFailed = "failed";
+
+[[noreturn]] void fail_errno(const std::string& what, const fs::path& path) {
+  throw std::runtime_error(path.string() + ": " + what + ": " + std::strerror(errno));
+}
+
+bool is_scan_file(const fs::path& path) {
+  const std::string ext = path.extension().string();
+  return ext == ".pcd" || ext == ".ply";
+}
+
+}  // namespace
+
+std::string scan_id(std::string_view bytes) {
+  unsigned char digest[SHA256_DIGEST_LENGTH];
+  SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), digest);
+  static const char* const kHex = "0123456789abcdef";
+  std::string id;
+  for (int i = 0; i < 16; ++i) {
+    id.push_back(kHex[digest[i] >> 4]);
+    id.push_back(kHex[digest[i] & 15]);
+  }
+  return id;
+}
+
+void fsync_path(const fs::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail_errno("cannot open to sync", path);
+  const int rc = ::fsync(fd);
+  ::close(fd);
+  if (rc != 0) fail_errno("fsync failed", path);
+}
+
+void write_file_durably(const fs::path& target, std::string_view bytes, const fs::path& temp_dir) {
+  static std::atomic<std::uint64_t> counter{0};
+  const fs::path temp = temp_dir / (target.filename().string() + "." + std::to_string(::getpid()) +
+                                    "." + std::to_string(counter++) + ".part");
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) fail_errno("cannot create", temp);
+  std::size_t written = 0;
+  while (written < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int saved = errno;
+      ::close(fd);
+      ::unlink(temp.c_str());
+      errno = saved;
+      fail_errno("write failed", temp);
+    }
+    written += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    const int saved = errno;
+    ::unlink(temp.c_str());
+    errno = saved;
+    fail_errno("fsync failed", temp);
+  }
+  if (::rename(temp.c_str(), target.c_str()) != 0) {
+    const int saved = errno;
+    ::unlink(temp.c_str());
+    errno = saved;
+    fail_errno("cannot rename into place", target);
+  }
+  fsync_path(target.parent_path());
+}
+
+Spool::Spool(fs::path dir, SpoolLimits limits) : dir_(std::move(dir)), limits_(limits) {
+  std::error_code ec;
+  for (const char* sub : {kScans, kTemp, kFailed}) {
+    fs::create_directories(dir_ / sub, ec);
+    if (ec) throw std::runtime_error((dir_ / sub).string() + ": cannot create: " + ec.message());
+  }
+  // Temp files are writes that never got acknowledged: nobody was told they were accepted.
+  for (const auto& entry : fs::directory_iterator(dir_ / kTemp)) {
+    fs::remove(entry.path(), ec);
+    ++removed_temp_files_;
+  }
+  // Files are "<sequence>_<id><ext>": the sequence keeps the acceptance order across restarts
+  // (modification times are too coarse to order scans accepted in the same millisecond).
+  std::vector<std::pair<std::uint64_t, SpooledScan>> found;
+  for (const auto& entry : fs::directory_iterator(dir_ / kScans)) {
+    if (!entry.is_regular_file() || !is_scan_file(entry.path())) continue;
+    const std::string stem = entry.path().stem().string();
+    const auto underscore = stem.find('_');
+    if (underscore == std::string::npos) continue;  // not ours
+    std::uint64_t sequence = 0;
+    try {
+      sequence = std::stoull(stem.substr(0, underscore));
+    } catch (const std::exception&) {
+      continue;
+    }
+    found.push_back({sequence, {stem.substr(underscore + 1), entry.path(), entry.file_size()}});
+  }
+  std::sort(found.begin(), found.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (auto& [sequence, scan] : found) {
+    next_sequence_ = std::max(next_sequence_, sequence + 1);
+    bytes_ += scan.bytes;
+    scans_.push_back(std::move(scan));
+  }
+}
+
+std::vector<SpooledScan>::const_iterator Spool::find(const std::string& id) const {
+  return std::find_if(scans_.begin(), scans_.end(),
+                      [&](const SpooledScan& s) { return s.id == id; });
+}
+
+Spool::Accepted Spool::accept(const std::string& id, std::string_view bytes, const std::string& ext,
+                              SpooledScan* stored) {
+  std::lock_guard lock(mutex_);
+  if (const auto it = find(id); it != scans_.end()) {
+    if (stored) *stored = *it;
+    return Accepted::kAlreadyQueued;
+  }
+  if (scans_.size() + 1 > limits_.max_scans || bytes_ + bytes.size() > limits_.max_bytes)
+    throw SpoolFull("spool full (" + std::to_string(scans_.size()) + " scans, " +
+                    std::to_string(bytes_) + " of " + std::to_string(limits_.max_bytes) +
+                    " bytes): scan of " + std::to_string(bytes.size()) + " bytes not accepted");
+  char sequence[24];
+  std::snprintf(sequence, sizeof sequence, "%016llu_",
+                static_cast<unsigned long long>(next_sequence_));
+  const fs::path target = dir_ / kScans / (sequence + id + ext);
+  write_file_durably(target, bytes, dir_ / kTemp);
+  ++next_sequence_;
+  scans_.push_back({id, target, bytes.size()});
+  if (stored) *stored = scans_.back();
+  bytes_ += bytes.size();
+  return Accepted::kNew;
+}
+
+std::vector<SpooledScan> Spool::pending() const {
+  std::lock_guard lock(mutex_);
+  return scans_;
+}
+
+bool Spool::contains(const std::string& id) const {
+  std::lock_guard lock(mutex_);
+  return find(id) != scans_.end();
+}
+
+void Spool::complete(const std::string& id) {
+  std::lock_guard lock(mutex_);
+  const auto it = find(id);
+  if (it == scans_.end()) return;
+  std::error_code ec;
+  fs::remove(it->path, ec);
+  if (ec) throw std::runtime_error(it->path.string() + ": cannot remove: " + ec.message());
+  fsync_path(dir_ / kScans);
+  bytes_ -= it->bytes;
+  scans_.erase(it);
+}
+
+void Spool::fail(const std::string& id, const std::string& reason) {
+  std::lock_guard lock(mutex_);
+  const auto it = find(id);
+  if (it == scans_.end()) return;
+  const fs::path target = dir_ / kFailed / (id + it->path.extension().string());
+  write_file_durably(dir_ / kFailed / (id + ".error"), reason + "\n", dir_ / kTemp);
+  if (::rename(it->path.c_str(), target.c_str()) != 0) fail_errno("cannot move", it->path);
+  fsync_path(dir_ / kFailed);
+  fsync_path(dir_ / kScans);
+  bytes_ -= it->bytes;
+  scans_.erase(it);
+}
+
+std::uint64_t Spool::bytes() const {
+  std::lock_guard lock(mutex_);
+  return bytes_;
+}
+
+std::size_t Spool::size() const {
+  std::lock_guard lock(mutex_);
+  return scans_.size();
+}
+
+}  // namespace primlabel::client::upload

@@ -1,0 +1,301 @@
+// primlabel-upload: the robot computer's scan uploader. Scans come from files, a watched
+// directory or a framed stream on stdin; each is kept in a durable spool until its labels are in
+// the output directory, so crashes, server restarts and network outages lose nothing.
+
+#include <signal.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+#include "common/client_flags.hpp"
+#include "directory_watch.hpp"
+#include "framing.hpp"
+#include "uploader.hpp"
+
+using namespace primlabel::client;
+using namespace primlabel::client::upload;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitUsage = 1;
+constexpr int kExitInput = 2;
+constexpr int kExitTimedOut = 3;
+constexpr int kExitRefused = 4;
+constexpr int kExitSpoolFull = 5;
+
+constexpr const char* kFooter =
+    "Each accepted scan is acknowledged on stdout as '<state> <id> <source>' (state: accepted, "
+    "queued = already in the spool, labeled = output exists, rejected = spool full) and labeled "
+    "into OUT/<id>.pcd, id = content hash. Exit codes (the highest that applies): 0 every scan "
+    "labeled (or --watch stopped by a signal), 1 usage, 2 an input could not be read, 3 "
+    "--timeout passed with scans still spooled, 4 the server refused scans for good (kept in "
+    "SPOOL/failed), 5 the spool was full and scans were not accepted.";
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+
+void install_signal_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path.string() + ": cannot open");
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  if (!in) throw std::runtime_error(path.string() + ": cannot read");
+  return bytes.str();
+}
+
+struct Intake {
+  Uploader& uploader;
+  bool remove_source = false;
+  int exit_code = kExitOk;
+
+  void raise(int code) { exit_code = std::max(exit_code, code); }
+
+  // Submits one scan and acknowledges it on stdout; false when the spool was full.
+  bool submit(std::string_view bytes, const std::string& ext, const std::string& source) {
+    std::string id, reason;
+    const auto result = uploader.submit(bytes, ext, &id, &reason);
+    static const char* const kState[] = {"accepted", "queued", "labeled", "rejected"};
+    std::printf("%s %s %s\n", kState[static_cast<int>(result)], id.c_str(), source.c_str());
+    std::fflush(stdout);
+    if (result == Uploader::Submitted::kSpoolFull) {
+      std::fprintf(stderr, "primlabel-upload: %s: %s\n", source.c_str(), reason.c_str());
+      return false;
+    }
+    return true;
+  }
+
+  // A file input; false when the spool was full (the file is left alone).
+  bool submit_file(const fs::path& path) {
+    std::string bytes;
+    try {
+      bytes = read_file(path);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "primlabel-upload: %s\n", e.what());
+      raise(kExitInput);
+      return true;
+    }
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+    if (ext != ".pcd" && ext != ".ply") {
+      std::fprintf(stderr, "primlabel-upload: %s: not a .pcd or .ply file\n", path.c_str());
+      raise(kExitInput);
+      return true;
+    }
+    if (!submit(bytes, ext, path.string())) return false;
+    if (remove_source) {
+      std::error_code ec;
+      fs::remove(path, ec);
+    }
+    return true;
+  }
+
+  void from_files(const std::vector<std::string>& files) {
+    for (const auto& f : files) {
+      if (g_stop) return;
+      if (!submit_file(f)) raise(kExitSpoolFull);
+    }
+  }
+
+  void from_stdin(std::uint64_t max_frame_bytes) {
+    std::ios::sync_with_stdio(false);
+    std::cin.exceptions(std::ios::goodbit);
+    for (std::uint64_t n = 0; !g_stop; ++n) {
+      std::optional<std::string> scan;
+      try {
+        scan = read_frame(std::cin, max_frame_bytes);
+      } catch (const FrameError& e) {
+        if (!g_stop) {
+          std::fprintf(stderr, "primlabel-upload: stdin frame %llu: %s\n",
+                       static_cast<unsigned long long>(n), e.what());
+          raise(kExitInput);
+        }
+        return;
+      }
+      if (!scan) return;
+      if (!submit(*scan, scan_extension(*scan), "stdin#" + std::to_string(n)))
+        raise(kExitSpoolFull);
+    }
+  }
+
+  // Until a signal: files that do not fit wait in the watched directory and are retried.
+  void watch(const fs::path& dir) {
+    DirectoryWatch watch(dir);
+    std::vector<fs::path> deferred;
+    auto offer = [&](const std::vector<fs::path>& files) {
+      for (const auto& f : files)
+        if (fs::exists(f) && !submit_file(f)) deferred.push_back(f);
+    };
+    offer(watch.existing());
+    while (!g_stop) {
+      offer(watch.next(std::chrono::milliseconds(500)));
+      if (!deferred.empty() && uploader.queued() == 0) {
+        std::vector<fs::path> again;
+        again.swap(deferred);
+        std::sort(again.begin(), again.end());
+        again.erase(std::unique(again.begin(), again.end()), again.end());
+        offer(again);
+      }
+    }
+  }
+};
+
+std::string summary_line(const UploadCounters& c, std::size_t left) {
+  char line[400];
+  std::snprintf(
+      line, sizeof line,
+      "summary: accepted %llu new, %llu already spooled, %llu already labeled; uploaded "
+      "%llu (%llu points), failed %llu, rejected %llu (spool full), retries %llu, left in "
+      "spool %zu",
+      static_cast<unsigned long long>(c.accepted),
+      static_cast<unsigned long long>(c.already_queued),
+      static_cast<unsigned long long>(c.already_labeled),
+      static_cast<unsigned long long>(c.uploaded), static_cast<unsigned long long>(c.points),
+      static_cast<unsigned long long>(c.failed), static_cast<unsigned long long>(c.rejected_full),
+      static_cast<unsigned long long>(c.retries), left);
+  return line;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"primlabel-upload: upload scans to a primlabel server through a durable spool.",
+               "primlabel-upload"};
+  app.footer(kFooter);
+  tools::ConnectionFlags connection;
+  connection.retries = 2;  // the uploader's own backoff takes over after these
+  connection.add_to(app);
+  UploaderOptions options;
+  std::string spool, out, watch_dir;
+  std::vector<std::string> files, frame_files;
+  bool from_stdin = false, quiet = false, remove_source = false;
+  double spool_mb = 1024, status_s = 10, timeout_s = 0, backoff_max_s = 30;
+  std::uint64_t max_scans = 10'000;
+  app.add_option("FILE", files, "Scan files (.pcd / .ply) to upload");
+  app.add_option("--spool", spool, "Spool directory (created)");
+  app.add_option("-o,--out", out, "Output directory for labeled scans (created)");
+  app.add_option("--watch", watch_dir, "Upload scans appearing in this directory until a signal");
+  app.add_flag("--stdin", from_stdin, "Read framed scans from stdin (see --frame)");
+  app.add_option("--frame", frame_files,
+                 "Write these files as a framed stream to stdout and exit (for --stdin)");
+  app.add_flag("--remove-source", remove_source, "Delete input files once spooled");
+  app.add_option("--spool-max-mb", spool_mb, "Spool size limit (MB)")->capture_default_str();
+  app.add_option("--spool-max-scans", max_scans, "Spool scan count limit")->capture_default_str();
+  app.add_option("--workers", options.workers, "Uploads in parallel")->capture_default_str();
+  app.add_option("--status-interval", status_s, "Seconds between status lines (0 = none)")
+      ->capture_default_str();
+  app.add_option("--timeout", timeout_s,
+                 "Give up waiting for the server after S seconds (0 = never); scans stay spooled")
+      ->capture_default_str();
+  app.add_option("--backoff-max", backoff_max_s, "Longest pause while the server is away (s)")
+      ->capture_default_str();
+  app.add_option("--model", options.label.model, "Model (default: the server's)");
+  app.add_option("--model-version", options.label.model_version, "Model version");
+  app.add_flag("--descriptors", options.label.descriptors, "Keep the FPFH descriptors");
+  app.add_flag("--probabilities", options.label.probabilities, "Keep the class probabilities");
+  app.add_flag("--tabletop", options.label.tabletop_only, "Label only the table top");
+  app.add_flag("-q,--quiet", quiet, "Only errors and the summary on stderr");
+  try {
+    app.parse(argc, argv);
+    if (frame_files.empty() && (spool.empty() || out.empty()))
+      throw CLI::ValidationError("--spool and --out are required");
+    if (!watch_dir.empty() && from_stdin)
+      throw CLI::ValidationError("--watch and --stdin exclude each other");
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "primlabel-upload: %s (see --help)\n", e.what());
+    return kExitUsage;
+  }
+
+  if (!frame_files.empty()) {
+    for (const auto& f : frame_files) {
+      try {
+        const std::string frame = encode_frame(read_file(f));
+        std::fwrite(frame.data(), 1, frame.size(), stdout);
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "primlabel-upload: %s\n", e.what());
+        return kExitInput;
+      }
+    }
+    return kExitOk;
+  }
+
+  install_signal_handlers();
+  options.spool_dir = spool;
+  options.output_dir = out;
+  options.limits.max_bytes = static_cast<std::uint64_t>(spool_mb * 1e6);
+  options.limits.max_scans = max_scans;
+  options.backoff.max = std::chrono::milliseconds(static_cast<long long>(backoff_max_s * 1000));
+  std::unique_ptr<Client> client;
+  std::unique_ptr<Uploader> uploader;
+  try {
+    client = std::make_unique<Client>(connection.options());
+    uploader = std::make_unique<Uploader>(*client, options);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "primlabel-upload: %s\n", e.what());
+    return kExitInput;
+  }
+  if (!quiet && uploader->queued() > 0)
+    std::fprintf(stderr, "primlabel-upload: resuming %zu scans from the spool\n",
+                 uploader->queued());
+  uploader->start();
+
+  // The operator's status line, on its own thread so a blocked intake does not silence it.
+  std::atomic<bool> status_done{false};
+  std::thread status([&] {
+    if (quiet || status_s <= 0) return;
+    auto next = std::chrono::steady_clock::now();
+    while (!status_done) {
+      next += std::chrono::milliseconds(static_cast<long long>(status_s * 1000));
+      while (!status_done && std::chrono::steady_clock::now() < next)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (!status_done)
+        std::fprintf(stderr, "primlabel-upload: status: %s\n", uploader->status_line().c_str());
+    }
+  });
+
+  Intake intake{*uploader, remove_source};
+  if (!watch_dir.empty()) {
+    try {
+      intake.from_files(files);
+      intake.watch(watch_dir);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "primlabel-upload: %s\n", e.what());
+      intake.raise(kExitInput);
+    }
+  } else {
+    intake.from_files(files);
+    if (from_stdin) intake.from_stdin(options.limits.max_bytes);
+  }
+  // Files and stdin: wait for the uploads (a watch ends only by signal, so it does not wait).
+  if (watch_dir.empty()) {
+    std::optional<std::chrono::steady_clock::time_point> until;
+    if (timeout_s > 0)
+      until = std::chrono::steady_clock::now() +
+              std::chrono::milliseconds(static_cast<long long>(timeout_s * 1000));
+    if (!uploader->wait_idle(g_stop, until) && !g_stop) intake.raise(kExitTimedOut);
+  }
+  uploader->stop();
+  status_done = true;
+  status.join();
+  const UploadCounters counters = uploader->counters();
+  if (counters.failed > 0) intake.raise(kExitRefused);
+  std::fprintf(stderr, "primlabel-upload: %s\n",
+               summary_line(counters, uploader->queued()).c_str());
+  return intake.exit_code;
+}

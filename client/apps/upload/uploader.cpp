@@ -1,0 +1,242 @@
+#include "uploader.hpp"
+
+#include <cstdio>
+#include <future>
+
+#include "common/labeled_output.hpp"
+#include "primlabel/core/cloud_io.hpp"
+
+namespace primlabel::client::upload {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+// Statuses that say "this scan will never be labeled": retrying cannot help. Everything else
+// (UNAVAILABLE, DEADLINE_EXCEEDED, RESOURCE_EXHAUSTED, a missing model while the server starts,
+// a bad token an operator will fix, ...) is retried with backoff.
+bool permanent(grpc::StatusCode code) {
+  return code == grpc::StatusCode::INVALID_ARGUMENT || code == grpc::StatusCode::OUT_OF_RANGE ||
+         code == grpc::StatusCode::UNIMPLEMENTED;
+}
+
+// Temp files of output writes a crash interrupted (core's atomic write: ".<name>.tmp.<pid>.<n>").
+void remove_output_temp_files(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with(".") && name.find(".tmp.") != std::string::npos) fs::remove(entry, ec);
+  }
+}
+
+}  // namespace
+
+Uploader::Uploader(Client& client, UploaderOptions options)
+    : client_(client),
+      options_(std::move(options)),
+      spool_(options_.spool_dir, options_.limits),
+      backoff_(options_.backoff) {
+  std::error_code ec;
+  fs::create_directories(options_.output_dir, ec);
+  if (ec)
+    throw std::runtime_error(options_.output_dir.string() + ": cannot create: " + ec.message());
+  remove_output_temp_files(options_.output_dir);
+  for (const SpooledScan& scan : spool_.pending()) {
+    if (fs::exists(output_path(scan.id))) {
+      finish_from_output(scan.id);  // crashed after writing the output, before forgetting it
+    } else {
+      queue_.push_back(scan);
+    }
+  }
+}
+
+Uploader::~Uploader() { stop(); }
+
+fs::path Uploader::output_path(const std::string& id) const {
+  return options_.output_dir / (id + ".pcd");
+}
+
+void Uploader::finish_from_output(const std::string& id) {
+  spool_.complete(id);
+  std::lock_guard lock(mutex_);
+  ++counters_.already_labeled;
+}
+
+Uploader::Submitted Uploader::submit(std::string_view bytes, const std::string& ext,
+                                     std::string* id_out, std::string* reason) {
+  const std::string id = scan_id(bytes);
+  if (id_out) *id_out = id;
+  if (fs::exists(output_path(id))) {
+    std::lock_guard lock(mutex_);
+    ++counters_.already_labeled;
+    return Submitted::kAlreadyLabeled;
+  }
+  Spool::Accepted accepted;
+  SpooledScan stored;
+  try {
+    accepted = spool_.accept(id, bytes, ext, &stored);
+  } catch (const SpoolFull& e) {
+    if (reason) *reason = e.what();
+    std::lock_guard lock(mutex_);
+    ++counters_.rejected_full;
+    return Submitted::kSpoolFull;
+  }
+  std::lock_guard lock(mutex_);
+  if (accepted == Spool::Accepted::kAlreadyQueued) {
+    ++counters_.already_queued;
+    return Submitted::kAlreadyQueued;
+  }
+  queue_.push_back(stored);
+  ++counters_.accepted;
+  changed_.notify_all();
+  return Submitted::kAccepted;
+}
+
+void Uploader::start() {
+  for (int i = 0; i < std::max(1, options_.workers); ++i) workers_.emplace_back([this] { work(); });
+}
+
+void Uploader::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    for (auto& call : calls_) call.cancel();
+    changed_.notify_all();
+  }
+  for (auto& worker : workers_) worker.join();
+  workers_.clear();
+}
+
+void Uploader::work() {
+  std::unique_lock lock(mutex_);
+  while (!stopping_) {
+    if (queue_.empty()) {
+      changed_.wait(lock);
+      continue;
+    }
+    if (Clock::now() < paused_until_) {
+      changed_.wait_until(lock, paused_until_);
+      continue;
+    }
+    const SpooledScan scan = queue_.front();
+    queue_.pop_front();
+    ++in_flight_;
+    lock.unlock();
+    bool done = false;
+    try {
+      done = upload(scan);
+    } catch (const std::exception& e) {  // the output or spool disk failed: try again later
+      std::fprintf(stderr, "primlabel-upload: %s: %s\n", scan.id.c_str(), e.what());
+    }
+    lock.lock();
+    --in_flight_;
+    if (done) {
+      backoff_.reset();
+      server_down_ = false;
+    } else {
+      queue_.push_front(scan);
+      ++counters_.retries;
+      paused_until_ = Clock::now() + backoff_.next();
+    }
+    changed_.notify_all();
+  }
+}
+
+bool Uploader::upload(const SpooledScan& scan) {
+  if (fs::exists(output_path(scan.id))) {
+    finish_from_output(scan.id);
+    return true;
+  }
+  PointCloud cloud;
+  try {
+    cloud = read_cloud(scan.path.string());
+  } catch (const std::exception& e) {
+    spool_.fail(scan.id, e.what());
+    std::fprintf(stderr, "primlabel-upload: %s: unreadable scan moved to %s: %s\n", scan.id.c_str(),
+                 (spool_.dir() / "failed").c_str(), e.what());
+    std::lock_guard lock(mutex_);
+    ++counters_.failed;
+    return true;
+  }
+  LabelOptions options = options_.label;
+  options.scan_id = scan.id;
+  std::promise<std::pair<CallStatus, LabelResult>> outcome;
+  std::list<CallHandle>::iterator call;
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_) return false;
+    call = calls_.insert(calls_.end(),
+                         client_.label_async(cloud, options, [&](CallStatus s, LabelResult r) {
+                           outcome.set_value({std::move(s), std::move(r)});
+                         }));
+  }
+  auto [status, result] = outcome.get_future().get();
+  {
+    std::lock_guard lock(mutex_);
+    call->wait();
+    calls_.erase(call);
+  }
+  if (!status.ok()) {
+    if (status.code == grpc::StatusCode::CANCELLED) {
+      std::lock_guard lock(mutex_);
+      if (stopping_) return false;  // stop(): the scan stays spooled for the next run
+    }
+    if (permanent(status.code)) {
+      spool_.fail(scan.id, status.message);
+      std::fprintf(stderr, "primlabel-upload: %s: refused, moved to %s: %s\n", scan.id.c_str(),
+                   (spool_.dir() / "failed").c_str(), status.message.c_str());
+      std::lock_guard lock(mutex_);
+      ++counters_.failed;
+      return true;
+    }
+    server_down_ = true;
+    std::fprintf(stderr, "primlabel-upload: %s: %s; will retry\n", scan.id.c_str(),
+                 status.message.c_str());
+    return false;
+  }
+  const std::size_t points = result.size();
+  write_pcd(output_path(scan.id).string(), tools::labeled_cloud(std::move(cloud), result));
+  fsync_path(options_.output_dir);  // the rename is durable before the spool forgets the scan
+  spool_.complete(scan.id);
+  std::lock_guard lock(mutex_);
+  ++counters_.uploaded;
+  counters_.points += points;
+  return true;
+}
+
+bool Uploader::wait_idle(const std::atomic<bool>& stop, std::optional<Clock::time_point> until) {
+  std::unique_lock lock(mutex_);
+  while (!(queue_.empty() && in_flight_ == 0)) {
+    if (stop || (until && Clock::now() >= *until)) return false;
+    changed_.wait_for(lock, std::chrono::milliseconds(100));
+  }
+  return true;
+}
+
+UploadCounters Uploader::counters() const {
+  std::lock_guard lock(mutex_);
+  return counters_;
+}
+
+std::size_t Uploader::queued() const {
+  std::lock_guard lock(mutex_);
+  return queue_.size() + in_flight_;
+}
+
+std::string Uploader::status_line() const {
+  std::lock_guard lock(mutex_);
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "queued %zu, in flight %zu, uploaded %llu, failed %llu, rejected %llu, retries "
+                "%llu, spool %.1f/%.1f MB, server %s",
+                queue_.size() + in_flight_, in_flight_,
+                static_cast<unsigned long long>(counters_.uploaded),
+                static_cast<unsigned long long>(counters_.failed),
+                static_cast<unsigned long long>(counters_.rejected_full),
+                static_cast<unsigned long long>(counters_.retries), spool_.bytes() / 1e6,
+                spool_.limits().max_bytes / 1e6, server_down_ ? "down" : "up");
+  return line;
+}
+
+}  // namespace primlabel::client::upload

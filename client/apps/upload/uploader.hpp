@@ -1,0 +1,96 @@
+#pragma once
+// The uploader's engine: takes scans into the spool, uploads them on worker threads, writes each
+// scan's labels to <output>/<id>.pcd (atomic rename, then fsync) and only then removes it from
+// the spool. While the server is away (UNAVAILABLE, deadline, overload, ...) the workers pause
+// with exponential backoff and resume when it answers again; nothing accepted is ever dropped.
+// A scan whose output already exists is never uploaded again (exactly one output per scan id).
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <filesystem>
+#include <list>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "primlabel/client/client.hpp"
+#include "spool.hpp"
+
+namespace primlabel::client::upload {
+
+struct UploaderOptions {
+  std::filesystem::path spool_dir;
+  std::filesystem::path output_dir;
+  SpoolLimits limits;
+  LabelOptions label;  // model, descriptors, probabilities, ... for every scan
+  BackoffPolicy backoff{std::chrono::milliseconds(500), 2.0, std::chrono::seconds(30), 0.2};
+  int workers = 1;
+};
+
+struct UploadCounters {
+  std::uint64_t accepted = 0;         // new scans taken into the spool
+  std::uint64_t already_queued = 0;   // submitted again while in the spool
+  std::uint64_t already_labeled = 0;  // submitted (or found in the spool) with output present
+  std::uint64_t rejected_full = 0;    // refused: the spool was full
+  std::uint64_t uploaded = 0;         // labeled and written
+  std::uint64_t failed = 0;           // refused by the server for good (kept in spool/failed)
+  std::uint64_t retries = 0;          // uploads that will be tried again
+  std::uint64_t points = 0;           // points labeled
+};
+
+class Uploader {
+ public:
+  // Opens the spool (recovering from a crash) and queues what it holds. Throws
+  // std::runtime_error when the spool or output directory cannot be used.
+  Uploader(Client& client, UploaderOptions options);
+  ~Uploader();  // stop()
+
+  enum class Submitted { kAccepted, kAlreadyQueued, kAlreadyLabeled, kSpoolFull };
+  // Takes one scan (its file bytes). Thread-safe. Throws std::runtime_error when the spool write
+  // fails; the scan is then not accepted.
+  Submitted submit(std::string_view bytes, const std::string& ext, std::string* id = nullptr,
+                   std::string* reason = nullptr);
+
+  void start();  // the worker threads
+  // Blocks until every queued scan is uploaded or failed, `stop` becomes true, or `until` passes.
+  // True when idle.
+  bool wait_idle(const std::atomic<bool>& stop,
+                 std::optional<std::chrono::steady_clock::time_point> until);
+  void stop();  // cancels uploads in flight (their scans stay spooled) and joins the workers
+
+  UploadCounters counters() const;
+  std::size_t queued() const;  // in the spool, not yet uploaded (includes those in flight)
+  bool server_down() const { return server_down_; }
+  // "queued 3, in flight 1, uploaded 10, failed 0, rejected 0, retries 2, spool 1.2/1024.0 MB,
+  // server up"
+  std::string status_line() const;
+  std::filesystem::path output_path(const std::string& id) const;
+
+ private:
+  void work();
+  // Uploads one scan; returns false when it should be tried again later.
+  bool upload(const SpooledScan& scan);
+  void finish_from_output(const std::string& id);  // output exists: just leave the spool
+
+  Client& client_;
+  UploaderOptions options_;
+  Spool spool_;
+  Backoff backoff_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<SpooledScan> queue_;
+  std::size_t in_flight_ = 0;
+  UploadCounters counters_;
+  std::list<CallHandle> calls_;  // in flight, for stop()
+  std::chrono::steady_clock::time_point paused_until_{};
+  std::atomic<bool> server_down_{false};
+  bool stopping_ = false;
+  std::vector<std::thread> workers_;
+};
+
+}  // namespace primlabel::client::upload

@@ -1,0 +1,68 @@
+#include "admin_service.hpp"
+
+#include "labeler_service.hpp"
+#include "registry_status.hpp"
+#include "request_record.hpp"
+
+namespace primlabel::server {
+
+grpc::Status AdminService::LoadModel(grpc::ServerContext* context,
+                                     const v1::LoadModelRequest* request,
+                                     v1::LoadModelResponse* response) {
+  RequestRecord record("LoadModel", *env_.metrics);
+  record.model = request->model();
+  if (grpc::Status status = env_.auth->check(*context, true); !status.ok())
+    return record.finish(status);
+  try {
+    const auto entry = env_.registry->load(request->model(), request->version());
+    record.version = entry->version;
+    env_.metrics->reloads(1, 0);
+  } catch (const RegistryError& error) {
+    if (error.kind() == RegistryError::Kind::kLoadFailed) env_.metrics->reloads(0, 1);
+    return record.finish(registry_status(error));
+  }
+  env_.models_changed();
+  for (const ServedModel& model : env_.registry->list())
+    if (model.name == request->model()) fill_model_info(model, *response->mutable_model());
+  return record.finish(grpc::Status::OK);
+}
+
+grpc::Status AdminService::UnloadModel(grpc::ServerContext* context,
+                                       const v1::UnloadModelRequest* request,
+                                       v1::UnloadModelResponse* response) {
+  RequestRecord record("UnloadModel", *env_.metrics);
+  record.model = request->model();
+  record.version = request->version();
+  if (grpc::Status status = env_.auth->check(*context, true); !status.ok())
+    return record.finish(status);
+  try {
+    response->set_unloaded_versions(env_.registry->unload(request->model(), request->version()));
+  } catch (const RegistryError& error) {
+    return record.finish(registry_status(error));
+  }
+  env_.models_changed();
+  return record.finish(grpc::Status::OK);
+}
+
+grpc::Status AdminService::ReloadModels(grpc::ServerContext* context,
+                                        const v1::ReloadModelsRequest*,
+                                        v1::ReloadModelsResponse* response) {
+  RequestRecord record("ReloadModels", *env_.metrics);
+  if (grpc::Status status = env_.auth->check(*context, true); !status.ok())
+    return record.finish(status);
+  try {
+    const ReloadReport report = env_.registry->rescan();
+    env_.metrics->reloads(report.loaded, report.failed);
+    response->set_loaded(report.loaded);
+    response->set_failed(report.failed);
+    for (const std::string& error : report.errors) response->add_errors(error);
+  } catch (const RegistryError& error) {
+    return record.finish(registry_status(error));
+  }
+  env_.models_changed();
+  for (const ServedModel& model : env_.registry->list())
+    fill_model_info(model, *response->add_models());
+  return record.finish(grpc::Status::OK);
+}
+
+}  // namespace primlabel::server

@@ -1,0 +1,25 @@
+#pragma once
+// primlabel.v1.ModelAdmin: load, unload and rescan models; needs the bearer token when one is
+// configured.
+
+#include "primlabel/v1/labeling.grpc.pb.h"
+#include "service_environment.hpp"
+
+namespace primlabel::server {
+
+class AdminService final : public v1::ModelAdmin::Service {
+ public:
+  explicit AdminService(const ServiceEnvironment& env) : env_(env) {}
+
+  grpc::Status LoadModel(grpc::ServerContext* context, const v1::LoadModelRequest* request,
+                         v1::LoadModelResponse* response) override;
+  grpc::Status UnloadModel(grpc::ServerContext* context, const v1::UnloadModelRequest* request,
+                           v1::UnloadModelResponse* response) override;
+  grpc::Status ReloadModels(grpc::ServerContext* context, const v1::ReloadModelsRequest* request,
+                            v1::ReloadModelsResponse* response) override;
+
+ private:
+  const ServiceEnvironment& env_;
+};
+
+}  // namespace primlabel::server

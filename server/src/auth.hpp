@@ -1,0 +1,38 @@
+#pragma once
+// Who may call what: a bearer token ("authorization: Bearer <token>") on admin RPCs, and
+// optionally on every RPC; TLS or mutual-TLS server credentials from PEM files.
+
+#include <grpcpp/security/server_credentials.h>
+#include <grpcpp/server_context.h>
+#include <grpcpp/support/status.h>
+
+#include <memory>
+#include <string>
+
+namespace primlabel::server {
+
+class TokenAuth {
+ public:
+  // An empty token means no checks at all.
+  TokenAuth(std::string token, bool required_for_all);
+
+  // OK, or UNAUTHENTICATED saying what is missing. `admin` RPCs need the token whenever one is
+  // configured; the others only with required_for_all.
+  grpc::Status check(const grpc::ServerContext& context, bool admin) const;
+
+  bool enabled() const { return !token_.empty(); }
+
+ private:
+  std::string token_;
+  bool required_for_all_;
+};
+
+struct TlsFiles {
+  std::string cert, key;  // PEM; both empty = plaintext
+  std::string client_ca;  // PEM; non-empty = clients must present a certificate it signed
+};
+
+// Insecure credentials without a certificate; throws std::runtime_error for unreadable files.
+std::shared_ptr<grpc::ServerCredentials> server_credentials(const TlsFiles& files);
+
+}  // namespace primlabel::server

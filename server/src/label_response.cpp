@@ -1,0 +1,104 @@
+#include "label_response.hpp"
+
+#include <algorithm>
+#include <map>
+
+#include "primlabel/core/taxonomy.hpp"
+#include "primlabel/wire/packing.hpp"
+
+namespace primlabel::server {
+
+LabelResponder::LabelResponder(const pipeline::LabelingResult& result,
+                               std::uint32_t requested_points, std::uint64_t max_bytes)
+    : result_(result),
+      points_(result.labels.size()),
+      classes_(std::uint64_t(result.probabilities.cols())) {
+  bytes_per_point_ =
+      wire::kLabelBytesPerPoint +
+      sizeof(float) * std::uint64_t(result.descriptor_dim) * (result.descriptors.empty() ? 0 : 1) +
+      sizeof(float) * classes_;
+  const std::uint64_t fitting = std::max<std::uint64_t>(1, max_bytes / bytes_per_point_);
+  chunk_points_ =
+      requested_points > 0 ? std::min<std::uint64_t>(requested_points, fitting) : fitting;
+}
+
+std::uint64_t LabelResponder::chunk_count() const {
+  return (points_ + chunk_points_ - 1) / chunk_points_;
+}
+
+void LabelResponder::fill_chunk(std::uint64_t index, v1::LabelChunk& chunk) const {
+  const std::uint64_t first = index * chunk_points_;
+  fill_range(first, std::min(chunk_points_, points_ - first), chunk);
+}
+
+void LabelResponder::fill_range(std::uint64_t first, std::uint64_t count,
+                                v1::LabelChunk& chunk) const {
+  chunk.set_first_point(first);
+  chunk.set_point_count(static_cast<std::uint32_t>(count));
+  wire::append_le(*chunk.mutable_labels(),
+                  std::span<const std::uint32_t>(result_.labels.data() + first, count));
+  if (!result_.descriptors.empty()) {
+    const std::size_t d = std::size_t(result_.descriptor_dim);
+    wire::append_le(*chunk.mutable_descriptors(),
+                    std::span<const float>(result_.descriptors.data() + first * d, count * d));
+  }
+  if (classes_ > 0) {
+    // Eigen is column-major: gather each point's row.
+    std::vector<float> rows(count * classes_);
+    for (std::uint64_t i = 0; i < count; ++i)
+      for (std::uint64_t k = 0; k < classes_; ++k)
+        rows[i * classes_ + k] = result_.probabilities(Eigen::Index(first + i), Eigen::Index(k));
+    wire::append_le(*chunk.mutable_probabilities(), std::span<const float>(rows));
+  }
+}
+
+namespace {
+
+// The model's own name for a class, else the taxonomy's.
+std::string class_name_of(const ModelEntry& entry, std::uint32_t id) {
+  for (const v1::PrimitiveClass& c : entry.metadata.classes())
+    if (c.id() == id) return c.name();
+  const auto taxonomy_class = class_from_id(id);
+  return taxonomy_class ? std::string(name(*taxonomy_class)) : std::string();
+}
+
+}  // namespace
+
+void fill_summary(const RequestRecord& record, const ModelEntry& entry,
+                  const pipeline::LabelingResult& result, v1::LabelSummary& summary) {
+  summary.set_request_id(record.id());
+  summary.set_scan_id(record.scan_id);
+  summary.set_model(entry.name);
+  summary.set_model_version(entry.version);
+  summary.set_points_received(record.points);
+  summary.set_points_dropped_non_finite(record.dropped_non_finite);
+
+  std::map<std::uint32_t, std::uint64_t> counts;
+  for (std::uint32_t id : result.class_ids) counts[id] = 0;
+  std::uint64_t labeled = 0;
+  for (std::uint32_t label : result.labels) {
+    ++counts[label];
+    if (label != class_id(PrimitiveClass::kUnknown)) ++labeled;
+  }
+  summary.set_points_labeled(labeled);
+  for (const auto& [id, points] : counts) {
+    v1::ClassCount* count = summary.add_class_counts();
+    count->set_class_id(id);
+    count->set_points(points);
+    count->set_name(class_name_of(entry, id));
+  }
+  const std::pair<const char*, double> stages[] = {
+      {"receive", record.stages.receive},     {"prefilter", record.stages.prefilter},
+      {"normals", record.stages.normals},     {"features", record.stages.features},
+      {"inference", record.stages.inference}, {"send", record.stages.send}};
+  for (const auto& [name, seconds] : stages) {
+    if (seconds < 0) continue;
+    v1::StageTiming* timing = summary.add_timings();
+    timing->set_stage(name);
+    timing->set_seconds(seconds);
+  }
+  summary.set_descriptor_dim(static_cast<std::uint32_t>(result.descriptor_dim));
+  *summary.mutable_classes() = entry.metadata.classes();
+}
+
+}  // namespace primlabel::server

@@ -1,0 +1,61 @@
+#include "request_record.hpp"
+
+#include <atomic>
+#include <cstdio>
+#include <random>
+
+#include "logging.hpp"
+#include "status_names.hpp"
+
+namespace primlabel::server {
+
+std::string next_request_id() {
+  static const unsigned prefix = std::random_device{}();
+  static std::atomic<std::uint64_t> counter{0};
+  char id[32];
+  std::snprintf(id, sizeof id, "%08x-%06llu", prefix,
+                static_cast<unsigned long long>(counter.fetch_add(1) + 1));
+  return id;
+}
+
+RequestRecord::RequestRecord(std::string method, ServerMetrics& metrics)
+    : method_(std::move(method)),
+      metrics_(metrics),
+      id_(next_request_id()),
+      start_(std::chrono::steady_clock::now()) {}
+
+double RequestRecord::elapsed_seconds() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+grpc::Status RequestRecord::finish(const grpc::Status& status) {
+  if (finished_) return status;
+  finished_ = true;
+  const double seconds = elapsed_seconds();
+  const std::string code = status_code_name(status.error_code());
+  metrics_.request_finished(method_, model, code, seconds);
+  if (status.ok() && points > 0) metrics_.points_labeled(model, double(points));
+  if (dropped_non_finite > 0) metrics_.points_dropped("non_finite", double(dropped_non_finite));
+  const std::pair<const char*, double> named_stages[] = {
+      {"receive", stages.receive},   {"prefilter", stages.prefilter}, {"normals", stages.normals},
+      {"features", stages.features}, {"inference", stages.inference}, {"send", stages.send}};
+  LogLine line(status.ok() ? LogLevel::kInfo : LogLevel::kWarn, "request");
+  line.kv("method", method_)
+      .kv("request_id", id_)
+      .kv("scan_id", scan_id)
+      .kv("model", model)
+      .kv("version", version)
+      .kv("points", points)
+      .kv("dropped_non_finite", dropped_non_finite)
+      .kv("duration_ms", seconds * 1e3)
+      .kv("status", code);
+  for (const auto& [name, value] : named_stages) {
+    if (value < 0) continue;
+    metrics_.stage(name, value);
+    line.kv(std::string(name) + "_ms", value * 1e3);
+  }
+  if (!status.ok()) line.kv("message", status.error_message());
+  return status;
+}
+
+}  // namespace primlabel::server

@@ -1,0 +1,47 @@
+#pragma once
+// One RPC's id, what it labeled and how long each stage took; on finish() it writes the
+// request's log line and its metrics.
+
+#include <grpcpp/support/status.h>
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+
+#include "server_metrics.hpp"
+
+namespace primlabel::server {
+
+// Seconds per stage; negative = the stage did not run.
+struct StageTimes {
+  double receive = -1, prefilter = -1, normals = -1, features = -1, inference = -1, send = -1;
+};
+
+class RequestRecord {
+ public:
+  RequestRecord(std::string method, ServerMetrics& metrics);
+  RequestRecord(const RequestRecord&) = delete;
+  RequestRecord& operator=(const RequestRecord&) = delete;
+
+  const std::string& id() const { return id_; }
+  double elapsed_seconds() const;
+
+  std::string scan_id, model, version;
+  std::uint64_t points = 0, dropped_non_finite = 0;
+  StageTimes stages;
+
+  // Logs and counts the request once; returns `status` for `return record.finish(...)`.
+  grpc::Status finish(const grpc::Status& status);
+
+ private:
+  std::string method_;
+  ServerMetrics& metrics_;
+  std::string id_;
+  std::chrono::steady_clock::time_point start_;
+  bool finished_ = false;
+};
+
+// A process-unique id: a random per-process prefix and a counter, e.g. "5f3a9c01-000042".
+std::string next_request_id();
+
+}  // namespace primlabel::server

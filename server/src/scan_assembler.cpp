@@ -1,0 +1,122 @@
+#include "scan_assembler.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "primlabel/wire/packing.hpp"
+
+namespace primlabel::server {
+
+namespace {
+
+grpc::Status invalid(const std::string& message) {
+  return {grpc::StatusCode::INVALID_ARGUMENT, message};
+}
+
+std::string describe_point(const Vec3f& p) {
+  std::ostringstream text;
+  text << "(" << p.x() << ", " << p.y() << ", " << p.z() << ")";
+  return text.str();
+}
+
+bool finite_non_negative(float value) { return std::isfinite(value) && value >= 0.0f; }
+
+}  // namespace
+
+grpc::Status check_header(const v1::ScanHeader& header, const ScanLimits& limits) {
+  if (header.expected_points() > limits.max_points)
+    return invalid("the scan announces " + std::to_string(header.expected_points()) +
+                   " points; this server takes at most " + std::to_string(limits.max_points));
+  const v1::LabelOptions& options = header.options();
+  if (!finite_non_negative(options.voxel_size()))
+    return invalid("options.voxel_size must be finite and >= 0");
+  if (!finite_non_negative(options.normal_radius()) ||
+      !finite_non_negative(options.feature_radius()))
+    return invalid("options.normal_radius and options.feature_radius must be finite and >= 0");
+  const v1::Vec3& viewpoint = header.viewpoint();
+  if (!std::isfinite(viewpoint.x()) || !std::isfinite(viewpoint.y()) ||
+      !std::isfinite(viewpoint.z()))
+    return invalid("the viewpoint must be finite");
+  if (options.non_finite() != v1::NON_FINITE_DROP && options.non_finite() != v1::NON_FINITE_REJECT)
+    return invalid("unknown options.non_finite policy " + std::to_string(options.non_finite()));
+  return grpc::Status::OK;
+}
+
+ScanAssembler::ScanAssembler(const v1::ScanHeader& header, const ScanLimits& limits)
+    : normals_(header.layout().normals()),
+      intensity_(header.layout().intensity()),
+      reject_non_finite_(header.options().non_finite() == v1::NON_FINITE_REJECT),
+      expected_points_(header.expected_points()),
+      limits_(limits) {
+  cloud_.viewpoint.origin =
+      Vec3f(header.viewpoint().x(), header.viewpoint().y(), header.viewpoint().z());
+  if (expected_points_ > 0) {
+    cloud_.xyz.reserve(expected_points_);
+    if (normals_) cloud_.normals.reserve(expected_points_);
+  }
+}
+
+grpc::Status ScanAssembler::add(const v1::PointChunk& chunk) {
+  ++chunks_;
+  const std::string where = "chunk " + std::to_string(chunks_);
+  const std::string& xyz = chunk.xyz();
+  if (xyz.size() % wire::kXyzBytesPerPoint != 0)
+    return invalid(where + ": xyz has " + std::to_string(xyz.size()) +
+                   " bytes, not a multiple of 12 (float32 x, y, z per point)");
+  const std::uint64_t n = xyz.size() / wire::kXyzBytesPerPoint;
+  if (normals_ && chunk.normals().size() != n * wire::kNormalBytesPerPoint)
+    return invalid(where + ": normals has " + std::to_string(chunk.normals().size()) + " bytes; " +
+                   std::to_string(n) + " points need " +
+                   std::to_string(n * wire::kNormalBytesPerPoint));
+  if (!normals_ && !chunk.normals().empty())
+    return invalid(where + " carries normals but the header's layout does not declare them");
+  if (intensity_ && chunk.intensity().size() != n * wire::kIntensityBytesPerPoint)
+    return invalid(where + ": intensity has " + std::to_string(chunk.intensity().size()) +
+                   " bytes; " + std::to_string(n) + " points need " +
+                   std::to_string(n * wire::kIntensityBytesPerPoint));
+  if (!intensity_ && !chunk.intensity().empty())
+    return invalid(where + " carries intensity but the header's layout does not declare it");
+
+  const std::uint64_t first = cloud_.size();
+  if (first + n > limits_.max_points)
+    return invalid(where + " brings the scan to " + std::to_string(first + n) +
+                   " points; this server takes at most " + std::to_string(limits_.max_points));
+  if (expected_points_ > 0 && first + n > expected_points_)
+    return invalid(where + " brings the scan to " + std::to_string(first + n) +
+                   " points, more than the " + std::to_string(expected_points_) +
+                   " the header announced");
+  bytes_ += xyz.size() + chunk.normals().size() + chunk.intensity().size();
+  if (bytes_ > limits_.max_bytes)
+    return invalid(where + " brings the scan to " + std::to_string(bytes_) +
+                   " bytes; this server takes at most " + std::to_string(limits_.max_bytes));
+
+  // Eigen::Vector3f is three packed floats, so the packed array unpacks straight into place.
+  if (n == 0) return grpc::Status::OK;
+  cloud_.xyz.resize(first + n);
+  wire::unpack_le<float>(xyz, cloud_.xyz[first].data());
+  if (normals_) {
+    cloud_.normals.resize(first + n);
+    wire::unpack_le<float>(chunk.normals(), cloud_.normals[first].data());
+  }
+  for (std::uint64_t i = first; i < first + n; ++i) {
+    if (is_finite(cloud_.xyz[i])) continue;
+    if (reject_non_finite_)
+      return invalid("point " + std::to_string(i) + " (" + where +
+                     ") has a non-finite coordinate " + describe_point(cloud_.xyz[i]) +
+                     " and options.non_finite is NON_FINITE_REJECT");
+    ++non_finite_;
+  }
+  cloud_.width = static_cast<std::uint32_t>(cloud_.size());
+  cloud_.height = 1;
+  return grpc::Status::OK;
+}
+
+grpc::Status ScanAssembler::finish() const {
+  if (cloud_.empty()) return invalid("the scan has no points");
+  if (expected_points_ > 0 && cloud_.size() != expected_points_)
+    return invalid("the scan has " + std::to_string(cloud_.size()) + " points but the header " +
+                   "announced " + std::to_string(expected_points_));
+  return grpc::Status::OK;
+}
+
+}  // namespace primlabel::server

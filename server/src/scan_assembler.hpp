@@ -1,0 +1,49 @@
+#pragma once
+// Builds the cloud of one scan from its PointChunks, checking each as it arrives: byte lengths
+// that fit the point layout, the point and byte limits, the announced point count, and
+// non-finite coordinates (counted, or refused when the request says so). Every refusal names
+// the chunk and, for a coordinate, the point.
+
+#include <grpcpp/support/status.h>
+
+#include <cstdint>
+
+#include "primlabel/core/point_cloud.hpp"
+#include "primlabel/v1/labeling.pb.h"
+
+namespace primlabel::server {
+
+struct ScanLimits {
+  std::uint64_t max_points = 0;
+  std::uint64_t max_bytes = 0;
+};
+
+class ScanAssembler {
+ public:
+  ScanAssembler(const v1::ScanHeader& header, const ScanLimits& limits);
+
+  // Checks and appends one chunk (chunks are numbered from 1 in messages).
+  grpc::Status add(const v1::PointChunk& chunk);
+  // After the last chunk: at least one point, and as many as the header announced.
+  grpc::Status finish() const;
+
+  PointCloud& cloud() { return cloud_; }
+  std::uint64_t points() const { return cloud_.size(); }
+  std::uint64_t non_finite() const { return non_finite_; }
+
+ private:
+  const bool normals_;
+  const bool intensity_;
+  const bool reject_non_finite_;
+  const std::uint64_t expected_points_;
+  const ScanLimits limits_;
+  PointCloud cloud_;
+  std::uint64_t bytes_ = 0;
+  std::uint64_t chunks_ = 0;
+  std::uint64_t non_finite_ = 0;
+};
+
+// Checks a header before any point arrives: limits against expected_points and option values.
+grpc::Status check_header(const v1::ScanHeader& header, const ScanLimits& limits);
+
+}  // namespace primlabel::server

@@ -1,0 +1,46 @@
+// primlabel-server: serves the labeling API until SIGTERM or SIGINT, then drains and exits 0.
+// Exit codes: 0 clean shutdown, 1 could not start, 2 bad usage.
+
+#include <signal.h>
+
+#include <chrono>
+#include <cstdio>
+
+#include "label_server.hpp"
+#include "logging.hpp"
+#include "server_config.hpp"
+
+int main(int argc, char** argv) {
+  using namespace primlabel::server;
+  ServerConfig config;
+  try {
+    config = parse_server_config(argc, argv);
+  } catch (const ConfigError& error) {
+    std::fputs(error.message.c_str(), error.exit_code == 0 ? stdout : stderr);
+    if (!error.message.empty() && error.message.back() != '\n') std::fputc('\n', stderr);
+    return error.exit_code;
+  }
+  set_log_level(parse_log_level(config.log_level));
+
+  // Signals are taken synchronously by this thread; block them before any thread starts so no
+  // other thread receives them.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+
+  std::unique_ptr<LabelServer> server;
+  try {
+    server = std::make_unique<LabelServer>(config);
+  } catch (const std::exception& e) {
+    log_error("startup_failed").kv("error", e.what());
+    return 1;
+  }
+  int signal_number = 0;
+  sigwait(&signals, &signal_number);
+  log_info("signal").kv("signal", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
+  server->shutdown(std::chrono::milliseconds(static_cast<long long>(config.drain_seconds * 1e3)));
+  server.reset();
+  return 0;
+}

@@ -1,0 +1,236 @@
+#pragma once
+// An in-process stand-in for the labeling server, for client tests that need no real model:
+// every point's label is round(x) (so a test chooses the labels by placing points), descriptors
+// are 33 values (point index + column / 100) and probabilities 3 columns (label share 1). Faults
+// can be switched on: UNAVAILABLE for the next calls, answers that skip or repeat a point, a
+// required bearer token, an unknown-model rejection.
+
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "primlabel/client/client.hpp"
+#include "primlabel/metrics/counter.hpp"
+#include "primlabel/metrics/family.hpp"
+#include "primlabel/v1/labeling.grpc.pb.h"
+#include "wire.hpp"
+
+namespace primlabel::test {
+
+class FakeLabeler final : public v1::Labeler::Service {
+ public:
+  static constexpr int kDescriptorDim = 33;
+  static constexpr int kClasses = 3;
+
+  std::atomic<int> unavailable_calls{0};  // fail this many next calls with UNAVAILABLE
+  std::atomic<bool> skip_a_point{false};  // answer without the last point
+  std::atomic<bool> repeat_a_point{false};
+  std::atomic<bool> reversed_chunks{false};  // send chunks last first (still a valid answer)
+  std::atomic<int> delay_ms{0};              // before answering, e.g. to test cancellation
+  std::string required_token;                // "" = none
+  std::atomic<int> label_calls{0};
+  std::atomic<int> chunks_received{0};
+  std::atomic<std::uint64_t> points_received{0};
+  std::mutex mutex;
+  std::vector<std::string> scan_ids;  // in arrival order
+
+  // When set, every Label / LabelCloud call is counted here as the real server does:
+  // primlabel_requests_total{method, model, status}.
+  metrics::Family<metrics::Counter>* requests_total = nullptr;
+
+  grpc::Status Label(
+      grpc::ServerContext* context,
+      grpc::ServerReaderWriter<v1::LabelResponse, v1::LabelRequest>* stream) override {
+    return counted("Label", label_stream(context, stream));
+  }
+
+  grpc::Status LabelCloud(grpc::ServerContext* context, const v1::LabelCloudRequest* request,
+                          v1::LabelCloudResponse* response) override {
+    return counted("LabelCloud", label_unary(context, request, response));
+  }
+
+ private:
+  grpc::Status counted(const std::string& method, grpc::Status status) {
+    if (requests_total)
+      requests_total
+          ->Add({{"method", method},
+                 {"model", "fake"},
+                 {"status", client::status_code_name(status.error_code())}})
+          .Increment();
+    return status;
+  }
+
+  grpc::Status label_stream(grpc::ServerContext* context,
+                            grpc::ServerReaderWriter<v1::LabelResponse, v1::LabelRequest>* stream) {
+    ++label_calls;
+    if (auto status = admit(context); !status.ok()) return status;
+    v1::LabelRequest request;
+    v1::ScanHeader header;
+    std::vector<Vec3f> points;
+    bool have_header = false;
+    while (stream->Read(&request)) {
+      if (request.has_header()) {
+        if (have_header) return {grpc::StatusCode::INVALID_ARGUMENT, "header twice"};
+        header = request.header();
+        have_header = true;
+      } else if (request.has_chunk()) {
+        if (!have_header) return {grpc::StatusCode::INVALID_ARGUMENT, "chunk before header"};
+        ++chunks_received;
+        const auto xyz = client::wire::unpack_vec3(request.chunk().xyz());
+        points.insert(points.end(), xyz.begin(), xyz.end());
+      } else {
+        break;  // EndOfScan
+      }
+    }
+    if (!have_header) return {grpc::StatusCode::INVALID_ARGUMENT, "no header"};
+    std::vector<v1::LabelResponse> responses;
+    v1::LabelSummary summary;
+    if (auto status = answer(header, points, responses, summary); !status.ok()) return status;
+    if (reversed_chunks) std::reverse(responses.begin(), responses.end());
+    for (const auto& r : responses) stream->Write(r);
+    v1::LabelResponse last;
+    *last.mutable_summary() = summary;
+    stream->Write(last);
+    return grpc::Status::OK;
+  }
+
+  grpc::Status label_unary(grpc::ServerContext* context, const v1::LabelCloudRequest* request,
+                           v1::LabelCloudResponse* response) {
+    ++label_calls;
+    if (auto status = admit(context); !status.ok()) return status;
+    const auto points = client::wire::unpack_vec3(request->points().xyz());
+    v1::ScanHeader header = request->header();
+    header.mutable_options()->set_response_chunk_points(0xFFFFFFFFu);  // one chunk
+    std::vector<v1::LabelResponse> responses;
+    if (auto status = answer(header, points, responses, *response->mutable_summary()); !status.ok())
+      return status;
+    if (!responses.empty()) *response->mutable_result() = responses.front().chunk();
+    return grpc::Status::OK;
+  }
+
+ public:
+  grpc::Status ListModels(grpc::ServerContext*, const v1::ListModelsRequest*,
+                          v1::ListModelsResponse* response) override {
+    auto* m = response->add_models();
+    m->set_name("fake");
+    m->set_version("1");
+    m->add_loaded_versions("1");
+    m->set_classes(kClasses);
+    m->set_is_default(true);
+    return grpc::Status::OK;
+  }
+
+  grpc::Status GetModelMetadata(grpc::ServerContext*, const v1::GetModelMetadataRequest* request,
+                                v1::ModelMetadata* response) override {
+    if (!request->model().empty() && request->model() != "fake")
+      return {grpc::StatusCode::NOT_FOUND, "no model '" + request->model() + "'"};
+    response->set_name("fake");
+    response->set_version("1");
+    for (int c = 0; c < kClasses; ++c) {
+      auto* cls = response->add_classes();
+      cls->set_id(c);
+      cls->set_name("class-" + std::to_string(c));
+    }
+    return grpc::Status::OK;
+  }
+
+ private:
+  grpc::Status admit(grpc::ServerContext* context) {
+    if (delay_ms > 0) {
+      for (int waited = 0; waited < delay_ms && !context->IsCancelled(); waited += 5)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      if (context->IsCancelled()) return {grpc::StatusCode::CANCELLED, "cancelled"};
+    }
+    if (!required_token.empty()) {
+      const auto& md = context->client_metadata();
+      const auto it = md.find("authorization");
+      if (it == md.end() ||
+          std::string(it->second.data(), it->second.size()) != "Bearer " + required_token)
+        return {grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"};
+    }
+    int expected = unavailable_calls.load();
+    while (expected > 0 && !unavailable_calls.compare_exchange_weak(expected, expected - 1)) {
+    }
+    if (expected > 0) return {grpc::StatusCode::UNAVAILABLE, "fake: try again"};
+    return grpc::Status::OK;
+  }
+
+  grpc::Status answer(const v1::ScanHeader& header, const std::vector<Vec3f>& points,
+                      std::vector<v1::LabelResponse>& responses, v1::LabelSummary& summary) {
+    if (!header.model().empty() && header.model() != "fake")
+      return {grpc::StatusCode::NOT_FOUND, "no model '" + header.model() + "'"};
+    if (points.empty()) return {grpc::StatusCode::INVALID_ARGUMENT, "zero points"};
+    {
+      std::lock_guard lock(mutex);
+      scan_ids.push_back(header.scan_id());
+    }
+    points_received += points.size();
+    const std::size_t n = points.size();
+    const std::size_t chunk =
+        header.options().response_chunk_points() ? header.options().response_chunk_points() : 1000;
+    const std::size_t answered = skip_a_point ? n - 1 : n;
+    for (std::size_t first = 0; first < answered; first += chunk) {
+      std::size_t count = std::min(chunk, answered - first);
+      if (repeat_a_point && first + count == answered && first > 0) {
+        --first;  // the last chunk starts one point early: that point is answered twice
+        ++count;
+      }
+      v1::LabelChunk& c = *responses.emplace_back().mutable_chunk();
+      c.set_first_point(first);
+      c.set_point_count(static_cast<std::uint32_t>(count));
+      std::vector<std::uint32_t> labels(count);
+      std::vector<float> descriptors, probabilities;
+      for (std::size_t i = 0; i < count; ++i) {
+        labels[i] = static_cast<std::uint32_t>(std::lround(std::max(0.0f, points[first + i].x())));
+        for (int d = 0; d < kDescriptorDim; ++d) descriptors.push_back((first + i) + d / 100.0f);
+        for (int k = 0; k < kClasses; ++k)
+          probabilities.push_back(labels[i] % kClasses == static_cast<std::uint32_t>(k));
+      }
+      c.set_labels(client::wire::pack_u32(labels.data(), count));
+      if (header.options().return_descriptors())
+        c.set_descriptors(client::wire::pack_f32(descriptors.data(), descriptors.size()));
+      if (header.options().return_probabilities())
+        c.set_probabilities(client::wire::pack_f32(probabilities.data(), probabilities.size()));
+    }
+    summary.set_scan_id(header.scan_id());
+    summary.set_model("fake");
+    summary.set_model_version("1");
+    summary.set_points_received(n);
+    if (header.options().return_descriptors()) summary.set_descriptor_dim(kDescriptorDim);
+    for (int k = 0; k < kClasses; ++k) {
+      auto* cls = summary.add_classes();
+      cls->set_id(k);
+      cls->set_name("class-" + std::to_string(k));
+    }
+    return grpc::Status::OK;
+  }
+};
+
+// The fake served on 127.0.0.1 at an ephemeral port, with grpc.health.v1.
+class FakeServer {
+ public:
+  FakeServer() {
+    grpc::EnableDefaultHealthCheckService(true);
+    grpc::ServerBuilder builder;
+    builder.AddListeningPort("127.0.0.1:0", grpc::InsecureServerCredentials(), &port_);
+    builder.RegisterService(&service);
+    server_ = builder.BuildAndStart();
+  }
+  ~FakeServer() { server_->Shutdown(std::chrono::system_clock::now()); }
+  std::string address() const { return "127.0.0.1:" + std::to_string(port_); }
+  void set_serving(bool serving) { server_->GetHealthCheckService()->SetServingStatus(serving); }
+
+  FakeLabeler service;
+
+ private:
+  int port_ = 0;
+  std::unique_ptr<grpc::Server> server_;
+};
+
+}  // namespace primlabel::test

@@ -1,0 +1,140 @@
+// The `primlabel` CLI as a script runs it, against the in-process fake server: output files and
+// the documented exit codes (0 ok, 1 usage, 2 file, 3 unavailable, 4 rejected).
+
+#include <gtest/gtest.h>
+
+#include "fake_labeler.hpp"
+#include "primlabel/core/cloud_io.hpp"
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+using test::FakeServer;
+
+std::string cli() { return test::binary("primlabel"); }
+
+// A small cloud whose fake labels are i % 5.
+void write_scan(const std::string& path, std::size_t n = 300) {
+  PointCloud cloud;
+  cloud.resize_unorganized(n);
+  for (std::size_t i = 0; i < n; ++i) cloud.xyz[i] = Vec3f(float(i % 5), 0.01f * i, 0.3f);
+  write_cloud(path, cloud);
+}
+
+// An address nothing listens on.
+std::string dead_address() { return FakeServer().address(); }
+
+TEST(ClientCli, HelpListsTheExitCodes) {
+  const auto r = test::run_command(cli() + " --help");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.output.find("3 server unavailable"), std::string::npos) << r.output;
+}
+
+TEST(ClientCli, UsageErrorsExitOneWithOneLine) {
+  for (const char* args : {"", " frobnicate", " label", " --deadline -3 health"}) {
+    const auto r = test::run_command(cli() + args);
+    EXPECT_EQ(r.exit_code, 1) << args << ": " << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+  }
+}
+
+TEST(ClientCli, HealthAndModels) {
+  FakeServer server;
+  auto r = test::run_command(cli() + " --server " + server.address() + " health");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output, "SERVING\n");
+  r = test::run_command(cli() + " --server " + server.address() + " models");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("fake"), std::string::npos) << r.output;
+  r = test::run_command(cli() + " --server " + server.address() + " info fake");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("class-2"), std::string::npos) << r.output;
+  server.set_serving(false);
+  r = test::run_command(cli() + " --server " + server.address() + " health");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+}
+
+TEST(ClientCli, LabelWritesLabelsDescriptorsProbabilitiesAndPng) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  const auto r = test::run_command(cli() + " --server " + server.address() + " label " +
+                                   dir.file("scan.pcd") + " -o " + dir.file("out.pcd") +
+                                   " --descriptors --probabilities --png --chunk-points 64");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const PointCloud out = read_cloud(dir.file("out.pcd"));
+  ASSERT_EQ(out.labels.size(), 300u);
+  for (std::size_t i = 0; i < 300; ++i) ASSERT_EQ(out.labels[i], i % 5);
+  ASSERT_NE(out.find_field("fpfh"), nullptr);
+  EXPECT_EQ(out.find_field("fpfh")->count, 33);
+  ASSERT_NE(out.find_field("probability"), nullptr);
+  EXPECT_EQ(out.find_field("probability")->count, 3);
+  EXPECT_TRUE(std::filesystem::exists(dir.file("out.png")));
+  EXPECT_NE(r.output.find("300 points"), std::string::npos) << r.output;
+}
+
+TEST(ClientCli, SeveralFilesGoToTheOutputDirectory) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("a.pcd"));
+  write_scan(dir.file("b.ply"), 40);
+  const auto r =
+      test::run_command(cli() + " -q --server " + server.address() + " label " + dir.file("a.pcd") +
+                        " " + dir.file("b.ply") + " -o " + dir.file("out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output, "");
+  EXPECT_EQ(read_cloud(dir.file("out/a_labeled.pcd")).labels.size(), 300u);
+  EXPECT_EQ(read_cloud(dir.file("out/b_labeled.pcd")).labels.size(), 40u);
+}
+
+TEST(ClientCli, MissingOrBrokenInputExitsTwo) {
+  FakeServer server;
+  test::TempDir dir;
+  std::ofstream(dir.file("broken.pcd")) << "not a pcd\n";
+  for (const std::string& input : {dir.file("missing.pcd"), dir.file("broken.pcd")}) {
+    const auto r = test::run_command(cli() + " --server " + server.address() + " label " + input);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find(input), std::string::npos) << r.output;
+  }
+  const auto r = test::run_command(cli() + " --server " + server.address() + " --token-file " +
+                                   dir.file("none") + " health");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+TEST(ClientCli, UnreachableServerExitsThree) {
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  const std::string server = " --retries 2 --server " + dead_address();
+  for (const std::string& command : {std::string(" health"), " label " + dir.file("scan.pcd")}) {
+    const auto r = test::run_command(cli() + server + command);
+    EXPECT_EQ(r.exit_code, 3) << command << ": " << r.output;
+    EXPECT_NE(r.output.find("UNAVAILABLE"), std::string::npos) << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+  }
+}
+
+TEST(ClientCli, RejectedRequestExitsFourWithTheStatus) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  auto r = test::run_command(cli() + " --server " + server.address() + " label --model nope " +
+                             dir.file("scan.pcd"));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("NOT_FOUND"), std::string::npos) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+  r = test::run_command(cli() + " --server " + server.address() + " info nope");
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  server.service.required_token = "tok";
+  r = test::run_command(cli() + " --server " + server.address() + " label " + dir.file("scan.pcd"));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("UNAUTHENTICATED"), std::string::npos) << r.output;
+  std::ofstream(dir.file("token")) << "tok\n";
+  r = test::run_command(cli() + " --server " + server.address() + " --token-file " +
+                        dir.file("token") + " label " + dir.file("scan.pcd"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+}
+
+}  // namespace
+}  // namespace primlabel

@@ -1,0 +1,344 @@
+// The scan uploader: spool durability (crash leftovers, restart), the spool-full policy, stdin
+// framing, exactly-once outputs, retries, and the tool's exit codes, against the fake server.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "fake_labeler.hpp"
+#include "primlabel/core/cloud_io.hpp"
+#include "process.hpp"
+#include "test_util.hpp"
+#include "upload/framing.hpp"
+#include "upload/spool.hpp"
+#include "upload/uploader.hpp"
+
+namespace primlabel {
+namespace {
+
+namespace fs = std::filesystem;
+using client::upload::Spool;
+using client::upload::SpoolFull;
+using client::upload::Uploader;
+using test::FakeServer;
+
+// The bytes of a small PCD scan whose fake labels are (i + seed) % 4.
+std::string scan_bytes(int seed, std::size_t n = 200) {
+  test::TempDir dir;
+  PointCloud cloud;
+  cloud.resize_unorganized(n);
+  for (std::size_t i = 0; i < n; ++i) cloud.xyz[i] = Vec3f(float((i + seed) % 4), 0.01f * i, 1);
+  write_pcd(dir.file("s.pcd"), cloud, PcdEncoding::kBinary);
+  std::ifstream in(dir.file("s.pcd"), std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+std::size_t files_in(const fs::path& dir) {
+  if (!fs::exists(dir)) return 0;
+  return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir), {}));
+}
+
+client::ClientOptions fast_client(const std::string& address) {
+  client::ClientOptions options;
+  options.address = address;
+  options.deadline = std::chrono::seconds(20);
+  options.retry_attempts = 1;
+  options.backoff.initial = std::chrono::milliseconds(5);
+  return options;
+}
+
+client::upload::UploaderOptions uploader_options(const test::TempDir& dir) {
+  client::upload::UploaderOptions options;
+  options.spool_dir = dir.file("spool");
+  options.output_dir = dir.file("out");
+  options.backoff = {std::chrono::milliseconds(10), 2.0, std::chrono::milliseconds(50), 0.2};
+  return options;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Spool
+
+TEST(UploadSpool, ScanIdIsAStableContentHash) {
+  EXPECT_EQ(client::upload::scan_id("abc"), client::upload::scan_id("abc"));
+  EXPECT_NE(client::upload::scan_id("abc"), client::upload::scan_id("abd"));
+  EXPECT_EQ(client::upload::scan_id("abc"), "ba7816bf8f01cfea414140de5dae2223");  // SHA-256
+}
+
+TEST(UploadSpool, AcceptedScansSurviveAReopenInAcceptanceOrder) {
+  test::TempDir dir;
+  {
+    Spool spool(dir.file("spool"), {});
+    EXPECT_EQ(spool.accept("bbb", "second-but-first", ".pcd"), Spool::Accepted::kNew);
+    EXPECT_EQ(spool.accept("aaa", "x", ".ply"), Spool::Accepted::kNew);
+    EXPECT_EQ(spool.accept("aaa", "x", ".ply"), Spool::Accepted::kAlreadyQueued);
+    EXPECT_EQ(spool.bytes(), 17u);
+  }
+  Spool reopened(dir.file("spool"), {});
+  const auto pending = reopened.pending();
+  ASSERT_EQ(pending.size(), 2u);
+  EXPECT_EQ(reopened.bytes(), 17u);
+  EXPECT_TRUE(reopened.contains("aaa"));
+  EXPECT_EQ(pending[1].path.extension(), ".ply");
+  reopened.complete("bbb");
+  EXPECT_FALSE(fs::exists(pending[0].path));
+  EXPECT_EQ(Spool(dir.file("spool"), {}).size(), 1u);
+}
+
+TEST(UploadSpool, ACrashMidWriteLeavesOnlyATempFileThatTheNextStartRemoves) {
+  test::TempDir dir;
+  { Spool spool(dir.file("spool"), {}); }
+  // What a crash between write and rename leaves: a partial file in tmp/, nothing in scans/.
+  write_bytes(dir.file("spool/tmp/0123.pcd.77.0.part"), "VERSION 0.7\nFIELDS x");
+  write_bytes(dir.file("spool/tmp/4567.pcd.77.1.part"), "");
+  Spool spool(dir.file("spool"), {});
+  EXPECT_EQ(spool.removed_temp_files(), 2u);
+  EXPECT_EQ(spool.size(), 0u);
+  EXPECT_EQ(files_in(dir.file("spool/tmp")), 0u);
+}
+
+TEST(UploadSpool, WhenFullNewScansAreRefusedAndAcceptedOnesKept) {
+  test::TempDir dir;
+  Spool spool(dir.file("spool"), {/*max_bytes=*/100, /*max_scans=*/2});
+  spool.accept("a", std::string(60, 'a'), ".pcd");
+  try {
+    spool.accept("b", std::string(41, 'b'), ".pcd");
+    FAIL() << "accepted over the byte limit";
+  } catch (const SpoolFull& e) {
+    EXPECT_NE(std::string(e.what()).find("spool full"), std::string::npos);
+  }
+  spool.accept("c", std::string(40, 'c'), ".pcd");         // exactly fits
+  EXPECT_THROW(spool.accept("d", "", ".pcd"), SpoolFull);  // over the scan count
+  EXPECT_EQ(spool.size(), 2u);
+  EXPECT_EQ(spool.bytes(), 100u);
+  spool.complete("a");
+  spool.accept("d", "d", ".pcd");
+  EXPECT_EQ(Spool(dir.file("spool"), {}).bytes(), 41u);  // what was accepted is on disk
+}
+
+TEST(UploadSpool, FailedScansMoveAsideWithTheirReason) {
+  test::TempDir dir;
+  Spool spool(dir.file("spool"), {});
+  spool.accept("bad", "junk", ".pcd");
+  spool.fail("bad", "INVALID_ARGUMENT: zero points");
+  EXPECT_EQ(spool.size(), 0u);
+  EXPECT_EQ(spool.bytes(), 0u);
+  EXPECT_TRUE(fs::exists(dir.file("spool/failed/bad.pcd")));
+  std::ifstream reason(dir.file("spool/failed/bad.error"));
+  std::string line;
+  std::getline(reason, line);
+  EXPECT_EQ(line, "INVALID_ARGUMENT: zero points");
+  EXPECT_EQ(Spool(dir.file("spool"), {}).size(), 0u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Framing
+
+TEST(UploadFraming, FramesRoundTripAndBadStreamsAreErrors) {
+  std::stringstream stream(client::upload::encode_frame("one") + client::upload::encode_frame("") +
+                           client::upload::encode_frame(std::string(1000, 'z')));
+  EXPECT_EQ(client::upload::read_frame(stream, 1 << 20), "one");
+  EXPECT_EQ(client::upload::read_frame(stream, 1 << 20), "");
+  EXPECT_EQ(client::upload::read_frame(stream, 1 << 20)->size(), 1000u);
+  EXPECT_FALSE(client::upload::read_frame(stream, 1 << 20).has_value());
+
+  std::stringstream garbage("VERSION 0.7 not framed");
+  EXPECT_THROW(client::upload::read_frame(garbage, 1 << 20), client::upload::FrameError);
+  std::string cut = client::upload::encode_frame("abcdef");
+  cut.pop_back();
+  std::stringstream truncated(cut);
+  EXPECT_THROW(client::upload::read_frame(truncated, 1 << 20), client::upload::FrameError);
+  std::stringstream big(client::upload::encode_frame(std::string(100, 'x')));
+  EXPECT_THROW(client::upload::read_frame(big, 99), client::upload::FrameError);
+  EXPECT_EQ(client::upload::scan_extension("ply\nformat ascii 1.0\n"), ".ply");
+  EXPECT_EQ(client::upload::scan_extension("# .PCD v0.7\n"), ".pcd");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The uploader against the fake server
+
+TEST(Uploader, LabelsEachScanOnceIntoItsOwnOutput) {
+  FakeServer server;
+  test::TempDir dir;
+  client::Client client(fast_client(server.address()));
+  Uploader uploader(client, uploader_options(dir));
+  uploader.start();
+  std::string id;
+  EXPECT_EQ(uploader.submit(scan_bytes(1), ".pcd", &id), Uploader::Submitted::kAccepted);
+  uploader.submit(scan_bytes(2), ".pcd");
+  std::atomic<bool> stop{false};
+  ASSERT_TRUE(
+      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  const PointCloud out = read_cloud(dir.file("out/" + id + ".pcd"));
+  ASSERT_EQ(out.labels.size(), 200u);
+  for (std::size_t i = 0; i < 200; ++i) ASSERT_EQ(out.labels[i], (i + 1) % 4);
+  EXPECT_EQ(files_in(dir.file("out")), 2u);
+  EXPECT_EQ(files_in(dir.file("spool/scans")), 0u);
+  // The same scan again: its output exists, it is not uploaded twice.
+  EXPECT_EQ(uploader.submit(scan_bytes(1), ".pcd"), Uploader::Submitted::kAlreadyLabeled);
+  uploader.stop();
+  EXPECT_EQ(server.service.label_calls, 2);
+  EXPECT_EQ(uploader.counters().uploaded, 2u);
+  EXPECT_EQ(server.service.scan_ids.front().size(), 32u);  // the content hash travels as scan_id
+}
+
+TEST(Uploader, RetriesWithBackoffWhileTheServerIsUnavailable) {
+  FakeServer server;
+  server.service.unavailable_calls = 4;
+  test::TempDir dir;
+  client::Client client(fast_client(server.address()));
+  Uploader uploader(client, uploader_options(dir));
+  uploader.start();
+  std::string id;
+  uploader.submit(scan_bytes(3), ".pcd", &id);
+  std::atomic<bool> stop{false};
+  ASSERT_TRUE(
+      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  EXPECT_EQ(uploader.counters().retries, 4u);
+  EXPECT_EQ(uploader.counters().uploaded, 1u);
+  EXPECT_TRUE(fs::exists(dir.file("out/" + id + ".pcd")));
+  EXPECT_NE(uploader.status_line().find("retries 4"), std::string::npos) << uploader.status_line();
+}
+
+TEST(Uploader, StartupResumesTheSpoolAndSkipsScansAlreadyWritten) {
+  FakeServer server;
+  test::TempDir dir;
+  const auto options = uploader_options(dir);
+  // A previous run accepted two scans and crashed after writing the first one's output.
+  const std::string done_id = client::upload::scan_id(scan_bytes(4));
+  const std::string todo_id = client::upload::scan_id(scan_bytes(5));
+  {
+    Spool spool(options.spool_dir, {});
+    spool.accept(done_id, scan_bytes(4), ".pcd");
+    spool.accept(todo_id, scan_bytes(5), ".pcd");
+    fs::create_directories(options.output_dir);
+    write_bytes((options.output_dir / (done_id + ".pcd")).string(), scan_bytes(4));
+    write_bytes((options.output_dir / ("." + todo_id + ".pcd.tmp.1.0")).string(), "partial");
+  }
+  client::Client client(fast_client(server.address()));
+  Uploader uploader(client, options);
+  EXPECT_EQ(uploader.queued(), 1u);
+  uploader.start();
+  std::atomic<bool> stop{false};
+  ASSERT_TRUE(
+      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  EXPECT_EQ(server.service.label_calls, 1);
+  EXPECT_EQ(uploader.counters().already_labeled, 1u);
+  EXPECT_EQ(files_in(options.output_dir), 2u);  // the crash's temp file is gone
+  EXPECT_EQ(files_in(options.spool_dir / "scans"), 0u);
+}
+
+TEST(Uploader, ARefusedScanMovesToFailedAndTheRestGoOn) {
+  FakeServer server;
+  test::TempDir dir;
+  client::Client client(fast_client(server.address()));
+  Uploader uploader(client, uploader_options(dir));
+  uploader.start();
+  std::string empty_id;
+  uploader.submit(scan_bytes(6, 0), ".pcd", &empty_id);  // the server refuses zero points
+  uploader.submit(scan_bytes(7), ".pcd");
+  std::atomic<bool> stop{false};
+  ASSERT_TRUE(
+      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  EXPECT_EQ(uploader.counters().failed, 1u);
+  EXPECT_EQ(uploader.counters().uploaded, 1u);
+  EXPECT_TRUE(fs::exists(dir.file("spool/failed/" + empty_id + ".pcd")));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The tool
+
+std::string upload_tool() { return test::binary("primlabel-upload"); }
+
+TEST(UploadCli, SpoolFullRejectsWithExitFiveAndKeepsWhatItAccepted) {
+  test::TempDir dir;
+  std::string dead;
+  { dead = FakeServer().address(); }
+  std::vector<std::string> files;
+  for (int i = 0; i < 4; ++i) {
+    files.push_back(dir.file("s" + std::to_string(i) + ".pcd"));
+    write_bytes(files.back(), scan_bytes(10 + i));
+  }
+  const std::string bytes = std::to_string(scan_bytes(10).size() * 2.5 / 1e6);
+  const auto r = test::run_command(upload_tool() + " -q --retries 1 --timeout 0.5 --server " +
+                                   dead + " --spool " + dir.file("spool") + " -o " +
+                                   dir.file("out") + " --spool-max-mb " + bytes + " " + files[0] +
+                                   " " + files[1] + " " + files[2] + " " + files[3]);
+  EXPECT_EQ(r.exit_code, 5) << r.output;
+  EXPECT_NE(r.output.find("spool full"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("left in spool 2"), std::string::npos) << r.output;
+  EXPECT_EQ(files_in(dir.file("spool/scans")), 2u);
+}
+
+TEST(UploadCli, TimeoutWithTheServerAwayExitsThreeThenALaterRunDrainsTheSpool) {
+  test::TempDir dir;
+  write_bytes(dir.file("a.pcd"), scan_bytes(20));
+  const std::string spool_out = " --spool " + dir.file("spool") + " -o " + dir.file("out");
+  std::string dead;
+  { dead = FakeServer().address(); }
+  auto r = test::run_command(upload_tool() + " --retries 1 --timeout 0.5 --server " + dead +
+                             spool_out + " " + dir.file("a.pcd"));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("accepted "), std::string::npos) << r.output;
+  EXPECT_EQ(files_in(dir.file("spool/scans")), 1u);
+  FakeServer server;
+  r = test::run_command(upload_tool() + " --server " + server.address() + spool_out);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("resuming 1 scans"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("uploaded 1 (200 points)"), std::string::npos) << r.output;
+  EXPECT_EQ(files_in(dir.file("out")), 1u);
+  EXPECT_EQ(files_in(dir.file("spool/scans")), 0u);
+}
+
+TEST(UploadCli, StdinFramesAreAcknowledgedAndLabeled) {
+  FakeServer server;
+  test::TempDir dir;
+  for (int i = 0; i < 3; ++i) write_bytes(dir.file(std::to_string(i) + ".pcd"), scan_bytes(30 + i));
+  const auto r =
+      test::run_command(upload_tool() + " --frame " + dir.file("0.pcd") + " " + dir.file("1.pcd") +
+                        " " + dir.file("2.pcd") + " " + dir.file("0.pcd") + " | " + upload_tool() +
+                        " --stdin -q --server " + server.address() + " --spool " +
+                        dir.file("spool") + " -o " + dir.file("out"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(files_in(dir.file("out")), 3u);
+  EXPECT_NE(r.output.find("accepted " + client::upload::scan_id(scan_bytes(31)) + " stdin#1"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(server.service.label_calls, 3);  // the repeated frame is the same scan
+  const auto garbage = test::run_command("echo nonsense | " + upload_tool() +
+                                         " --stdin -q --server " + server.address() + " --spool " +
+                                         dir.file("spool") + " -o " + dir.file("out"));
+  EXPECT_EQ(garbage.exit_code, 2) << garbage.output;
+}
+
+TEST(UploadCli, WatchedDirectoryScansAreUploadedUntilASignal) {
+  FakeServer server;
+  test::TempDir dir;
+  fs::create_directories(dir.file("in"));
+  write_bytes(dir.file("in/early.pcd"), scan_bytes(40));
+  test::Process uploader(
+      {upload_tool(), "--server", server.address(), "--watch", dir.file("in"), "--spool",
+       dir.file("spool"), "-o", dir.file("out"), "--status-interval", "0.2"},
+      dir.file("upload.log"));
+  // A writer that renames finished files into place, and one that writes in place.
+  write_bytes(dir.file("in/.late.pcd.tmp"), scan_bytes(41));
+  fs::rename(dir.file("in/.late.pcd.tmp"), dir.file("in/late.pcd"));
+  write_bytes(dir.file("in/direct.pcd"), scan_bytes(42));
+  write_bytes(dir.file("in/notes.txt"), "ignored");
+  EXPECT_TRUE(
+      test::eventually([&] { return files_in(dir.file("out")) == 3; }, std::chrono::seconds(30)))
+      << uploader.log();
+  EXPECT_TRUE(uploader.wait_for_log("status: queued 0", std::chrono::seconds(10)))
+      << uploader.log();
+  EXPECT_EQ(uploader.kill(SIGTERM), 0) << uploader.log();
+  EXPECT_NE(uploader.log().find("uploaded 3"), std::string::npos) << uploader.log();
+}
+
+}  // namespace
+}  // namespace primlabel

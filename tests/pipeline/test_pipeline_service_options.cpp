@@ -1,0 +1,173 @@
+// label_cloud options the labeling service exposes: descriptors out, client normals, radius
+// overrides, voxel downsampling, per-stage timings and cancellation.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <stop_token>
+#include <thread>
+
+#include "primlabel/core/normals.hpp"
+#include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/tabletop/voxel_grid.hpp"
+#include "random_label_model.hpp"
+
+namespace primlabel {
+namespace {
+
+using testing::random_label_model;
+using testing::table_with_box_cloud;
+
+TEST(PipelineServiceOptions, DescriptorsAreReturnedRowMajorAsDescribeComputesThem) {
+  const LabelModel model = random_label_model();
+  PointCloud cloud = table_with_box_cloud();
+  pipeline::LabelingOptions options;
+  options.want_descriptors = true;
+  const auto result = pipeline::label_cloud(model, cloud, options);
+  ASSERT_EQ(result.descriptor_dim, kFpfhSize);
+  ASSERT_EQ(result.descriptors.size(), cloud.size() * kFpfhSize);
+  PointCloud again = table_with_box_cloud();
+  const auto described = pipeline::describe_cloud(again, model.features, 0);
+  for (std::size_t i = 0; i < result.descriptors.size(); ++i) {
+    const float a = result.descriptors[i], b = described.descriptors[i];
+    ASSERT_TRUE((std::isnan(a) && std::isnan(b)) || a == b) << "value " << i;
+  }
+  EXPECT_TRUE(pipeline::label_cloud(model, again, {}).descriptors.empty());
+}
+
+TEST(PipelineServiceOptions, TimingsAreSeparatePerStage) {
+  PointCloud cloud = table_with_box_cloud();
+  const auto result = pipeline::label_cloud(random_label_model(), cloud, {});
+  EXPECT_GT(result.normal_seconds, 0.0);
+  EXPECT_GT(result.descriptor_seconds, 0.0);
+  EXPECT_GT(result.inference_seconds, 0.0);
+  EXPECT_DOUBLE_EQ(result.feature_seconds, result.normal_seconds + result.descriptor_seconds);
+  EXPECT_EQ(result.described_points, cloud.size());
+}
+
+TEST(PipelineServiceOptions, ClientNormalsSkipEstimationAndGiveTheSameLabels) {
+  const LabelModel model = random_label_model();
+  PointCloud estimated = table_with_box_cloud();
+  const auto reference = pipeline::label_cloud(model, estimated, {});
+
+  PointCloud supplied = table_with_box_cloud();
+  supplied.normals = estimated.normals;  // as a sensor driver would send them
+  pipeline::LabelingOptions options;
+  options.use_cloud_normals = true;
+  const auto result = pipeline::label_cloud(model, supplied, options);
+  EXPECT_EQ(result.labels, reference.labels);
+  EXPECT_EQ(result.normal_seconds, 0.0);
+
+  PointCloud none = table_with_box_cloud();
+  EXPECT_THROW(pipeline::label_cloud(model, none, options), std::invalid_argument);
+}
+
+TEST(PipelineServiceOptions, RadiusOverridesOnlyWhenTheModelAllowsThem) {
+  LabelModel model = random_label_model();
+  pipeline::LabelingOptions options;
+  options.want_descriptors = true;
+  options.feature_radius = 0.05f;
+  PointCloud cloud = table_with_box_cloud();
+  EXPECT_THROW(pipeline::label_cloud(model, cloud, options), std::invalid_argument);
+
+  model.features.radii_overridable = true;
+  const auto wider = pipeline::label_cloud(model, cloud, options);
+  PointCloud again = table_with_box_cloud();
+  options.feature_radius = 0.0f;
+  const auto own = pipeline::label_cloud(model, again, options);
+  EXPECT_NE(wider.descriptors, own.descriptors);
+}
+
+TEST(PipelineServiceOptions, VoxelDownsamplingGivesEveryPointItsVoxelsResults) {
+  const LabelModel model = random_label_model();
+  PointCloud cloud = table_with_box_cloud(0.0025f);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  cloud.xyz[3] = Vec3f(nan, 0.0f, 0.0f);
+  pipeline::LabelingOptions options;
+  options.voxel_size = 0.005f;
+  options.want_descriptors = true;
+  options.want_probabilities = true;
+  options.threads = 1;
+  const auto result = pipeline::label_cloud(model, cloud, options);
+  ASSERT_EQ(result.labels.size(), cloud.size());
+  ASSERT_EQ(result.probabilities.rows(), Eigen::Index(cloud.size()));
+  ASSERT_EQ(result.descriptors.size(), cloud.size() * kFpfhSize);
+  EXPECT_LT(result.described_points, cloud.size() / 2);
+  EXPECT_EQ(result.labels[3], 0u);
+  EXPECT_TRUE(std::isnan(result.probabilities(3, 0)));
+
+  // Points of one voxel share everything.
+  const auto grid = tabletop::voxel_downsample(cloud.xyz, tabletop::finite_indices(cloud.xyz),
+                                               options.voxel_size);
+  std::size_t checked = 0;
+  for (std::size_t v = 0; v < grid.centroids.size(); ++v) {
+    const std::uint32_t first = grid.members[grid.member_offsets[v]];
+    for (std::uint32_t m = grid.member_offsets[v] + 1; m < grid.member_offsets[v + 1]; ++m) {
+      const std::uint32_t i = grid.members[m];
+      ASSERT_EQ(result.labels[i], result.labels[first]);
+      ASSERT_EQ(result.probabilities(i, 1), result.probabilities(first, 1));
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, cloud.size() / 2);
+  EXPECT_GT(result.labeled_points, cloud.size() / 2);
+
+  // Same labels for any thread count.
+  PointCloud again = table_with_box_cloud(0.0025f);
+  again.xyz[3] = cloud.xyz[3];
+  options.threads = 2;
+  EXPECT_EQ(pipeline::label_cloud(model, again, options).labels, result.labels);
+}
+
+TEST(PipelineServiceOptions, AStoppedTokenCancelsBeforeAnyWork) {
+  std::stop_source source;
+  source.request_stop();
+  pipeline::LabelingOptions options;
+  options.stop = source.get_token();
+  PointCloud cloud = table_with_box_cloud();
+  EXPECT_THROW(pipeline::label_cloud(random_label_model(), cloud, options), pipeline::Cancelled);
+}
+
+TEST(PipelineServiceOptions, StoppingFromAnotherThreadCancelsInsideTheStages) {
+  // A CRF on a dense cloud; stop it at a few points in time and expect either a result (it was
+  // faster) or Cancelled, never anything else, and the same labels as usual when it completes.
+  const LabelModel model = random_label_model("crf", "1", 7, 0.5f);
+  PointCloud reference_cloud = table_with_box_cloud(0.003f);
+  const auto reference = pipeline::label_cloud(model, reference_cloud, {});
+  int cancelled = 0;
+  for (int delay_ms : {0, 10, 40}) {
+    std::stop_source source;
+    pipeline::LabelingOptions options;
+    options.stop = source.get_token();
+    PointCloud cloud = table_with_box_cloud(0.003f);
+    std::jthread stopper([&source, delay_ms] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
+      source.request_stop();
+    });
+    try {
+      EXPECT_EQ(pipeline::label_cloud(model, cloud, options).labels, reference.labels);
+    } catch (const pipeline::Cancelled&) {
+      ++cancelled;
+    }
+  }
+  EXPECT_GE(cancelled, 1);
+}
+
+TEST(PipelineServiceOptions, InferenceHonoursItsStopToken) {
+  PointCloud cloud = table_with_box_cloud();
+  const LabelModel model = random_label_model("crf", "1", 7, 0.5f);
+  const auto described = pipeline::describe_cloud(cloud, model.features, 0);
+  const auto graph = pipeline::build_scene_graph(cloud, described, model.graph);
+  std::stop_source source;
+  source.request_stop();
+  crf::InferenceOptions options;
+  options.stop = source.get_token();
+  EXPECT_THROW(crf::infer(model.weights, described.descriptors, graph, options), Cancelled);
+  options.stop = {};
+  EXPECT_EQ(crf::infer(model.weights, described.descriptors, graph, options).labels.size(),
+            cloud.size());
+}
+
+}  // namespace
+}  // namespace primlabel

@@ -1,0 +1,252 @@
+// The labeling service in process on 127.0.0.1:0: streamed and unary labeling give exactly the
+// labels of label_cloud in process, optional arrays and chunking, the model RPCs, health,
+// reflection and metrics.
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+
+#include "primlabel/metrics/metrics.hpp"
+#include "server_test_util.hpp"
+
+namespace primlabel::servertest {
+namespace {
+
+using testing::random_label_model;
+using testing::table_with_box_cloud;
+
+TEST(LabelService, StreamedLabelsMatchLabelCloudInProcess) {
+  const LabelModel model = random_label_model("tabletop", "1");
+  TestServer server({model});
+  const PointCloud cloud = table_with_box_cloud(0.01f);
+  const LabelAnswer answer =
+      label_stream(*server.stub, scan_requests(cloud, header_for("tabletop"), 1000));
+  ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+  EXPECT_EQ(answer.labels, reference_labels(model, cloud));
+  ASSERT_TRUE(answer.summary);
+  EXPECT_EQ(answer.summary->model(), "tabletop");
+  EXPECT_EQ(answer.summary->model_version(), "1");
+  EXPECT_EQ(answer.summary->scan_id(), "s1");
+  EXPECT_EQ(answer.summary->points_received(), cloud.size());
+  EXPECT_FALSE(answer.summary->request_id().empty());
+  std::uint64_t counted = 0;
+  for (const auto& count : answer.summary->class_counts()) counted += count.points();
+  EXPECT_EQ(counted, cloud.size());
+  std::vector<std::string> stages;
+  for (const auto& timing : answer.summary->timings()) stages.push_back(timing.stage());
+  EXPECT_EQ(stages, (std::vector<std::string>{"receive", "prefilter", "normals", "features",
+                                              "inference", "send"}));
+}
+
+TEST(LabelService, DescriptorsProbabilitiesAndSmallResponseChunks) {
+  const LabelModel model = random_label_model("m", "1");
+  TestServer server({model});
+  const PointCloud cloud = table_with_box_cloud(0.01f);
+  v1::ScanHeader header = header_for();  // the only model is the default
+  header.mutable_options()->set_return_descriptors(true);
+  header.mutable_options()->set_return_probabilities(true);
+  header.mutable_options()->set_response_chunk_points(777);
+  const LabelAnswer answer = label_stream(*server.stub, scan_requests(cloud, header, 500));
+  ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+  EXPECT_EQ(answer.chunks.size(), (cloud.size() + 776) / 777);
+  for (std::size_t c = 0; c + 1 < answer.chunks.size(); ++c)
+    EXPECT_EQ(answer.chunks[c].point_count(), 777u);
+  ASSERT_EQ(answer.summary->descriptor_dim(), 33u);
+  ASSERT_EQ(answer.summary->classes_size(), 5);
+  ASSERT_EQ(answer.descriptors.size(), cloud.size() * 33);
+  ASSERT_EQ(answer.probabilities.size(), cloud.size() * 5);
+
+  PointCloud local = cloud;
+  pipeline::LabelingOptions options;
+  options.want_descriptors = options.want_probabilities = true;
+  const auto expected = pipeline::label_cloud(model, local, options);
+  EXPECT_EQ(answer.labels, expected.labels);
+  for (std::size_t i = 0; i < answer.descriptors.size(); i += 101) {
+    const float a = answer.descriptors[i], b = expected.descriptors[i];
+    ASSERT_TRUE((std::isnan(a) && std::isnan(b)) || a == b) << i;
+  }
+  for (std::size_t i = 0; i < cloud.size(); i += 97)
+    for (int k = 0; k < 5; ++k) {
+      const float a = answer.probabilities[i * 5 + k], b = expected.probabilities(i, k);
+      ASSERT_TRUE((std::isnan(a) && std::isnan(b)) || a == b) << i;
+    }
+}
+
+TEST(LabelService, ClientNormalsAndHalfCloseWithoutEndOfScan) {
+  const LabelModel model = random_label_model("m", "1");
+  TestServer server({model});
+  PointCloud cloud = table_with_box_cloud(0.01f);
+  const auto expected = reference_labels(model, cloud);
+  PointCloud with_normals = cloud;
+  pipeline::label_cloud(model, with_normals, {});  // fills the normals the server would compute
+  v1::ScanHeader header = header_for();
+  header.mutable_layout()->set_normals(true);
+  const LabelAnswer answer =
+      label_stream(*server.stub, scan_requests(with_normals, header, 1500, /*with_end=*/false));
+  ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+  EXPECT_EQ(answer.labels, expected);
+  for (const auto& timing : answer.summary->timings())
+    if (timing.stage() == "normals") EXPECT_EQ(timing.seconds(), 0.0);
+}
+
+TEST(LabelService, UnaryLabelCloudAndVoxelOption) {
+  const LabelModel model = random_label_model("m", "1");
+  TestServer server({model});
+  const PointCloud cloud = table_with_box_cloud(0.005f);
+  LabelAnswer answer = label_cloud(*server.stub, cloud, header_for("m"));
+  ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+  EXPECT_EQ(answer.labels, reference_labels(model, cloud));
+
+  v1::ScanHeader header = header_for("m");
+  header.mutable_options()->set_voxel_size(0.01f);
+  answer = label_cloud(*server.stub, cloud, header);
+  ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+  PointCloud local = cloud;
+  pipeline::LabelingOptions options;
+  options.voxel_size = 0.01f;
+  EXPECT_EQ(answer.labels, pipeline::label_cloud(model, local, options).labels);
+}
+
+TEST(LabelService, LatestOrPinnedVersionAndExplicitVersions) {
+  const LabelModel v2 = random_label_model("m", "2", 11);
+  const LabelModel v10 = random_label_model("m", "10", 12);
+  const PointCloud cloud = table_with_box_cloud(0.01f);
+  {
+    TestServer server({v2, v10});
+    LabelAnswer answer = label_cloud(*server.stub, cloud, header_for("m"));
+    ASSERT_TRUE(answer.status.ok());
+    EXPECT_EQ(answer.summary->model_version(), "10");  // "10" is later than "2"
+    EXPECT_EQ(answer.labels, reference_labels(v10, cloud));
+    v1::ScanHeader header = header_for("m");
+    header.set_model_version("2");
+    answer = label_cloud(*server.stub, cloud, header);
+    ASSERT_TRUE(answer.status.ok());
+    EXPECT_EQ(answer.summary->model_version(), "2");
+    EXPECT_EQ(answer.labels, reference_labels(v2, cloud));
+  }
+  TestServer pinned({v2, v10}, [](server::ServerConfig& c) { c.pins["m"] = "2"; });
+  const LabelAnswer answer = label_cloud(*pinned.stub, cloud, header_for("m"));
+  ASSERT_TRUE(answer.status.ok());
+  EXPECT_EQ(answer.summary->model_version(), "2");
+}
+
+TEST(LabelService, ListModelsAndMetadata) {
+  LabelModel a = random_label_model("alpha", "1");
+  a.validation.accuracy = 0.75;
+  const LabelModel b = random_label_model("beta", "3");
+  TestServer server({a, b}, [](server::ServerConfig& c) { c.default_model = "beta"; });
+  grpc::ClientContext context;
+  v1::ListModelsResponse list;
+  ASSERT_TRUE(server.stub->ListModels(&context, {}, &list).ok());
+  ASSERT_EQ(list.models_size(), 2);
+  EXPECT_EQ(list.models(0).name(), "alpha");
+  EXPECT_FALSE(list.models(0).is_default());
+  EXPECT_DOUBLE_EQ(list.models(0).validation_accuracy(), 0.75);
+  EXPECT_EQ(list.models(1).name(), "beta");
+  EXPECT_EQ(list.models(1).version(), "3");
+  EXPECT_TRUE(list.models(1).is_default());
+  EXPECT_EQ(list.models(1).classes(), 5u);
+  EXPECT_EQ(list.models(1).kind(), v1::MODEL_KIND_NODE_ONLY);
+
+  grpc::ClientContext meta_context;
+  v1::GetModelMetadataRequest request;
+  request.set_model("alpha");
+  v1::ModelMetadata metadata;
+  ASSERT_TRUE(server.stub->GetModelMetadata(&meta_context, request, &metadata).ok());
+  EXPECT_EQ(metadata.name(), "alpha");
+  EXPECT_EQ(metadata.version(), "1");
+  EXPECT_EQ(metadata.classes_size(), 5);
+  EXPECT_EQ(metadata.path(), "alpha/1/model.plm");
+  EXPECT_NE(metadata.model_crc32(), 0u);
+  EXPECT_FLOAT_EQ(metadata.features().feature_radius(), 0.03f);
+  EXPECT_EQ(metadata.created_by(), "random_label_model");
+
+  grpc::ClientContext missing_context;
+  request.set_model("gamma");
+  const grpc::Status missing = server.stub->GetModelMetadata(&missing_context, request, &metadata);
+  EXPECT_EQ(missing.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_NE(missing.error_message().find("gamma"), std::string::npos);
+}
+
+TEST(LabelService, HealthFollowsLoadedModels) {
+  TestServer empty({});
+  EXPECT_EQ(health_status(empty.channel, ""), "NOT_SERVING");
+  EXPECT_EQ(health_status(empty.channel, "primlabel.v1.Labeler"), "NOT_SERVING");
+  const LabelAnswer answer = label_cloud(*empty.stub, table_with_box_cloud(0.02f), header_for());
+  EXPECT_EQ(answer.status.error_code(), grpc::StatusCode::NOT_FOUND);
+
+  TestServer server({random_label_model()});
+  EXPECT_EQ(health_status(server.channel, ""), "SERVING");
+  EXPECT_EQ(health_status(server.channel, "primlabel.v1.Labeler"), "SERVING");
+}
+
+TEST(LabelService, ReflectionListsTheServices) {
+  TestServer server({random_label_model()});
+  // grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo with list_services = "":
+  // field 7 (string), empty.
+  grpc::GenericStub generic(server.channel);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+  grpc::CompletionQueue queue;
+  auto call = generic.PrepareCall(
+      &context, "/grpc.reflection.v1alpha.ServerReflection/ServerReflectionInfo", &queue);
+  void* tag;
+  bool ok;
+  call->StartCall(reinterpret_cast<void*>(1));
+  ASSERT_TRUE(queue.Next(&tag, &ok) && ok);
+  const std::string list_services("\x3a\x00", 2);
+  grpc::Slice slice(list_services);
+  grpc::ByteBuffer request(&slice, 1);
+  call->Write(request, reinterpret_cast<void*>(2));
+  ASSERT_TRUE(queue.Next(&tag, &ok) && ok);
+  grpc::ByteBuffer reply;
+  call->Read(&reply, reinterpret_cast<void*>(3));
+  ASSERT_TRUE(queue.Next(&tag, &ok) && ok);
+  std::vector<grpc::Slice> slices;
+  ASSERT_TRUE(reply.Dump(&slices).ok());
+  std::string bytes;
+  for (const auto& s : slices) bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
+  EXPECT_NE(bytes.find("primlabel.v1.Labeler"), std::string::npos);
+  EXPECT_NE(bytes.find("primlabel.v1.ModelAdmin"), std::string::npos);
+  EXPECT_NE(bytes.find("grpc.health.v1.Health"), std::string::npos);
+  context.TryCancel();
+  grpc::Status finished;
+  call->Finish(&finished, reinterpret_cast<void*>(4));
+  while (queue.Next(&tag, &ok)) {
+    if (tag == reinterpret_cast<void*>(4)) break;
+  }
+  queue.Shutdown();
+  while (queue.Next(&tag, &ok)) {
+  }
+}
+
+TEST(LabelService, MetricsCountRequestsPointsAndStages) {
+  const LabelModel model = random_label_model("m", "1");
+  TestServer server({model});
+  const PointCloud cloud = table_with_box_cloud(0.01f);
+  ASSERT_TRUE(label_stream(*server.stub, scan_requests(cloud, header_for())).status.ok());
+  EXPECT_EQ(label_cloud(*server.stub, cloud, header_for("nope")).status.error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  const std::string text = metrics::http_get(
+      "127.0.0.1:" + std::to_string(server.server->metrics_port()), "/metrics", 5000);
+  const auto samples = metrics::parse_exposition(text);
+  using metrics::sum_samples;
+  EXPECT_EQ(sum_samples(samples, "primlabel_requests_total",
+                        {{"method", "Label"}, {"model", "m"}, {"status", "OK"}}),
+            1.0);
+  EXPECT_EQ(sum_samples(samples, "primlabel_requests_total",
+                        {{"method", "LabelCloud"}, {"status", "NOT_FOUND"}}),
+            1.0);
+  EXPECT_EQ(sum_samples(samples, "primlabel_points_total", {{"model", "m"}}), double(cloud.size()));
+  for (const char* stage : {"receive", "normals", "features", "inference", "send"})
+    EXPECT_EQ(sum_samples(samples, "primlabel_stage_seconds_count", {{"stage", stage}}), 1.0)
+        << stage;
+  EXPECT_EQ(sum_samples(samples, "primlabel_request_seconds_count", {{"method", "Label"}}), 1.0);
+  EXPECT_EQ(sum_samples(samples, "primlabel_model_info", {{"model", "m"}, {"version", "1"}}), 1.0);
+  EXPECT_EQ(sum_samples(samples, "primlabel_models_loaded"), 1.0);
+  EXPECT_EQ(sum_samples(samples, "primlabel_model_reloads_total"), 1.0);
+  EXPECT_EQ(sum_samples(samples, "primlabel_model_reload_failures_total"), 0.0);
+  EXPECT_EQ(sum_samples(samples, "primlabel_inflight_requests"), 0.0);
+  EXPECT_EQ(sum_samples(samples, "primlabel_queue_depth"), 0.0);
+}
+
+}  // namespace
+}  // namespace primlabel::servertest
