@@ -140,6 +140,19 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   return text;
 }
 
+// A valid header for `classes` classes claiming `total_sv` support vectors (all of the last
+// class), and no support vectors.
+std::string many_classes_header(int classes, int total_sv) {
+  std::string text = "svm_type c_svc\nkernel_type rbf\ngamma 1\nnr_class " +
+                     std::to_string(classes) + "\ntotal_sv " + std::to_string(total_sv) + "\nrho";
+  for (int p = 0; p < classes * (classes - 1) / 2; ++p) text += " 0";
+  text += "\nlabel";
+  for (int k = 0; k < classes; ++k) text += " " + std::to_string(k);
+  text += "\nnr_sv";
+  for (int k = 0; k < classes; ++k) text += " " + std::to_string(k + 1 == classes ? total_sv : 0);
+  return text + "\nSV\n";
+}
+
 TEST(CrfSvm, CorruptLibsvmTextIsRejectedWithTheReason) {
   const std::string good = noisy_problem().svm.to_libsvm_text();
   const struct {
@@ -162,12 +175,27 @@ TEST(CrfSvm, CorruptLibsvmTextIsRejectedWithTheReason) {
       {replaced(good, "\nSV\n", "\nSV\n1 2 3:nan\n"), "feature value 'nan' is not a finite"},
       {replaced(good, "\nSV\n", "\nSV\n1 2 3:0.5\n"), "more support vectors than total_sv"},
       {good, "label 2 is not one of the 2 classes", 2},
+      {many_classes_header(200, 20000), "total_sv 20000 is more than the text holds"},
       {good + "\n", "(accepted)"},
   };
   for (const auto& c : cases) {
     const std::string error = parse_error(c.text, c.classes, c.dim);
     EXPECT_NE(error.find(c.reason), std::string::npos)
         << "expected: " << c.reason << "\ngot: " << error;
+  }
+}
+
+TEST(CrfSvm, TruncatedTextIsRefusedUpToTheLastLine) {
+  // The text has no checksum (the model file has): a cut inside the last support vector's line
+  // can leave a valid, shorter line. Any earlier cut loses a line and is refused.
+  const std::string good = noisy_problem().svm.to_libsvm_text();
+  const std::size_t last_line = good.rfind('\n', good.size() - 2) + 1;
+  for (std::size_t cut = 0; cut < good.size(); cut += 7) {
+    try {
+      SvmClassifier::from_libsvm_text(good.substr(0, cut), {11, 12, 13}, 8, 0.01f);
+      EXPECT_GT(cut, last_line) << "accepted a cut at " << cut;
+    } catch (const std::invalid_argument&) {
+    }
   }
 }
 

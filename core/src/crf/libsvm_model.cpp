@@ -1,5 +1,6 @@
 #include "libsvm_model.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -184,6 +185,10 @@ std::unique_ptr<LibsvmModel> LibsvmModel::parse(const std::string& text, int max
   if (std::accumulate(m->nr_sv_.begin(), m->nr_sv_.end(), 0LL) != total_sv)
     parser.fail("nr_sv does not add up to total_sv " + std::to_string(total_sv));
 
+  // Each support vector line holds nr_class - 1 coefficients of at least two characters: bounds
+  // the allocation below by the text's size.
+  if (std::uint64_t(total_sv) * std::uint64_t(std::max(m->nr_class_ - 1, 1)) * 2 > text.size())
+    parser.fail("total_sv " + std::to_string(total_sv) + " is more than the text holds");
   m->coef_.assign(std::size_t(m->nr_class_ - 1), std::vector<double>(std::size_t(total_sv)));
   int parsed = 0;
   while (parser.next_line(line)) {
