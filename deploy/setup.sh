@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One entry point for a fresh Debian 12 machine: installs what is missing, builds, then runs.
 #
-#   deploy/setup.sh run     install + build + the main job (features of the bundled sample)
+#   deploy/setup.sh run     install + build + the main job: the default model, then the labeling
+#                           service on 127.0.0.1 labels a held-out scan sent by the primlabel CLI
 #   deploy/setup.sh test    install + build + the whole test suite (CTest)
 #   deploy/setup.sh build   install + build only
 #   deploy/setup.sh deps    install only
@@ -25,10 +26,14 @@ PACKAGES=(
   libeigen3-dev libnanoflann-dev liblzf-dev libcli11-dev libpng-dev zlib1g-dev
   libprotobuf-dev protobuf-compiler liblbfgspp-dev libsvm-dev
   libgrpc++-dev protobuf-compiler-grpc
+  libssl-dev
   libgtest-dev
-  python3-yaml nginx prometheus
 )
+# Only the tests need these: the deployment checks (YAML, nginx -t, promtool, the local
+# three-replica proof) and TLS certificates made on the fly.
+TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl)
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev)
+[[ "${1:-}" == test ]] && PACKAGES+=("${TEST_PACKAGES[@]}")
 
 log() { echo "[setup] $*" >&2; }
 
@@ -65,18 +70,43 @@ default_model() {
     return
   fi
   mkdir -p "$(dirname "$model")"
-  "$BUILD_DIR/bin/primlabel-train" --sensor lms400 --kind crf --name tabletop-lms400 \
-    --curve "$(dirname "$model")/training_curve.csv" -o "$model.tmp"
+  "$BUILD_DIR/bin/primlabel-train" --sensor lms400 --kind crf --name tabletop-lms400 -o "$model.tmp"
   mv "$model.tmp" "$model"
   log "wrote the default model $model"
 }
 
+# The main job: the default model served by primlabel-server on 127.0.0.1, and a held-out
+# synthetic LMS400 scan (a test seed, never trained on) labeled through it by the primlabel CLI.
 run_main_job() {
-  local out="$BUILD_DIR/out"
+  local out="$BUILD_DIR/out" bin="$BUILD_DIR/bin"
   mkdir -p "$out"
-  "$BUILD_DIR/bin/primlabel-features" "$ROOT/tests/data/samples/bun0.pcd" \
-    -o "$out/bun0_features.pcd" --normal-k 10 --feature-radius 0.02 --viewpoint 0,0,0
-  log "wrote $out/bun0_features.pcd (x y z, normals, curvature, fpfh 33)"
+  default_model "$BUILD_DIR/models"
+  "$bin/primlabel-synth" --scene table --sensor lms400 --seed 3000 -o "$out/scan.pcd"
+
+  local log_file="$out/server.log"
+  "$bin/primlabel-server" --models "$BUILD_DIR/models" --listen 127.0.0.1:0 \
+    --metrics-listen 127.0.0.1:0 --drain-seconds 5 >"$log_file" 2>&1 &
+  local server=$!
+  trap 'kill "$server" 2>/dev/null || true' EXIT
+  local port=""
+  for _ in $(seq 1 100); do  # up to 10 s for the model to load and the port to open
+    port=$(sed -n 's/.*event=listening.* port=\([0-9]*\).*/\1/p' "$log_file" | head -n1)
+    [[ -n "$port" ]] && break
+    kill -0 "$server" 2>/dev/null || { cat "$log_file" >&2; return 1; }
+    sleep 0.1
+  done
+  [[ -n "$port" ]] || { log "the server did not start; see $log_file"; return 1; }
+  log "primlabel-server serves $BUILD_DIR/models on 127.0.0.1:$port"
+
+  "$bin/primlabel" --server "127.0.0.1:$port" health
+  "$bin/primlabel" --server "127.0.0.1:$port" models
+  "$bin/primlabel" --server "127.0.0.1:$port" label "$out/scan.pcd" \
+    -o "$out/scan_labeled.pcd" --png
+  "$bin/primlabel-eval" --model "$BUILD_DIR/models/tabletop-lms400/1/model.plm" \
+    "$out/scan.pcd" | grep -E '^accuracy' || true
+  kill -TERM "$server" && wait "$server" || true
+  trap - EXIT
+  log "wrote $out/scan_labeled.pcd and its PNG render (labels from the service)"
 }
 
 run_tests() {
@@ -89,5 +119,5 @@ case "${1:-}" in
   build) install_packages; build ;;
   run) install_packages; build; run_main_job ;;
   test) install_packages; build; run_tests ;;
-  *) echo "usage: $0 run|test|build|deps" >&2; exit 2 ;;
+  *) echo "usage: $0 run|test|build|deps|default-model [DIR]" >&2; exit 2 ;;
 esac
