@@ -1,19 +1,27 @@
 // primlabel-eval: labels clouds with a trained model and scores them against their ground truth,
-// or re-measures the paper's Table I.
+// or re-measures the paper's Table I and Fig. 4.
 //
 //   primlabel-eval --model table.plm scene.pcd [--json] [--out labeled.pcd]
 //   primlabel-eval --model table.plm --no-truth mosd_scene.pcd     # predicted label histogram
+//   primlabel-eval --model table.plm --confusion-png confusion.png a.pcd b.pcd   # over all files
 //   primlabel-eval --table1 [--json]
+//   primlabel-eval --fig4 out/ [--fig4-scenes 3]                    # the paper's Fig. 4
+//   primlabel-eval --model kinect.plm --mosd-report out/ ../shared/data/mosd/*.pcd
 
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "cli_common.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "primlabel/crf/metrics.hpp"
+#include "primlabel/pipeline/confusion_plot.hpp"
+#include "primlabel/pipeline/fig4.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/pipeline/mosd_report.hpp"
 #include "primlabel/pipeline/table1.hpp"
 #include "primlabel/synth/labeled_cloud.hpp"
 
@@ -22,11 +30,11 @@ namespace {
 using namespace primlabel;
 
 struct Arguments {
-  std::string model, classes, out;
+  std::string model, classes, out, confusion_png, fig4_dir, mosd_dir;
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
   bool table1 = false, no_pfh = false, no_svm = false;
-  int table1_train = 8, table1_test = 4, pfh_max_neighbors = 40, threads = 0;
+  int table1_train = 8, table1_test = 4, pfh_max_neighbors = 40, threads = 0, fig4_scenes = 3;
 };
 
 std::string class_name(std::uint32_t id) {
@@ -103,6 +111,7 @@ void print_histogram(const std::string& path, const std::vector<std::uint32_t>& 
 int evaluate_files(const Arguments& args) {
   const LabelModel model = load_model(args.model);
   const ClassMap map = args.classes.empty() ? ClassMap{} : read_class_map(args.classes);
+  crf::ConfusionMatrix overall(model.class_ids());  // every scored file, for the PNG
   for (const std::string& path : args.files) {
     PointCloud cloud = read_cloud(path);
     const bool scored = !args.no_truth && cloud.has_labels();
@@ -119,6 +128,7 @@ int evaluate_files(const Arguments& args) {
       crf::ConfusionMatrix confusion(model.class_ids());
       confusion.add(cloud.labels, result.labels, class_id(PrimitiveClass::kUnknown));
       print_scores(path, confusion, args.json);
+      overall.add(confusion);
     } else {
       print_histogram(path, result.labels, args.json);
     }
@@ -126,6 +136,15 @@ int evaluate_files(const Arguments& args) {
       cloud.labels = result.labels;
       write_tagged_cloud(args.out, cloud, {{"classes", class_map_tag(ClassMap::taxonomy())}});
     }
+  }
+  if (!args.confusion_png.empty()) {
+    if (overall.total() == 0)
+      throw std::runtime_error("--confusion-png: no file had ground-truth primitive labels");
+    std::vector<std::string> names;
+    for (std::uint32_t id : overall.class_ids()) names.push_back(class_name(id));
+    pipeline::write_confusion_png(
+        args.confusion_png, overall, names,
+        args.files.size() == 1 ? args.files.front() : std::to_string(args.files.size()) + " files");
   }
   return cli::kExitOk;
 }
@@ -146,6 +165,64 @@ int table1(const Arguments& args) {
   return cli::kExitOk;
 }
 
+int mosd_report(const Arguments& args) {
+  const LabelModel model = load_model(args.model);
+  std::error_code ec;
+  std::filesystem::create_directories(args.mosd_dir, ec);
+  if (ec) throw std::runtime_error(args.mosd_dir + ": cannot be created (" + ec.message() + ")");
+  pipeline::LabelingOptions options;
+  options.threads = args.threads;
+  options.tabletop_only = args.tabletop_only;
+  std::vector<pipeline::MosdSceneReport> scenes;
+  for (const std::string& path : args.files) {
+    const std::string png = (std::filesystem::path(args.mosd_dir) /
+                             (std::filesystem::path(path).stem().string() + "_labels.png"))
+                                .string();
+    scenes.push_back(pipeline::report_mosd_scene(model, path, png, options));
+    if (!args.quiet)
+      std::fprintf(stderr, "%s: %.2f%% of %llu table points plane, wrote %s\n", path.c_str(),
+                   100.0 * scenes.back().plane_share(),
+                   static_cast<unsigned long long>(scenes.back().table_points), png.c_str());
+  }
+  const pipeline::MosdReport report = pipeline::summarize_mosd(std::move(scenes));
+  const std::string json = pipeline::mosd_report_json(report);
+  const std::string json_path =
+      (std::filesystem::path(args.mosd_dir) / "mosd_report.json").string();
+  std::ofstream(json_path) << json;
+  std::fputs((args.json ? json : pipeline::mosd_report_text(report)).c_str(), stdout);
+  return cli::kExitOk;
+}
+
+int fig4(const Arguments& args) {
+  pipeline::Fig4Options options;
+  options.scenes = args.fig4_scenes;
+  options.threads = args.threads;
+  if (!args.quiet)
+    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  const pipeline::Fig4 result = pipeline::run_fig4(options);
+  pipeline::write_fig4(result, args.fig4_dir);
+  if (!args.json) {
+    std::printf("%s", pipeline::hik_text(result).c_str());
+    return cli::kExitOk;
+  }
+  const pipeline::ClassSignatures& s = result.signatures;
+  std::string line = "{\"classes\":[";
+  for (std::size_t k = 0; k < s.class_ids.size(); ++k)
+    line += (k ? "," : "") + json_string(class_name(s.class_ids[k]));
+  line += "],\"points\":[";
+  for (std::size_t k = 0; k < s.points.size(); ++k)
+    line += (k ? "," : "") + std::to_string(s.points[k]);
+  line += "],\"hik\":[";
+  for (Eigen::Index r = 0; r < result.hik.rows(); ++r) {
+    line += r ? ",[" : "[";
+    for (Eigen::Index c = 0; c < result.hik.cols(); ++c)
+      line += (c ? "," : "") + json_number(result.hik(r, c));
+    line += "]";
+  }
+  std::printf("%s]}\n", line.c_str());
+  return cli::kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -155,11 +232,23 @@ int main(int argc, char** argv) {
   auto* files = app.add_option("files", args.files, "clouds to label (.pcd or .ply)");
   auto* model = app.add_option("--model", args.model, "model file (primlabel-train -o)");
   app.add_flag("--json", args.json, "one JSON object per file (or per Table I row) on stdout");
-  app.add_flag("--no-truth", args.no_truth,
-               "the files' labels are no primitive classes (e.g. segment ids): print the "
-               "predicted label histogram");
+  auto* no_truth =
+      app.add_flag("--no-truth", args.no_truth,
+                   "the files' labels are no primitive classes (e.g. segment ids): print the "
+                   "predicted label histogram");
   app.add_option("--classes", args.classes, "class map of the files' labels (id name per line)");
-  app.add_option("--out", args.out, "write the predicted labels (one input file)");
+  auto* out = app.add_option("--out", args.out, "write the predicted labels (one input file)");
+  auto* mosd =
+      app.add_option("--mosd-report", args.mosd_dir,
+                     "mOSD scenes (label 1-9 table): share of table points labeled plane, and a "
+                     "labeled PNG per scene, into DIR (with mosd_report.json)")
+          ->needs(model)
+          ->excludes(no_truth)
+          ->excludes(out);
+  app.add_option("--confusion-png", args.confusion_png,
+                 "confusion matrix over all scored files as PNG (rows true, columns predicted)")
+      ->excludes(no_truth)
+      ->excludes(mosd);
   app.add_flag("--tabletop-only", args.tabletop_only, "label only the table and the objects on it");
   auto* t1 = app.add_flag("--table1", args.table1,
                           "re-measure the paper's Table I on synthetic LMS400 scenes");
@@ -175,10 +264,17 @@ int main(int argc, char** argv) {
                  "Table I: PFH uses the M nearest within the feature radius (default 40)")
       ->check(CLI::PositiveNumber)
       ->needs(t1);
+  auto* f4 = app.add_option("--fig4", args.fig4_dir,
+                            "write the paper's Fig. 4 (class-mean FPFH signatures, HIK distance "
+                            "matrix; CSV and PNG) from synthetic LMS400 training scenes to DIR");
+  app.add_option("--fig4-scenes", args.fig4_scenes, "Fig. 4: training scenes (default 3)")
+      ->check(CLI::PositiveNumber)
+      ->needs(f4);
   app.add_option("--threads", args.threads, "worker threads (default: all cores)")
       ->check(CLI::PositiveNumber);
   app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
-  t1->excludes(model)->excludes(files);
+  t1->excludes(model)->excludes(files)->excludes(f4);
+  f4->excludes(model)->excludes(files);
 
   try {
     app.parse(argc, argv);
@@ -187,10 +283,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "primlabel-eval: usage error: %s (see --help)\n", e.what());
     return cli::kExitUsage;
   }
-  if (!args.table1 && (args.model.empty() || args.files.empty())) {
+  const bool study = args.table1 || !args.fig4_dir.empty();
+  if (!study && (args.model.empty() || args.files.empty())) {
     std::fprintf(stderr,
                  "primlabel-eval: usage error: give --model and at least one file, or --table1 "
-                 "(see --help)\n");
+                 "or --fig4 (see --help)\n");
     return cli::kExitUsage;
   }
   if (!args.out.empty() && args.files.size() != 1) {
@@ -198,7 +295,10 @@ int main(int argc, char** argv) {
     return cli::kExitUsage;
   }
   try {
-    return args.table1 ? table1(args) : evaluate_files(args);
+    if (args.table1) return table1(args);
+    if (!args.fig4_dir.empty()) return fig4(args);
+    if (!args.mosd_dir.empty()) return mosd_report(args);
+    return evaluate_files(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "primlabel-eval: error: %s\n", e.what());
     return cli::kExitFailure;

@@ -1,8 +1,9 @@
-// primlabel-train: trains a labeling model (CRF, node-only) from labeled synthetic scenes or
+// primlabel-train: trains a labeling model (CRF, node-only, SVM) from labeled synthetic scenes or
 // labeled PCD/PLY files and writes a model file.
 //
 //   primlabel-train --synth-train 4 --synth-val 1 --sensor lms400 -o table.plm --curve curve.csv
 //   primlabel-train --train a.pcd b.pcd --val c.pcd --classes map.txt --kind node -o m.plm
+//   primlabel-train --synth-train 3 --kind svm --svm-max-points 20000 -o svm.plm
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -23,7 +24,8 @@ struct Arguments {
   int synth_train = 8, synth_val = 1, iterations = 200, graph_k = 8, threads = 0;
   std::string sensor = "lms400", kind = "crf", objective = "piecewise", descriptor = "fpfh";
   std::string fpfh_variant = "paper";
-  double label_radius = synth::kDefaultLabelRadius, l2 = 1e-6;
+  double label_radius = synth::kDefaultLabelRadius, l2 = 1e-6, svm_c = 10.0, svm_gamma = 0.0;
+  std::size_t svm_max_points = 20000;
   float feature_radius = 0.025f, normal_radius = 0.01f;
   std::vector<std::string> train_files, val_files;
   std::string classes, output, curve_csv, curve_png, name;
@@ -96,7 +98,12 @@ int run(const Arguments& args) {
   say(args, "classes:" + names);
 
   pipeline::ModelTrainingOptions options;
-  options.kind = args.kind == "node" ? ModelKind::kNodeOnly : ModelKind::kCrf;
+  options.kind = args.kind == "node"  ? ModelKind::kNodeOnly
+                 : args.kind == "svm" ? ModelKind::kSvm
+                                      : ModelKind::kCrf;
+  options.svm.c = args.svm_c;
+  options.svm.gamma = args.svm_gamma;
+  options.svm.max_training_points = args.svm_max_points;
   options.objective = args.objective == "bethe" ? crf::TrainingObjective::kBetheBp
                       : args.objective == "pl"  ? crf::TrainingObjective::kPseudoLikelihood
                                                 : crf::TrainingObjective::kPiecewise;
@@ -104,7 +111,7 @@ int run(const Arguments& args) {
   options.iterations = args.iterations;
   options.threads = args.threads;
   std::vector<crf::TrainingIteration> curve;
-  if (!args.curve_csv.empty() || !args.curve_png.empty())
+  if (options.kind != ModelKind::kSvm && (!args.curve_csv.empty() || !args.curve_png.empty()))
     options.on_iteration = [&](const crf::TrainingIteration& it) {
       curve.push_back(it);
       char line[256];
@@ -114,12 +121,14 @@ int run(const Arguments& args) {
       say(args, line);
     };
   say(args, "training " + args.kind + " (" +
-                (options.kind == ModelKind::kNodeOnly ? std::string("node-only") : args.objective) +
+                (options.kind == ModelKind::kNodeOnly ? std::string("node-only")
+                 : options.kind == ModelKind::kSvm    ? std::string("libsvm RBF")
+                                                      : args.objective) +
                 ")...");
   pipeline::ModelTrainingResult trained =
       pipeline::train_label_model(train, val, class_ids, features, graph, options);
   LabelModel& model = trained.model;
-  if (options.kind == ModelKind::kCrf) say(args, "couplings: " + model.training.objective);
+  if (options.kind != ModelKind::kNodeOnly) say(args, model.training.objective);
   if (!args.name.empty()) model.name = args.name;
   save_model(args.output, model);
 
@@ -130,11 +139,15 @@ int run(const Arguments& args) {
   }
   if (!args.curve_png.empty()) pipeline::write_curve_png(args.curve_png, curve);
 
+  const std::string how = options.kind == ModelKind::kSvm
+                              ? std::string("libsvm")
+                              : std::to_string(trained.details.iterations) + " iterations (" +
+                                    trained.details.message + ")";
   char line[512];
-  std::snprintf(
-      line, sizeof line, "trained in %.1f s, %d iterations (%s); validation accuracy %s; wrote %s",
-      trained.seconds, trained.details.iterations, trained.details.message.c_str(),
-      val.empty() ? "-" : std::to_string(model.validation.accuracy).c_str(), args.output.c_str());
+  std::snprintf(line, sizeof line, "trained in %.1f s, %s; validation accuracy %s; wrote %s",
+                trained.seconds, how.c_str(),
+                val.empty() ? "-" : std::to_string(model.validation.accuracy).c_str(),
+                args.output.c_str());
   say(args, line);
   return cli::kExitOk;
 }
@@ -142,7 +155,7 @@ int run(const Arguments& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Train a point labeling model (CRF or node-only) from labeled clouds."};
+  CLI::App app{"Train a point labeling model (CRF, node-only or SVM) from labeled clouds."};
   app.name("primlabel-train");
   Arguments args;
   auto* synth_train =
@@ -164,6 +177,13 @@ int main(int argc, char** argv) {
       ->needs(train_files);
   app.add_option("--kind", args.kind, "crf, node (node-only) or svm")
       ->check(CLI::IsMember({"crf", "node", "svm"}));
+  app.add_option("--svm-c", args.svm_c, "SVM: C (default 10)")->check(CLI::PositiveNumber);
+  app.add_option("--svm-gamma", args.svm_gamma,
+                 "SVM: RBF gamma (default 0: 1 / mean squared feature distance)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--svm-max-points", args.svm_max_points,
+                 "SVM: train on at most this many points, a seeded subsample (default 20000)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--objective", args.objective,
                  "CRF objective: piecewise (default: node factors, then a validated coupling), "
                  "pl (pseudo-likelihood) or bethe (loopy BP)")
@@ -198,10 +218,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "primlabel-train: usage error: %s (see --help)\n", e.what());
     return cli::kExitUsage;
   }
-  if (args.kind == "svm") {
+  if (args.kind == "svm" && (!args.curve_csv.empty() || !args.curve_png.empty())) {
     std::fprintf(stderr,
-                 "primlabel-train: usage error: --kind svm: SVM models cannot be saved yet (the "
-                 "SVM baseline has no libsvm text serialisation); see primlabel-eval --table1\n");
+                 "primlabel-train: usage error: --curve and --curve-png need an iterative model "
+                 "(--kind crf or node)\n");
     return cli::kExitUsage;
   }
   try {

@@ -2,11 +2,13 @@
 // message that names the file and the problem.
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <fstream>
 
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/model/label_model.hpp"
+#include "primlabel/v1/model.pb.h"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -38,6 +40,18 @@ LabelModel sample_crf() {
   m.validation.per_class = {{0.99, 0.98, 0.985, 100}, {0.9, 0.8, 0.85, 10}, {0.7, 0.6, 0.65, 5}};
   m.created_unix_ms = 1763776800000;
   m.created_by = "test";
+  return m;
+}
+
+// An SVM over three classes with three support vectors, in libsvm's text format.
+LabelModel sample_svm() {
+  LabelModel m = sample_crf();
+  m.kind = ModelKind::kSvm;
+  m.svm_model =
+      "svm_type c_svc\nkernel_type rbf\ngamma 0.5\nnr_class 3\ntotal_sv 3\nrho 0.1 0.2 0.3\n"
+      "label 0 1 2\nnr_sv 1 1 1\nSV\n1 0.5 1:0.25 7:1 \n-1 0.5 2:0.5 \n-0.5 -1 33:0.125 \n";
+  m.svm_class_ids = m.weights.class_ids;
+  m.weights.feature_scale = 0.02f;
   return m;
 }
 
@@ -77,14 +91,36 @@ TEST(LabelModel, NodeOnlyAndSvmRoundTrip) {
   EXPECT_TRUE(node_back.weights.edge_weights.isZero());
   EXPECT_TRUE(node_back.weights.node_weights == node.weights.node_weights);
 
-  LabelModel svm = sample_crf();
-  svm.kind = ModelKind::kSvm;
-  svm.svm_model = "svm_type c_svc\nkernel_type rbf\n";
-  svm.svm_class_ids = svm.weights.class_ids;
+  const LabelModel svm = sample_svm();
   const LabelModel svm_back = parse_model(serialize_model(svm), "svm");
   EXPECT_EQ(svm_back.kind, ModelKind::kSvm);
   EXPECT_EQ(svm_back.svm_model, svm.svm_model);
   EXPECT_EQ(svm_back.class_ids(), svm.class_ids());
+  EXPECT_EQ(svm_back.weights.feature_scale, 0.02f);
+}
+
+TEST(LabelModel, SvmWithBrokenLibsvmTextIsRefusedOnLoad) {
+  // A file from another writer: valid envelope and checksum, but the libsvm text is cut short.
+  v1::ModelEnvelope envelope;
+  const std::string bytes = serialize_model(sample_svm());
+  ASSERT_TRUE(envelope.ParseFromString(bytes.substr(16)));
+  v1::Model model;
+  ASSERT_TRUE(model.ParseFromString(envelope.model()));
+  const std::string text = model.svm().libsvm_model();
+  model.mutable_svm()->set_libsvm_model(text.substr(0, text.find("\n-1 ") + 1));
+  envelope.set_model(model.SerializeAsString());
+  envelope.set_model_crc32(
+      static_cast<std::uint32_t>(crc32(0L, reinterpret_cast<const Bytef*>(envelope.model().data()),
+                                       static_cast<uInt>(envelope.model().size()))));
+  try {
+    parse_model(bytes.substr(0, 16) + envelope.SerializeAsString(), "cut.plm");
+    FAIL() << "accepted a truncated SVM";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("cut.plm: SVM model: libsvm model, line 10: only 1 of 3 "
+                                         "support vectors (truncated?)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 std::string load_error(const std::string& path) {

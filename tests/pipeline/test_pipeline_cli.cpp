@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "png_decode.hpp"
 #include "primlabel/core/features.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/labeled_cloud.hpp"
@@ -72,6 +73,19 @@ TEST_F(PipelineCli, TrainedModelLoadsAndLabelsWithJsonScores) {
   EXPECT_FALSE(model.class_ids().empty());
 }
 
+TEST_F(PipelineCli, SvmModelTrainsAndEvaluates) {
+  const std::string svm = (*dir_ / "svm.plm").string();
+  const Result trained = run(test::binary("primlabel-train") +
+                             " --synth-train 1 --synth-val 0 --kind svm --svm-max-points 1000 "
+                             "--threads 2 -q -o " +
+                             svm);
+  ASSERT_EQ(trained.exit_code, 0) << trained.output;
+  EXPECT_EQ(load_model(svm).kind, ModelKind::kSvm);
+  const Result r = run(eval() + " --model " + svm + " --json -q --threads 2 " + scene_path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("\"accuracy\":0."), std::string::npos) << r.output;
+}
+
 TEST_F(PipelineCli, WritesPredictedLabelsAndHistogramWithoutTruth) {
   const std::string out = (*dir_ / "labeled.pcd").string();
   const Result r = run(eval() + " --model " + zero_model_path() + " --no-truth -q --out " + out +
@@ -80,6 +94,16 @@ TEST_F(PipelineCli, WritesPredictedLabelsAndHistogramWithoutTruth) {
   EXPECT_NE(r.output.find("predicted labels"), std::string::npos) << r.output;
   const PointCloud labeled = load_labeled_cloud(out);
   EXPECT_TRUE(labeled.has_labels());
+}
+
+TEST_F(PipelineCli, WritesTheConfusionMatrixAsPng) {
+  const std::string png = (*dir_ / "confusion.png").string();
+  const Result r = run(eval() + " --model " + zero_model_path() + " -q --confusion-png " + png +
+                       " " + scene_path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test::Decoded decoded = test::decode_png(png);
+  EXPECT_GT(decoded.width, 200);
+  EXPECT_GT(decoded.distinct_colors(), 4u);
 }
 
 TEST_F(PipelineCli, MissingFileFailsWithOneLine) {
@@ -102,10 +126,14 @@ TEST_F(PipelineCli, CorruptModelFailsWithOneLine) {
 TEST_F(PipelineCli, BadUsageExitsTwo) {
   for (const std::string& command :
        {eval() + " --model", eval() + " --bogus-flag x.pcd", eval() + " x.pcd",
-        eval() + " --table1 --model m.plm",
+        eval() + " --table1 --model m.plm", eval() + " --fig4 out --model m.plm",
+        eval() + " --fig4-scenes 2 --table1", eval() + " --fig4 out --table1",
+        eval() + " --model m.plm --no-truth --confusion-png c.png x.pcd",
+        eval() + " --mosd-report out x.pcd", eval() + " --model m.plm --mosd-report out",
+        eval() + " --model m.plm --mosd-report out --confusion-png c.png x.pcd",
         test::binary("primlabel-train") + " --kind nonsense -o m.plm",
         test::binary("primlabel-train") + " --synth-train 1",
-        test::binary("primlabel-train") + " --kind svm -o m.plm",
+        test::binary("primlabel-train") + " --kind svm --curve c.csv -o m.plm",
         test::binary("primlabel-train") + " --train a.pcd --synth-train 2 -o m.plm"}) {
     const Result r = run(command);
     EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;

@@ -192,13 +192,5 @@ TEST(PipelineLabeling, LabelsOutsideTheModelClassesAreIgnoredInTraining) {
   EXPECT_GT(planes, 0u);
 }
 
-TEST(PipelineLabeling, SvmModelsAreRejectedWithAModelError) {
-  LabelModel svm = zero_model();
-  svm.kind = ModelKind::kSvm;
-  svm.svm_model = "svm_type c_svc";
-  PointCloud cloud = small_scene();
-  EXPECT_THROW(pipeline::label_cloud(svm, cloud), ModelError);
-}
-
 }  // namespace
 }  // namespace primlabel

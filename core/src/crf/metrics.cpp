@@ -57,6 +57,14 @@ void ConfusionMatrix::add(std::span<const std::uint32_t> truth_ids,
   }
 }
 
+void ConfusionMatrix::add(const ConfusionMatrix& other) {
+  if (other.class_ids_ != class_ids_)
+    throw std::invalid_argument("ConfusionMatrix: adding a matrix over other classes");
+  for (std::size_t i = 0; i < counts_.size(); ++i) counts_[i] += other.counts_[i];
+  total_ += other.total_;
+  skipped_ += other.skipped_;
+}
+
 std::uint64_t ConfusionMatrix::count(int truth_index, int predicted_index) const {
   return counts_[std::size_t(truth_index) * (num_classes() + 1) + predicted_index];
 }

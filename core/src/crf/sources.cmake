@@ -13,6 +13,7 @@ target_sources(primlabel_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/bethe_objective.cpp
   ${CMAKE_CURRENT_LIST_DIR}/training.cpp
   ${CMAKE_CURRENT_LIST_DIR}/svm_baseline.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/libsvm_model.cpp
   ${CMAKE_CURRENT_LIST_DIR}/metrics.cpp
 )
 # libsvm (libsvm-dev) for the RBF-SVM baseline.

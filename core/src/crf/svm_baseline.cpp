@@ -12,6 +12,7 @@
 #include <string>
 
 #include "../parallel.hpp"
+#include "libsvm_model.hpp"
 
 namespace primlabel::crf {
 namespace {
@@ -32,16 +33,14 @@ struct SvmClassifier::Impl {
   std::vector<std::uint32_t> class_ids;
   int dim = 0;
   float scale = 0.01f;
-  bool probability = true;
-  std::vector<svm_node> nodes;  // the training rows; the model's support vectors point here
-  std::vector<svm_node*> rows;
-  std::vector<double> targets;
-  svm_parameter param{};
-  svm_model* model = nullptr;
+  std::size_t training_points = 0;
+  std::unique_ptr<detail::LibsvmModel> model;
   std::vector<int> column_of_label;  // libsvm's label order -> our class index
 
-  ~Impl() {
-    if (model) svm_free_and_destroy_model(&model);
+  void set_model(std::unique_ptr<detail::LibsvmModel> m) {
+    model = std::move(m);
+    const svm_model& view = model->model();
+    column_of_label.assign(view.label, view.label + view.nr_class);  // labels: class indices
   }
 };
 
@@ -60,7 +59,6 @@ SvmClassifier SvmClassifier::train(std::span<const LabeledGraph> scenes,
   impl->class_ids = class_ids;
   impl->dim = dim;
   impl->scale = options.feature_scale;
-  impl->probability = options.probability;
 
   // Every usable labelled point, then a seeded subsample kept in data order.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> samples;  // (scene, point)
@@ -87,15 +85,20 @@ SvmClassifier SvmClassifier::train(std::span<const LabeledGraph> scenes,
     std::sort(samples.begin(), samples.end());
   }
 
+  // The training rows; libsvm's model points into them until it is copied below.
+  std::vector<svm_node> nodes;
+  std::vector<svm_node*> rows;
+  std::vector<double> targets;
   std::vector<std::size_t> starts;
   std::vector<svm_node> row;
   for (const auto& [s, i] : samples) {
     to_nodes(scenes[s].descriptors.data() + std::size_t(i) * dim, dim, options.feature_scale, row);
-    starts.push_back(impl->nodes.size());
-    impl->nodes.insert(impl->nodes.end(), row.begin(), row.end());
-    impl->targets.push_back(scenes[s].labels[i]);
+    starts.push_back(nodes.size());
+    nodes.insert(nodes.end(), row.begin(), row.end());
+    targets.push_back(scenes[s].labels[i]);
   }
-  for (std::size_t start : starts) impl->rows.push_back(impl->nodes.data() + start);
+  for (std::size_t start : starts) rows.push_back(nodes.data() + start);
+  impl->training_points = rows.size();
 
   double gamma = options.gamma;
   if (gamma <= 0.0) {
@@ -118,7 +121,7 @@ SvmClassifier SvmClassifier::train(std::span<const LabeledGraph> scenes,
     gamma = mean > 0.0 ? 1.0 / mean : 1.0;
   }
 
-  svm_parameter& param = impl->param;
+  svm_parameter param{};
   param.svm_type = C_SVC;
   param.kernel_type = RBF;
   param.gamma = gamma;
@@ -129,31 +132,58 @@ SvmClassifier SvmClassifier::train(std::span<const LabeledGraph> scenes,
   param.probability = options.probability ? 1 : 0;
   param.nr_weight = 0;
   svm_problem problem;
-  problem.l = static_cast<int>(impl->rows.size());
-  problem.y = impl->targets.data();
-  problem.x = impl->rows.data();
+  problem.l = static_cast<int>(rows.size());
+  problem.y = targets.data();
+  problem.x = rows.data();
   if (const char* error = svm_check_parameter(&problem, &param))
     throw std::invalid_argument(std::string("SVM: ") + error);
   svm_set_print_string_function(&quiet);
   std::srand(options.seed);  // libsvm's probability cross-validation draws from rand()
-  impl->model = svm_train(&problem, &param);
-
-  const int labels = svm_get_nr_class(impl->model);
-  std::vector<int> label_values(labels);
-  svm_get_labels(impl->model, label_values.data());
-  impl->column_of_label = label_values;  // labels are our class indices
+  svm_model* trained = svm_train(&problem, &param);
+  std::unique_ptr<detail::LibsvmModel> copy;
+  try {
+    copy = detail::LibsvmModel::copy_of(*trained);
+  } catch (...) {
+    svm_free_and_destroy_model(&trained);
+    throw;
+  }
+  svm_free_and_destroy_model(&trained);
+  impl->set_model(std::move(copy));
   return SvmClassifier(std::move(impl));
 }
+
+SvmClassifier SvmClassifier::from_libsvm_text(const std::string& text,
+                                              const std::vector<std::uint32_t>& class_ids,
+                                              int descriptor_dim, float feature_scale) {
+  if (class_ids.empty() || descriptor_dim <= 0)
+    throw std::invalid_argument("SVM: no classes or no descriptor");
+  if (!std::isfinite(feature_scale) || feature_scale <= 0.0f)
+    throw std::invalid_argument("SVM: the feature scale must be positive");
+  auto impl = std::make_unique<Impl>();
+  impl->class_ids = class_ids;
+  impl->dim = descriptor_dim;
+  impl->scale = feature_scale;
+  impl->set_model(detail::LibsvmModel::parse(text, descriptor_dim));
+  for (int label : impl->column_of_label)
+    if (label < 0 || label >= static_cast<int>(class_ids.size()))
+      throw std::invalid_argument("libsvm model: label " + std::to_string(label) +
+                                  " is not one of the " + std::to_string(class_ids.size()) +
+                                  " classes");
+  return SvmClassifier(std::move(impl));
+}
+
+std::string SvmClassifier::to_libsvm_text() const { return impl_->model->to_text(); }
 
 SvmPrediction SvmClassifier::predict(std::span<const float> descriptors,
                                      std::uint32_t unknown_label, int threads) const {
   const Impl& m = *impl_;
+  const svm_model* model = &m.model->model();
   const long long n = static_cast<long long>(descriptors.size() / m.dim);
   const int k_count = static_cast<int>(m.class_ids.size());
   SvmPrediction out;
   out.labels.assign(n, unknown_label);
-  if (m.probability) out.probabilities.setZero(n, k_count);
-  const bool with_probability = m.probability && svm_check_probability_model(m.model);
+  out.probabilities.setZero(n, k_count);
+  const bool with_probability = svm_check_probability_model(model);
 #pragma omp parallel num_threads(primlabel::detail::resolve_threads(threads))
   {
     std::vector<svm_node> row;
@@ -162,18 +192,18 @@ SvmPrediction SvmClassifier::predict(std::span<const float> descriptors,
     for (long long i = 0; i < n; ++i) {
       const float* d = descriptors.data() + i * m.dim;
       if (!std::all_of(d, d + m.dim, [](float v) { return std::isfinite(v); })) {
-        if (m.probability)
-          out.probabilities.row(i).setConstant(std::numeric_limits<float>::quiet_NaN());
+        out.probabilities.row(i).setConstant(std::numeric_limits<float>::quiet_NaN());
         continue;
       }
       to_nodes(d, m.dim, m.scale, row);
       double label;
       if (with_probability) {
-        label = svm_predict_probability(m.model, row.data(), estimates.data());
+        label = svm_predict_probability(model, row.data(), estimates.data());
         for (std::size_t c = 0; c < estimates.size(); ++c)
           out.probabilities(i, m.column_of_label[c]) = static_cast<float>(estimates[c]);
       } else {
-        label = svm_predict(m.model, row.data());
+        label = svm_predict(model, row.data());
+        out.probabilities(i, static_cast<int>(label)) = 1.0f;
       }
       out.labels[i] = m.class_ids[static_cast<int>(label)];
     }
@@ -181,10 +211,15 @@ SvmPrediction SvmClassifier::predict(std::span<const float> descriptors,
   return out;
 }
 
-double SvmClassifier::gamma() const { return impl_->param.gamma; }
-std::size_t SvmClassifier::training_points() const { return impl_->rows.size(); }
+double SvmClassifier::gamma() const { return impl_->model->model().param.gamma; }
+float SvmClassifier::feature_scale() const { return impl_->scale; }
+int SvmClassifier::descriptor_dim() const { return impl_->dim; }
+bool SvmClassifier::has_probabilities() const {
+  return svm_check_probability_model(&impl_->model->model()) != 0;
+}
+std::size_t SvmClassifier::training_points() const { return impl_->training_points; }
 std::size_t SvmClassifier::support_vectors() const {
-  return static_cast<std::size_t>(svm_get_nr_sv(impl_->model));
+  return static_cast<std::size_t>(impl_->model->model().l);
 }
 const std::vector<std::uint32_t>& SvmClassifier::class_ids() const { return impl_->class_ids; }
 

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "primlabel/core/taxonomy.hpp"
+#include "primlabel/crf/svm_baseline.hpp"
 #include "primlabel/v1/model.pb.h"
 
 namespace primlabel {
@@ -250,6 +251,12 @@ void LabelModel::validate(const std::string& source) const {
       fail(source, "class id " + std::to_string(id) + " is not in the taxonomy");
   if (kind == ModelKind::kSvm) {
     if (svm_model.empty()) fail(source, "the SVM model is empty");
+    try {
+      crf::SvmClassifier::from_libsvm_text(svm_model, svm_class_ids, features.descriptor_dim(),
+                                           weights.feature_scale);
+    } catch (const std::invalid_argument& e) {
+      fail(source, std::string("SVM model: ") + e.what());
+    }
     return;
   }
   if (weights.descriptor_dim != features.descriptor_dim())

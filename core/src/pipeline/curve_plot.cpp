@@ -1,61 +1,13 @@
-// Training-curve PNG: its own tiny RGB raster (lines, axes) written with libpng.
+// Training-curve PNG: lines and axes on a Raster.
 
 #include "primlabel/pipeline/curve_plot.hpp"
 
-#include <png.h>
-
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <stdexcept>
-#include <vector>
+
+#include "primlabel/render/raster.hpp"
 
 namespace primlabel::pipeline {
-
-namespace {
-
-struct Raster {
-  int width, height;
-  std::vector<std::uint8_t> rgb;
-  Raster(int w, int h) : width(w), height(h), rgb(std::size_t(w) * h * 3, 255) {}
-  void set(int x, int y, std::uint32_t c) {
-    if (x < 0 || y < 0 || x >= width || y >= height) return;
-    std::uint8_t* p = &rgb[(std::size_t(y) * width + x) * 3];
-    p[0] = std::uint8_t(c >> 16), p[1] = std::uint8_t(c >> 8), p[2] = std::uint8_t(c);
-  }
-  // Two pixels thick so the lines survive downscaling in viewers.
-  void line(double x0, double y0, double x1, double y1, std::uint32_t c) {
-    const int steps = int(std::max(std::abs(x1 - x0), std::abs(y1 - y0))) + 1;
-    for (int s = 0; s <= steps; ++s) {
-      const double t = double(s) / steps;
-      const int x = int(std::lround(x0 + t * (x1 - x0))), y = int(std::lround(y0 + t * (y1 - y0)));
-      set(x, y, c), set(x + 1, y, c), set(x, y + 1, c);
-    }
-  }
-};
-
-void write_png(const std::string& path, const Raster& raster) {
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) throw std::runtime_error(path + ": cannot be written");
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!png || !info || setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(file);
-    throw std::runtime_error(path + ": PNG could not be written");
-  }
-  png_init_io(png, file);
-  png_set_IHDR(png, info, raster.width, raster.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < raster.height; ++y)
-    png_write_row(png, raster.rgb.data() + std::size_t(y) * raster.width * 3);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  if (std::fclose(file) != 0) throw std::runtime_error(path + ": cannot be written");
-}
-
-}  // namespace
 
 void write_curve_png(const std::string& path, std::span<const crf::TrainingIteration> curve,
                      int width, int height) {
@@ -85,7 +37,7 @@ void write_curve_png(const std::string& path, std::span<const crf::TrainingItera
                     kCurveValidationRgb);
     }
   }
-  write_png(path, raster);
+  raster.write_png(path);
 }
 
 }  // namespace primlabel::pipeline

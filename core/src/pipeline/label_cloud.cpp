@@ -1,6 +1,7 @@
 // Labeling a cloud with a trained model: optionally downsample to voxels, optionally restrict to
 // the table-top, describe with the model's settings (or allowed overrides), build its graph,
-// infer (CRF or node-only), and carry the results back to every input point.
+// infer (CRF or node-only) or classify point by point (SVM), and carry the results back to every
+// input point.
 
 #include <chrono>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/pipeline/svm_model.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
 #include "primlabel/tabletop/voxel_grid.hpp"
 
@@ -56,6 +58,10 @@ LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& 
   result.feature_seconds = described.normal_seconds + described.feature_seconds;
   result.described_points = cloud.size();
   throw_if_stopped(options.stop, "labeling");
+  if (model.kind == ModelKind::kSvm) {  // point by point: no graph
+    classify_with_svm(model, std::move(described), options, result);
+    return result;
+  }
 
   const auto start = std::chrono::steady_clock::now();
   crf::GraphOptions graph_options = model.graph;
@@ -221,9 +227,6 @@ LabelingResult label_voxels(const LabelModel& model, const FeatureSettings& feat
 
 LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
                            const LabelingOptions& options) {
-  if (model.kind == ModelKind::kSvm)
-    throw ModelError(
-        "SVM models cannot be applied yet: SvmClassifier has no libsvm text deserialisation");
   if (options.use_cloud_normals && cloud.normals.size() != cloud.size())
     throw std::invalid_argument("use_cloud_normals: the cloud has " +
                                 std::to_string(cloud.normals.size()) + " normals for " +

@@ -4,7 +4,11 @@ target_sources(primlabel_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/describe.cpp
   ${CMAKE_CURRENT_LIST_DIR}/label_cloud.cpp
   ${CMAKE_CURRENT_LIST_DIR}/training.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/svm_model.cpp
   ${CMAKE_CURRENT_LIST_DIR}/curve_plot.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/confusion_plot.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/fig4.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/mosd_report.cpp
   ${CMAKE_CURRENT_LIST_DIR}/table1.cpp
 )
 
@@ -17,4 +21,4 @@ add_executable(primlabel-eval
   ${CMAKE_CURRENT_SOURCE_DIR}/apps/eval_main.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/apps/cli_common.cpp)
 target_link_libraries(primlabel-eval PRIVATE primlabel::core CLI11::CLI11)
-target_link_libraries(primlabel_core PRIVATE PNG::PNG)
+

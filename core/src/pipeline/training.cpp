@@ -9,6 +9,7 @@
 
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/pipeline/svm_model.hpp"
 
 namespace primlabel::pipeline {
 
@@ -126,6 +127,10 @@ std::vector<std::uint32_t> classes_present(std::span<const SceneData> scenes) {
 
 std::vector<std::uint32_t> predict_scene(const LabelModel& model, const SceneData& scene,
                                          int threads) {
+  if (model.kind == ModelKind::kSvm)
+    return svm_classifier_of(model)
+        .predict(scene.graph.descriptors, class_id(PrimitiveClass::kUnknown), threads)
+        .labels;
   crf::InferenceOptions inference = model.inference;
   inference.threads = threads;
   inference.unknown_label = class_id(PrimitiveClass::kUnknown);
@@ -151,6 +156,20 @@ EvaluationSummary summarize(const crf::ConfusionMatrix& confusion) {
   return summary;
 }
 
+TrainingSummary summarize_training(std::span<const SceneData> training, std::size_t num_classes) {
+  TrainingSummary summary;
+  for (const SceneData& s : training) {
+    summary.sources.push_back(s.source);
+    summary.points += s.truth.size();
+  }
+  summary.scenes = training.size();
+  summary.class_points.assign(num_classes, 0);
+  for (const SceneData& s : training)
+    for (int label : s.graph.labels)
+      if (label >= 0) ++summary.class_points[std::size_t(label)];
+  return summary;
+}
+
 ModelTrainingResult train_label_model(std::span<const SceneData> training,
                                       std::span<const SceneData> validation,
                                       const std::vector<std::uint32_t>& class_ids,
@@ -158,7 +177,8 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
                                       const crf::GraphOptions& graph,
                                       const ModelTrainingOptions& options) {
   if (options.kind == ModelKind::kSvm)
-    throw std::invalid_argument("train_label_model trains CRF and node-only models only");
+    return train_svm_model(training, validation, class_ids, features, graph, options.svm,
+                           options.threads);
   if (training.empty()) throw std::invalid_argument("no training scenes");
   const std::vector<crf::LabeledGraph> train_graphs = graphs_of(training);
   const std::vector<crf::LabeledGraph> val_graphs = graphs_of(validation);
@@ -192,15 +212,7 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
   m.created_by = "primlabel-train";
 
   TrainingSummary& summary = m.training;
-  for (const SceneData& s : training) {
-    summary.sources.push_back(s.source);
-    summary.points += s.truth.size();
-  }
-  summary.scenes = training.size();
-  summary.class_points.assign(class_ids.size(), 0);
-  for (const SceneData& s : training)
-    for (int label : s.graph.labels)
-      if (label >= 0) ++summary.class_points[std::size_t(label)];
+  summary = summarize_training(training, class_ids.size());
   summary.objective = objective_name(options.kind, options.objective);
   summary.l2 = options.l2;
   summary.iterations = std::uint32_t(out.details.iterations);

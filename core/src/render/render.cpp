@@ -1,56 +1,19 @@
 // A small software rasteriser for point clouds: project, splat with a z-buffer, outline depth
 // discontinuities so shapes read in 3D, draw a title and a legend with the built-in font, and
-// write a PNG with libpng.
+// write a PNG (Raster).
 
 #include "primlabel/render/render.hpp"
 
-#include <png.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <csetjmp>
 #include <cstdio>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
 
-#include "font5x7.hpp"
+#include "primlabel/render/raster.hpp"
 
 namespace primlabel {
 namespace {
-
-using render_detail::glyph;
-using render_detail::kGlyphHeight;
-using render_detail::kGlyphWidth;
-
-struct Image {
-  int width, height;
-  std::vector<std::uint32_t> rgb;  // 0xRRGGBB, row-major
-  void set(int x, int y, std::uint32_t c) {
-    if (x >= 0 && y >= 0 && x < width && y < height) rgb[std::size_t(y) * width + x] = c;
-  }
-  void fill(int x0, int y0, int w, int h, std::uint32_t c) {
-    for (int y = y0; y < y0 + h; ++y)
-      for (int x = x0; x < x0 + w; ++x) set(x, y, c);
-  }
-};
-
-int text_width(const std::string& text, int scale) {
-  return static_cast<int>(text.size()) * (kGlyphWidth + 1) * scale;
-}
-
-void draw_text(Image& image, int x, int y, const std::string& text, std::uint32_t color,
-               int scale) {
-  for (char c : text) {
-    const std::uint8_t* columns = glyph(c);
-    for (int col = 0; col < kGlyphWidth; ++col)
-      for (int row = 0; row < kGlyphHeight; ++row)
-        if (columns[col] >> row & 1)
-          image.fill(x + col * scale, y + row * scale, scale, scale, color);
-    x += (kGlyphWidth + 1) * scale;
-  }
-}
 
 // A view: screen axes (right, up) and viewing direction; perspective from `eye` when set.
 struct Camera {
@@ -120,41 +83,6 @@ Camera make_camera(const PointCloud& cloud, const RenderOptions& options) {
   return camera;
 }
 
-void write_png(const Image& image, const std::string& path) {
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) throw std::runtime_error("cannot write PNG '" + path + "': " + std::strerror(errno));
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!png || !info) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(file);
-    throw std::runtime_error("cannot write PNG '" + path + "': out of memory");
-  }
-  std::vector<png_byte> row(std::size_t(image.width) * 3);
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(file);
-    throw std::runtime_error("cannot write PNG '" + path + "': libpng failed (disk full?)");
-  }
-  png_init_io(png, file);
-  png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      const std::uint32_t c = image.rgb[std::size_t(y) * image.width + x];
-      row[3 * x] = png_byte(c >> 16);
-      row[3 * x + 1] = png_byte(c >> 8);
-      row[3 * x + 2] = png_byte(c);
-    }
-    png_write_row(png, row.data());
-  }
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  if (std::fclose(file) != 0)
-    throw std::runtime_error("cannot write PNG '" + path + "': " + std::strerror(errno));
-}
-
 std::uint32_t scale_color(std::uint32_t c, float f) {
   auto ch = [&](int shift) {
     return std::uint32_t(std::clamp(float((c >> shift) & 0xFF) * f, 0.0f, 255.0f)) << shift;
@@ -172,18 +100,17 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
   if (options.width < 64 || options.height < 64 || options.width > 16384 || options.height > 16384)
     throw std::invalid_argument("render: image size must be 64..16384 pixels a side");
 
-  Image image{options.width, options.height,
-              std::vector<std::uint32_t>(std::size_t(options.width) * options.height,
-                                         options.background & 0xFFFFFF)};
+  Raster image(options.width, options.height, options.background);
+  std::vector<std::uint32_t>& pixels = image.pixels();
   const int text_scale = options.width >= 600 ? 2 : 1;
-  const int line_height = (kGlyphHeight + 4) * text_scale;
+  const int line_height = Raster::text_height(text_scale) + 4 * text_scale;
   const int margin = 6 * text_scale;
 
   // Plot area: below the title, right of the legend column.
   const int title_height = options.title.empty() ? 0 : line_height + 2 * margin;
   int legend_width = 0;
   for (const LegendEntry& entry : options.legend)
-    legend_width = std::max(legend_width, text_width(entry.name, text_scale));
+    legend_width = std::max(legend_width, Raster::text_width(entry.name, text_scale));
   if (!options.legend.empty()) legend_width += 3 * margin + line_height;
   const int plot_x = legend_width + margin, plot_y = title_height + margin;
   const int plot_w = options.width - plot_x - margin, plot_h = options.height - plot_y - margin;
@@ -215,8 +142,8 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
     const float offset_y = plot_y + 0.5f * (plot_h - scale * span_y);
     // Depth in pixel units, so outline strength does not depend on the cloud's size.
     const float depth_scale = camera.perspective ? 1.0f : scale;
-    std::vector<float> zbuffer(image.rgb.size(), INFINITY);
-    std::vector<std::uint32_t> color(image.rgb.size(), 0);
+    std::vector<float> zbuffer(pixels.size(), INFINITY);
+    std::vector<std::uint32_t> color(pixels.size(), 0);
     const int r = std::max(options.point_radius_px, 0);
     for (const Projected& p : projected) {
       const int cx = int(std::lround(offset_x + scale * (p.x - min_x)));
@@ -226,8 +153,8 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
         for (int dx = -r; dx <= r; ++dx) {
           if (dx * dx + dy * dy > r * r + r) continue;  // round splats
           const int x = cx + dx, y = cy + dy;
-          if (x < 0 || y < 0 || x >= image.width || y >= image.height) continue;
-          const std::size_t at = std::size_t(y) * image.width + x;
+          if (x < 0 || y < 0 || x >= image.width() || y >= image.height()) continue;
+          const std::size_t at = std::size_t(y) * image.width() + x;
           if (depth < zbuffer[at]) {
             zbuffer[at] = depth;
             color[at] = point_rgb[p.index] & 0xFFFFFF;
@@ -236,9 +163,9 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
     }
     // Outlines: a pixel behind its neighbourhood's mean depth is at a silhouette or a crease.
     const int ring = 2;
-    for (int y = 0; y < image.height; ++y)
-      for (int x = 0; x < image.width; ++x) {
-        const std::size_t at = std::size_t(y) * image.width + x;
+    for (int y = 0; y < image.height(); ++y)
+      for (int x = 0; x < image.width(); ++x) {
+        const std::size_t at = std::size_t(y) * image.width() + x;
         if (!std::isfinite(zbuffer[at])) continue;
         float sum = 0;
         int n = 0;
@@ -247,8 +174,8 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
           for (int dx = -ring; dx <= ring; dx += ring) {
             if (!dx && !dy) continue;
             const int nx = x + dx, ny = y + dy;
-            if (nx < 0 || ny < 0 || nx >= image.width || ny >= image.height) continue;
-            const float z = zbuffer[std::size_t(ny) * image.width + nx];
+            if (nx < 0 || ny < 0 || nx >= image.width() || ny >= image.height()) continue;
+            const float z = zbuffer[std::size_t(ny) * image.width() + nx];
             if (!std::isfinite(z)) {
               border = true;
               continue;
@@ -258,11 +185,11 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
           }
         float shade = border ? 0.75f : 1.0f;
         if (n) shade *= std::max(0.35f, std::exp(-0.25f * std::max(0.0f, zbuffer[at] - sum / n)));
-        image.rgb[at] = scale_color(color[at], shade);
+        pixels[at] = scale_color(color[at], shade);
       }
   }
 
-  if (!options.title.empty()) draw_text(image, margin, margin, options.title, 0x202020, text_scale);
+  if (!options.title.empty()) image.text(margin, margin, options.title, 0x202020, text_scale);
   if (!options.legend.empty()) {
     const int rows = static_cast<int>(options.legend.size());
     int y = options.height - margin - rows * line_height;
@@ -271,12 +198,12 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
       const int swatch = line_height - 3 * text_scale;
       image.fill(margin, y, swatch, swatch, 0x404040);
       image.fill(margin + 1, y + 1, swatch - 2, swatch - 2, entry.rgb & 0xFFFFFF);
-      draw_text(image, margin + swatch + margin, y + (swatch - kGlyphHeight * text_scale) / 2,
-                entry.name, 0x202020, text_scale);
+      image.text(margin + swatch + margin, y + (swatch - Raster::text_height(text_scale)) / 2,
+                 entry.name, 0x202020, text_scale);
       y += line_height;
     }
   }
-  write_png(image, path);
+  image.write_png(path);
 }
 
 }  // namespace primlabel

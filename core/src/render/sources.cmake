@@ -1,6 +1,8 @@
 # Rendering: a software rasteriser writing PNG (libpng), colourings and legends, and the
 # primlabel-render tool. Included by core/CMakeLists.txt.
 target_sources(primlabel_core PRIVATE
+  ${CMAKE_CURRENT_LIST_DIR}/raster.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/heatmap.cpp
   ${CMAKE_CURRENT_LIST_DIR}/render.cpp
   ${CMAKE_CURRENT_LIST_DIR}/colorize.cpp
 )

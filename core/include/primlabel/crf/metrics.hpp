@@ -28,6 +28,10 @@ class ConfusionMatrix {
   void add(std::span<const std::uint32_t> truth_ids, std::span<const std::uint32_t> predicted_ids,
            std::optional<std::uint32_t> ignore_truth = std::nullopt);
 
+  // Adds another matrix's counts (e.g. over several scenes); throws std::invalid_argument when
+  // its classes differ.
+  void add(const ConfusionMatrix& other);
+
   int num_classes() const { return static_cast<int>(class_ids_.size()); }
   const std::vector<std::uint32_t>& class_ids() const { return class_ids_; }
   // predicted_index == num_classes() is the "other" column.

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "primlabel/crf/training.hpp"
@@ -28,7 +29,7 @@ struct SvmOptions {
 
 struct SvmPrediction {
   std::vector<std::uint32_t> labels;  // class id per point; unknown_label without a descriptor
-  Eigen::MatrixXf probabilities;      // num_points x K (empty without probability outputs)
+  Eigen::MatrixXf probabilities;      // num_points x K, model class order
 };
 
 class SvmClassifier {
@@ -39,13 +40,29 @@ class SvmClassifier {
                              const std::vector<std::uint32_t>& class_ids,
                              const SvmOptions& options = {});
 
+  // A classifier from libsvm's text model format (as to_libsvm_text writes it, or libsvm's
+  // svm_save_model for a C-SVC RBF model whose labels index `class_ids`). gamma travels in the
+  // text; the class ids, descriptor size and feature scale do not. Throws std::invalid_argument
+  // naming the line and the reason when the text is not such a model.
+  static SvmClassifier from_libsvm_text(const std::string& text,
+                                        const std::vector<std::uint32_t>& class_ids,
+                                        int descriptor_dim, float feature_scale);
+
+  // libsvm's text model format, values at full precision: from_libsvm_text of it predicts
+  // bit-identically, and libsvm's svm_load_model reads it.
+  std::string to_libsvm_text() const;
+
   // `descriptors` is row-major points x descriptor_dim; rows that are not finite get
   // `unknown_label` (and NaN probabilities). Parallel over points; same result for any threads.
+  // Without a probability model (or with one class) the probabilities are one-hot.
   SvmPrediction predict(std::span<const float> descriptors, std::uint32_t unknown_label = 0,
                         int threads = 0) const;
 
   double gamma() const;
-  std::size_t training_points() const;
+  float feature_scale() const;
+  int descriptor_dim() const;
+  bool has_probabilities() const;
+  std::size_t training_points() const;  // 0 for a classifier read from text
   std::size_t support_vectors() const;
   const std::vector<std::uint32_t>& class_ids() const;
 

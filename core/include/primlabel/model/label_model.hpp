@@ -70,7 +70,9 @@ struct LabelModel {
   FeatureSettings features;
   crf::GraphOptions graph;
   crf::CrfModel weights;  // kCrf, kNodeOnly (class_ids are the model's classes)
-  std::string svm_model;  // kSvm: libsvm's text model
+  // kSvm: libsvm's text model (crf::SvmClassifier::to_libsvm_text; its labels index
+  // svm_class_ids), the classes, and weights.feature_scale as the SVM's feature scale.
+  std::string svm_model;
   std::vector<std::uint32_t> svm_class_ids;
   crf::InferenceOptions inference;
   TrainingSummary training;
@@ -82,7 +84,8 @@ struct LabelModel {
   const std::vector<std::uint32_t>& class_ids() const {
     return kind == ModelKind::kSvm ? svm_class_ids : weights.class_ids;
   }
-  // Throws ModelError (prefixed with `source`) when the parts do not fit together.
+  // Throws ModelError (prefixed with `source`) when the parts do not fit together (for kSvm: when
+  // the libsvm text does not parse or does not fit the classes and descriptor).
   void validate(const std::string& source = "model") const;
 };
 

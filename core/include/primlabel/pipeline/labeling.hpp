@@ -89,9 +89,9 @@ struct LabelingResult {
 
 // Labels every point with the model's own feature, graph and inference settings (and the
 // overrides in `options`). Points with non-finite coordinates or no descriptor get class 0.
-// Throws ModelError for an SVM model (its libsvm text cannot be loaded into SvmClassifier yet),
-// std::invalid_argument for overrides the model does not allow or missing normals, and
-// Cancelled when options.stop is requested.
+// Throws ModelError when an SVM model's libsvm text does not load, std::invalid_argument for
+// overrides the model does not allow or missing normals, and Cancelled when options.stop is
+// requested.
 LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
                            const LabelingOptions& options = {});
 

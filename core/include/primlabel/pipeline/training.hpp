@@ -10,6 +10,7 @@
 
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/crf/metrics.hpp"
+#include "primlabel/crf/svm_baseline.hpp"
 #include "primlabel/crf/training.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/synth/generate.hpp"
@@ -50,6 +51,7 @@ struct ModelTrainingOptions {
   // the training scenes) best, as pseudo-likelihood overestimates them; and keep instead
   // node-only terms with a calibrated Potts coupling when that validates better (training.cpp).
   bool calibrate_edges = true;
+  crf::SvmOptions svm;  // kSvm
   // Called per iteration with train / validation accuracy (slower: runs inference each time).
   std::function<void(const crf::TrainingIteration&)> on_iteration;
 };
@@ -62,7 +64,10 @@ struct ModelTrainingResult {
   float potts_coupling = 0.0f;  // > 0 when node-only terms + a Potts coupling validated better
 };
 
-// Trains a CRF or node-only model; the scenes' labels must follow `class_ids`. Records the
+// Sources, scene and point counts, and labeled points per class of training scenes.
+TrainingSummary summarize_training(std::span<const SceneData> training, std::size_t num_classes);
+
+// Trains a CRF, node-only or SVM model; the scenes' labels must follow `class_ids`. Records the
 // training summary and, when there are validation scenes, the validation metrics in the model.
 ModelTrainingResult train_label_model(std::span<const SceneData> training,
                                       std::span<const SceneData> validation,
@@ -71,7 +76,7 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
                                       const crf::GraphOptions& graph,
                                       const ModelTrainingOptions& options);
 
-// Predicted taxonomy ids for a described scene with a CRF / node-only model.
+// Predicted taxonomy ids for a described scene.
 std::vector<std::uint32_t> predict_scene(const LabelModel& model, const SceneData& scene,
                                          int threads);
 

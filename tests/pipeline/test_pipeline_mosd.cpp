@@ -1,0 +1,76 @@
+// The mOSD report on a real Kinect scene (../shared/data/mosd; skipped when absent): it labels
+// the scene, counts its table points, and draws it. An untrained all-zero model labels every
+// described point plane, so the share is known up to the points without a descriptor.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "png_decode.hpp"
+#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/core/features.hpp"
+#include "primlabel/pipeline/mosd_report.hpp"
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+std::string mosd(const std::string& name) {
+  return std::string(PRIMLABEL_SHARED_DATA) + "/mosd/" + name + ".pcd";
+}
+
+LabelModel zero_model() {
+  LabelModel model;
+  model.kind = ModelKind::kNodeOnly;
+  model.weights = crf::CrfModel::zeros({1, 2, 4}, kFpfhSize);
+  // Small radii: fast on 300k points; the labels do not matter here.
+  model.features.normals = Neighborhood::Radius(0.008f);
+  model.features.features = Neighborhood::Radius(0.012f);
+  return model;
+}
+
+TEST(PipelineMosd, ReportCountsTablePointsAndDrawsTheScene) {
+  const std::string path = mosd("learn0");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+  test::TempDir dir;
+  pipeline::LabelingOptions options;
+  options.threads = 2;
+  const pipeline::MosdSceneReport scene =
+      pipeline::report_mosd_scene(zero_model(), path, dir.file("learn0.png"), options);
+  EXPECT_GT(scene.table_points, 100000u);  // learn0: 153,323 table points
+  EXPECT_GT(scene.object_points, 10000u);
+  EXPECT_LE(scene.table_points + scene.object_points, scene.points);
+  const double share = scene.plane_share();
+  EXPECT_GE(share, 0.0);
+  EXPECT_LE(share, 1.0);
+  EXPECT_GT(share, 0.9);  // all described points are "plane"
+  EXPECT_EQ(scene.table_predicted[1], scene.table_plane);
+
+  const test::Decoded png = test::decode_png(scene.png);
+  EXPECT_EQ(png.width, 960);
+  EXPECT_EQ(png.height, 720);
+  EXPECT_GT(png.distinct_colors(), 8u);
+
+  const pipeline::MosdReport report = pipeline::summarize_mosd({scene, scene});
+  EXPECT_EQ(report.table_points, 2 * scene.table_points);
+  EXPECT_DOUBLE_EQ(report.plane_share(), share);
+  const std::string json = pipeline::mosd_report_json(report);
+  EXPECT_NE(json.find("\"plane_share\":"), std::string::npos) << json;
+  EXPECT_NE(pipeline::mosd_report_text(report).find("overall"), std::string::npos);
+}
+
+TEST(PipelineMosd, SceneWithoutLabelsIsAClearError) {
+  test::TempDir dir;
+  PointCloud cloud = test::plane_grid(0, 0, 0.1f, 0.01f);
+  write_cloud(dir.file("plain.pcd"), cloud);
+  try {
+    pipeline::report_mosd_scene(zero_model(), dir.file("plain.pcd"), "");
+    FAIL() << "accepted a cloud without labels";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("plain.pcd: no label field"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace primlabel
