@@ -35,9 +35,6 @@ grpc::Status plan_labeling(const v1::ScanHeader& header, const ServiceEnvironmen
   const LabelModel& model = *plan.entry->model;
   const std::string which =
       "model '" + plan.entry->name + "' version '" + plan.entry->version + "'";
-  if (model.kind == ModelKind::kSvm)
-    return {grpc::StatusCode::FAILED_PRECONDITION,
-            which + " is an SVM model, which the server cannot apply yet"};
   const v1::LabelOptions& options = header.options();
   if ((options.normal_radius() > 0.0f || options.feature_radius() > 0.0f) &&
       !model.features.radii_overridable)

@@ -5,6 +5,7 @@
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 
 #include "primlabel/metrics/metrics.hpp"
+#include "primlabel/pipeline/training.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {
@@ -34,6 +35,36 @@ TEST(LabelService, StreamedLabelsMatchLabelCloudInProcess) {
   for (const auto& timing : answer.summary->timings()) stages.push_back(timing.stage());
   EXPECT_EQ(stages, (std::vector<std::string>{"receive", "prefilter", "normals", "features",
                                               "inference", "send"}));
+}
+
+// SVM models (the paper's baseline) are served like CRFs: the same labels as in process.
+TEST(LabelService, SvmModelsLabelAsInProcess) {
+  const FeatureSettings features;
+  const crf::GraphOptions graph;
+  std::vector<std::uint32_t> every_class;
+  for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
+  std::vector<pipeline::SceneData> train;
+  train.push_back(pipeline::prepare_scene(
+      pipeline::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
+      features, graph, every_class, 2));
+  const auto class_ids = pipeline::classes_present(train);
+  pipeline::assign_labels(train.front(), class_ids);
+  pipeline::ModelTrainingOptions options;
+  options.kind = ModelKind::kSvm;
+  options.svm.max_training_points = 1500;
+  options.threads = 2;
+  LabelModel model =
+      pipeline::train_label_model(train, {}, class_ids, features, graph, options).model;
+  model.name = "svm";
+  model.version = "1";
+  TestServer server({model});
+  const PointCloud cloud = table_with_box_cloud(0.01f);
+  const LabelAnswer answer =
+      label_stream(*server.stub, scan_requests(cloud, header_for("svm"), 1000));
+  ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+  EXPECT_EQ(answer.labels, reference_labels(model, cloud));
+  ASSERT_TRUE(answer.summary);
+  EXPECT_GT(answer.summary->points_labeled(), cloud.size() / 2);
 }
 
 TEST(LabelService, DescriptorsProbabilitiesAndSmallResponseChunks) {
