@@ -9,6 +9,7 @@
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/svm_model.hpp"
 #include "primlabel/pipeline/training.hpp"
+#include "small_svm_model.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -26,23 +27,7 @@ PointCloud small_scene() {
   return scene;
 }
 
-LabelModel train_small_svm() {
-  const FeatureSettings features;
-  const crf::GraphOptions graph;
-  std::vector<std::uint32_t> every_class;
-  for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
-  std::vector<pipeline::SceneData> train;
-  train.push_back(pipeline::prepare_scene(
-      pipeline::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
-      features, graph, every_class, 2));
-  const auto class_ids = pipeline::classes_present(train);
-  pipeline::assign_labels(train.front(), class_ids);
-  pipeline::ModelTrainingOptions options;
-  options.kind = ModelKind::kSvm;
-  options.svm.max_training_points = 1500;
-  options.threads = 2;
-  return pipeline::train_label_model(train, {}, class_ids, features, graph, options).model;
-}
+using testing::train_small_svm_model;
 
 // Equal element by element, NaN where the other is NaN.
 bool identical(const Eigen::MatrixXf& a, const Eigen::MatrixXf& b) {
@@ -52,7 +37,7 @@ bool identical(const Eigen::MatrixXf& a, const Eigen::MatrixXf& b) {
 
 // One case, so the training runs once per process.
 TEST(PipelineSvm, TrainedSvmLabelsASceneIdenticallyAfterAFileRoundTrip) {
-  const LabelModel model = train_small_svm();
+  const LabelModel model = train_small_svm_model();
   EXPECT_EQ(model.kind, ModelKind::kSvm);
   EXPECT_NE(model.training.objective.find("svm rbf"), std::string::npos);
   const PointCloud scene = small_scene();

@@ -5,8 +5,8 @@
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 
 #include "primlabel/metrics/metrics.hpp"
-#include "primlabel/pipeline/training.hpp"
 #include "server_test_util.hpp"
+#include "small_svm_model.hpp"
 
 namespace primlabel::servertest {
 namespace {
@@ -39,22 +39,7 @@ TEST(LabelService, StreamedLabelsMatchLabelCloudInProcess) {
 
 // SVM models (the paper's baseline) are served like CRFs: the same labels as in process.
 TEST(LabelService, SvmModelsLabelAsInProcess) {
-  const FeatureSettings features;
-  const crf::GraphOptions graph;
-  std::vector<std::uint32_t> every_class;
-  for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
-  std::vector<pipeline::SceneData> train;
-  train.push_back(pipeline::prepare_scene(
-      pipeline::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
-      features, graph, every_class, 2));
-  const auto class_ids = pipeline::classes_present(train);
-  pipeline::assign_labels(train.front(), class_ids);
-  pipeline::ModelTrainingOptions options;
-  options.kind = ModelKind::kSvm;
-  options.svm.max_training_points = 1500;
-  options.threads = 2;
-  LabelModel model =
-      pipeline::train_label_model(train, {}, class_ids, features, graph, options).model;
+  LabelModel model = testing::train_small_svm_model();
   model.name = "svm";
   model.version = "1";
   TestServer server({model});
