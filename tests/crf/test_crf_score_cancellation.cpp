@@ -46,8 +46,6 @@ TEST(CrfScoreCancellation, AStoppedTokenCancelsEveryScoreLoop) {
   const Graph& graph = f.scene.graph;
   const auto& x = f.scene.descriptors;
   const std::stop_token stop = stopped();
-  EXPECT_THROW(detail::node_scores(f.model, x, graph, 2, stop), Cancelled);
-  EXPECT_THROW(detail::edge_scores(f.model, x, graph, 2, stop), Cancelled);
   ScratchBuffer<std::uint32_t> edge_of, block_first;
   EXPECT_THROW(detail::number_edges(graph, 2, edge_of, block_first, stop), Cancelled);
   const std::size_t edges = detail::number_edges(graph, 2, edge_of, block_first);
@@ -68,15 +66,6 @@ TEST(CrfScoreCancellation, ANeverStoppedTokenGivesTheSameScores) {
   std::stop_source never;
   const std::stop_token token = never.get_token();
   for (int threads : {1, 3}) {
-    const RowMatrixXf nodes = detail::node_scores(f.model, x, graph, 1);
-    const RowMatrixXf nodes_t = detail::node_scores(f.model, x, graph, threads, token);
-    ASSERT_EQ(nodes.size(), nodes_t.size());
-    EXPECT_TRUE(same_bits(nodes.data(), nodes_t.data(), nodes.size()));
-    const RowMatrixXf slots = detail::edge_scores(f.model, x, graph, 1);
-    const RowMatrixXf slots_t = detail::edge_scores(f.model, x, graph, threads, token);
-    ASSERT_EQ(slots.size(), slots_t.size());
-    EXPECT_TRUE(same_bits(slots.data(), slots_t.data(), slots.size()));
-
     ScratchBuffer<std::uint32_t> edge_of, block_first, edge_of_t, block_first_t;
     const std::size_t edges = detail::number_edges(graph, 1, edge_of, block_first);
     ASSERT_EQ(detail::number_edges(graph, threads, edge_of_t, block_first_t, token), edges);

@@ -26,15 +26,6 @@ using RowMatrixXd = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen:
 // The score functions below check `stop` once per block of nodes (or edges), skip the remaining
 // blocks once it is requested and then throw primlabel::Cancelled; an empty token never stops.
 
-// theta_i(k) for every node: num_nodes x K; rows of inactive nodes are zero.
-RowMatrixXf node_scores(const CrfModel& model, std::span<const float> descriptors,
-                        const Graph& graph, int threads, const std::stop_token& stop = {});
-
-// theta_ij(k, k) for every directed slot: num_slots x K (both directions of an edge hold the same
-// row). Zero when the model has no edge terms.
-RowMatrixXf edge_scores(const CrfModel& model, std::span<const float> descriptors,
-                        const Graph& graph, int threads, const std::stop_token& stop = {});
-
 // ---- Padded layouts of the inference fast path ------------------------------------------------
 // Rows of K classes are stored with a stride padded to a multiple of 4 floats, so the per-class
 // loops run on whole SSE/AVX vectors; pad entries are 0 unless stated otherwise.
