@@ -57,8 +57,8 @@ LabelModel quick_model(synth::SensorKind sensor) {
       pipeline::train_label_model(train, {}, class_ids, features, graph, options).model;
   model.kind = ModelKind::kCrf;
   crf::CrfModel& w = model.weights;
-  w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.feature_dim());
-  w.edge_weights.col(w.feature_dim() - 1).setConstant(0.25f);
+  w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.edge_feature_dim());
+  w.edge_weights.col(w.edge_feature_dim() - 1).setConstant(0.25f);
   return model;
 }
 

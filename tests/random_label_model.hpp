@@ -32,7 +32,7 @@ inline LabelModel random_label_model(const std::string& name = "random",
     for (Eigen::Index c = 0; c < model.weights.node_weights.cols(); ++c)
       model.weights.node_weights(r, c) = uniform(rng);
   if (coupling > 0.0f)
-    model.weights.edge_weights.col(model.weights.feature_dim() - 1).setConstant(coupling);
+    model.weights.edge_weights.col(model.weights.edge_feature_dim() - 1).setConstant(coupling);
   model.created_by = "random_label_model";
   return model;
 }

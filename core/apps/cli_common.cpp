@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "primlabel/crf/model.hpp"
+
 namespace primlabel::cli {
 
 Vec3f parse_vec3(const std::string& text) {
@@ -27,6 +29,23 @@ Vec3f parse_vec3(const std::string& text) {
   if (std::getline(in, rest)) throw std::invalid_argument("expected X,Y,Z but got '" + text + "'");
   if (!is_finite(v)) throw std::invalid_argument("'" + text + "' is not a finite position");
   return v;
+}
+
+std::vector<float> node_knots(const std::string& basis, const std::vector<float>& knots) {
+  if (basis == "linear") {
+    if (!knots.empty()) throw std::invalid_argument("--node-knots needs --node-basis tent");
+    return {};
+  }
+  if (knots.empty()) return crf::default_node_knots();
+  if (knots.size() < 2 || knots.size() > std::size_t(crf::kMaxNodeKnots))
+    throw std::invalid_argument("--node-knots: give 2 to " + std::to_string(crf::kMaxNodeKnots) +
+                                " knots");
+  for (std::size_t a = 1; a < knots.size(); ++a)
+    if (!(knots[a] > knots[a - 1]))
+      throw std::invalid_argument("--node-knots: knots must increase (" +
+                                  std::to_string(knots[a - 1]) + " then " +
+                                  std::to_string(knots[a]) + ")");
+  return knots;
 }
 
 ProgressPrinter::ProgressPrinter(bool quiet) : quiet_(quiet), tty_(isatty(STDERR_FILENO) == 1) {}

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "primlabel/core/point_cloud.hpp"
 #include "primlabel/core/progress.hpp"
@@ -17,6 +18,14 @@ inline constexpr int kExitUsage = 2;
 
 // Parses "X,Y,Z" into a vector; throws std::invalid_argument with a readable reason.
 Vec3f parse_vec3(const std::string& text);
+
+// The CRF node feature basis of --node-basis (tent | linear) and --node-knots: the knots given,
+// crf::default_node_knots() for tent without them, nothing for linear. Throws
+// std::invalid_argument for knots with linear or knots that are not increasing.
+std::vector<float> node_knots(const std::string& basis, const std::vector<float>& knots);
+inline constexpr const char* kNodeKnotsHelp =
+    "tent basis knots, scaled units (bin % / 100), comma separated and increasing "
+    "(default 0,0.025,0.05,0.1,0.15,0.25,0.35,0.5,0.7,1)";
 
 // Prints "<stage>: 42% (1234/5678 points)" to stderr once a stage has run for a second:
 // redrawn in place on a terminal, a line per 10% otherwise. Silent when quiet.

@@ -34,6 +34,8 @@ struct Arguments {
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
   bool table1 = false, no_pfh = false, no_svm = false;
+  std::string node_basis = "tent";
+  std::vector<float> node_knots;
   int table1_train = 8, table1_test = 4, pfh_max_neighbors = 40, threads = 0, fig4_scenes = 3;
 };
 
@@ -156,6 +158,7 @@ int table1(const Arguments& args) {
   options.with_pfh = !args.no_pfh;
   options.with_svm = !args.no_svm;
   options.pfh_max_neighbors = args.pfh_max_neighbors;
+  options.node_knots = cli::node_knots(args.node_basis, args.node_knots);
   options.threads = args.threads;
   if (!args.quiet)
     options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
@@ -259,6 +262,13 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->needs(t1);
   app.add_flag("--no-pfh", args.no_pfh, "Table I: FPFH rows only")->needs(t1);
+  app.add_option("--node-basis", args.node_basis,
+                 "Table I: CRF / node-only node features, tent (default) or linear (as the paper)")
+      ->check(CLI::IsMember({"tent", "linear"}))
+      ->needs(t1);
+  app.add_option("--node-knots", args.node_knots, std::string("Table I: ") + cli::kNodeKnotsHelp)
+      ->delimiter(',')
+      ->needs(t1);
   app.add_flag("--no-svm", args.no_svm, "Table I: no SVM rows")->needs(t1);
   app.add_option("--pfh-max-neighbors", args.pfh_max_neighbors,
                  "Table I: PFH uses the M nearest within the feature radius (default 40)")
@@ -281,6 +291,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
     std::fprintf(stderr, "primlabel-eval: usage error: %s (see --help)\n", e.what());
+    return cli::kExitUsage;
+  }
+  try {
+    (void)cli::node_knots(args.node_basis, args.node_knots);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "primlabel-eval: usage error: %s\n", e.what());
     return cli::kExitUsage;
   }
   const bool study = args.table1 || !args.fig4_dir.empty();

@@ -23,9 +23,10 @@ using namespace primlabel;
 struct Arguments {
   int synth_train = 8, synth_val = 1, iterations = 200, graph_k = 8, threads = 0;
   std::string sensor = "lms400", kind = "crf", objective = "piecewise", descriptor = "fpfh";
-  std::string fpfh_variant = "paper";
+  std::string fpfh_variant = "paper", node_basis = "tent";
   double label_radius = synth::kDefaultLabelRadius, l2 = 1e-6, svm_c = 10.0, svm_gamma = 0.0;
   std::size_t svm_max_points = 20000;
+  std::vector<float> node_knots;
   float feature_radius = 0.025f, normal_radius = 0.01f;
   std::vector<std::string> train_files, val_files;
   std::string classes, output, curve_csv, curve_png, name;
@@ -109,6 +110,7 @@ int run(const Arguments& args) {
                                                 : crf::TrainingObjective::kPiecewise;
   options.l2 = args.l2;
   options.iterations = args.iterations;
+  options.node_knots = cli::node_knots(args.node_basis, args.node_knots);
   options.threads = args.threads;
   std::vector<crf::TrainingIteration> curve;
   if (options.kind != ModelKind::kSvm && (!args.curve_csv.empty() || !args.curve_png.empty()))
@@ -193,6 +195,11 @@ int main(int argc, char** argv) {
   app.add_option("--fpfh-variant", args.fpfh_variant,
                  "paper (default: also the point's own SPFH, as Open3D) or pcl (as PCL)")
       ->check(CLI::IsMember({"pcl", "paper"}));
+  app.add_option("--node-basis", args.node_basis,
+                 "CRF / node-only node features: tent (default: a piecewise-linear function of "
+                 "each bin) or linear (the bins themselves, as the paper)")
+      ->check(CLI::IsMember({"tent", "linear"}));
+  app.add_option("--node-knots", args.node_knots, cli::kNodeKnotsHelp)->delimiter(',');
   app.add_option("--l2", args.l2, "L2 regularisation (default 1e-6)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--iterations", args.iterations, "L-BFGS iterations (default 200)")

@@ -1,6 +1,7 @@
 #pragma once
 // Exact marginals, MAP and log-partition of a tiny CRF by enumerating every labelling.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -33,6 +34,34 @@ struct Exact {
   }
 };
 
+// phi(u) of crf/model.hpp written as hat functions (independently of the library's code): knot
+// a's hat rises from t_{a-1} to 1 at t_a and falls to 0 at t_{a+1}; u is clamped to the knots.
+inline double tent(const std::vector<float>& knots, std::size_t a, double u) {
+  u = std::clamp(u, double(knots.front()), double(knots.back()));
+  if (a > 0 && u >= knots[a - 1] && u <= knots[a])
+    return (u - knots[a - 1]) / (double(knots[a]) - knots[a - 1]);
+  if (a + 1 < knots.size() && u >= knots[a] && u <= knots[a + 1])
+    return (double(knots[a + 1]) - u) / (double(knots[a + 1]) - knots[a]);
+  return 0.0;
+}
+
+inline double node_score(const CrfModel& model, const float* descriptor, int c) {
+  const int d = model.descriptor_dim;
+  const double s = model.feature_scale;
+  const auto& knots = model.node_knots;
+  double t = model.node_weights(c, model.node_feature_dim() - 1);
+  for (int f = 0; f < d; ++f) {
+    if (knots.empty()) {
+      t += model.node_weights(c, f) * s * descriptor[f];
+      continue;
+    }
+    for (std::size_t a = 0; a < knots.size(); ++a)
+      t +=
+          model.node_weights(c, f * int(knots.size()) + int(a)) * tent(knots, a, s * descriptor[f]);
+  }
+  return t;
+}
+
 inline Exact brute_force(const CrfModel& model, std::span<const float> descriptors,
                          const Graph& graph) {
   const int k = model.num_classes();
@@ -45,11 +74,7 @@ inline Exact brute_force(const CrfModel& model, std::span<const float> descripto
   e.node_theta.assign(n * k, 0.0);
   e.edge_theta.assign(graph.num_slots() * k, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < k; ++c) {
-      double t = model.node_weights(c, d);
-      for (int f = 0; f < d; ++f) t += model.node_weights(c, f) * s * descriptors[i * d + f];
-      e.node_theta[i * k + c] = t;
-    }
+    for (int c = 0; c < k; ++c) e.node_theta[i * k + c] = node_score(model, &descriptors[i * d], c);
     for (std::uint32_t p = graph.offsets[i]; p < graph.offsets[i + 1]; ++p) {
       const std::uint32_t j = graph.neighbors[p];
       for (int c = 0; c < k; ++c) {

@@ -66,19 +66,23 @@ struct TinyProblem {
 
 TinyProblem tiny_problem(std::size_t n,
                          const std::vector<std::pair<std::uint32_t, std::uint32_t>>& edges,
-                         int classes, std::uint32_t seed, float edge_strength) {
+                         int classes, std::uint32_t seed, float edge_strength,
+                         std::vector<float> node_knots = {}) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
   std::uniform_real_distribution<float> value(0.0f, 100.0f);
   TinyProblem t;
   std::vector<std::uint32_t> ids(classes);
   for (int k = 0; k < classes; ++k) ids[k] = 10 + k;
-  t.model = CrfModel::zeros(ids, 3);
-  for (int k = 0; k < classes; ++k)
+  t.model = CrfModel::zeros(ids, 3, 0.01f, std::move(node_knots));
+  for (int k = 0; k < classes; ++k) {
     for (int f = 0; f < 4; ++f) {
       t.model.node_weights(k, f) = 2.0f * uniform(rng);
       t.model.edge_weights(k, f) = edge_strength * uniform(rng);
     }
+    for (int f = 4; f < t.model.node_feature_dim(); ++f)  // the tent basis has more
+      t.model.node_weights(k, f) = 2.0f * uniform(rng);
+  }
   t.descriptors.resize(n * 3);
   for (float& v : t.descriptors) v = value(rng);
   t.graph = graph_from_edges(n, edges);
@@ -93,6 +97,25 @@ const std::vector<std::pair<std::uint32_t, std::uint32_t>> kLoopy = {{0, 1}, {1,
 TEST(CrfInference, SumProductIsExactOnATree) {
   for (std::uint32_t seed = 1; seed <= 5; ++seed) {
     const TinyProblem t = tiny_problem(7, kTree, 3, seed, 2.0f);
+    const testing::Exact exact = testing::brute_force(t.model, t.descriptors, t.graph);
+    InferenceOptions options;
+    options.compute_marginals = true;
+    options.max_iterations = 200;
+    options.tolerance = 1e-7f;
+    const InferenceResult r = infer(t.model, t.descriptors, t.graph, options);
+    EXPECT_TRUE(r.converged);
+    for (std::size_t i = 0; i < 7; ++i)
+      for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(r.marginals(i, k), exact.marginals[i][k], 2e-5)
+            << "seed " << seed << " node " << i;
+  }
+}
+
+// The tent basis (checked against the test's own hat functions): node scores of the inference
+// path, the sparse one, equal the brute-force ones.
+TEST(CrfInference, SumProductIsExactOnATreeWithTentNodeFeatures) {
+  for (std::uint32_t seed = 1; seed <= 5; ++seed) {
+    const TinyProblem t = tiny_problem(7, kTree, 3, seed, 2.0f, {0.0f, 0.1f, 0.3f, 0.6f, 0.8f});
     const testing::Exact exact = testing::brute_force(t.model, t.descriptors, t.graph);
     InferenceOptions options;
     options.compute_marginals = true;

@@ -59,14 +59,25 @@ LabeledGraph small_scene(std::uint32_t seed, int width = 12, int height = 10) {
   return scene;
 }
 
+// The tent basis the tests use: knots where the synthetic descriptors' scaled values lie.
+const std::vector<float> kKnots = {0.0f, 0.2f, 0.5f, 1.0f};
+
+detail::ParameterShape shape_of(const CrfModel& like, bool edges) {
+  return {like.num_classes(), like.node_feature_dim() - 1, like.descriptor_dim, edges};
+}
+
 TEST(CrfTraining, PseudoLikelihoodAndNodeOnlyGradientsMatchFiniteDifferences) {
   const std::vector<LabeledGraph> scenes = {small_scene(1), small_scene(2)};
-  const auto prepared = detail::prepare_scenes(scenes, 0.01f);
-  for (const bool edges : {true, false}) {
-    detail::ParameterShape shape{3, 5, edges};
-    auto objective = detail::make_pseudo_likelihood(prepared, shape, 2);
-    const Eigen::VectorXd x = random_parameters(shape.size(), 3, 1.0);
-    EXPECT_LT(gradient_error(*objective, x, 1e-5), 1e-7) << (edges ? "PL" : "node-only");
+  for (const auto& knots : {std::vector<float>{}, kKnots}) {
+    const CrfModel like = CrfModel::zeros(ids(3), 5, 0.01f, knots);
+    for (const bool edges : {true, false}) {
+      const auto prepared = detail::prepare_scenes(scenes, like, edges);
+      const detail::ParameterShape shape = shape_of(like, edges);
+      auto objective = detail::make_pseudo_likelihood(prepared, shape, 2);
+      const Eigen::VectorXd x = random_parameters(shape.size(), 3, 1.0);
+      EXPECT_LT(gradient_error(*objective, x, 1e-5), 1e-7)
+          << (edges ? "PL" : "node-only") << ", " << knots.size() << " knots";
+    }
   }
 }
 
@@ -84,22 +95,25 @@ TEST(CrfTraining, BetheObjectiveIsExactOnATree) {
   scene.graph = graph_from_edges(7, tree);
   scene.labels = {0, 0, 1, 2, 2, 1, 0};
   const std::vector<LabeledGraph> scenes = {scene};
-  const auto prepared = detail::prepare_scenes(scenes, 0.01f);
-  const detail::ParameterShape shape{3, 3, true};
-  detail::BpSettings bp;
-  bp.max_iterations = 300;
-  bp.tolerance = 1e-7f;
-  bp.threads = 1;
-  auto objective = detail::make_bethe(prepared, shape, bp);
-  const Eigen::VectorXd x = random_parameters(shape.size(), 11, 1.5);
-  Eigen::VectorXd grad(x.size());
-  const double value_bethe = objective->evaluate(x, grad);
+  for (const auto& knots : {std::vector<float>{}, kKnots}) {
+    const CrfModel like = CrfModel::zeros(ids(3), 3, 0.01f, knots);
+    const auto prepared = detail::prepare_scenes(scenes, like, true);
+    const detail::ParameterShape shape = shape_of(like, true);
+    detail::BpSettings bp;
+    bp.max_iterations = 300;
+    bp.tolerance = 1e-7f;
+    bp.threads = 1;
+    auto objective = detail::make_bethe(prepared, shape, bp);
+    const Eigen::VectorXd x = random_parameters(shape.size(), 11, 1.5);
+    Eigen::VectorXd grad(x.size());
+    const double value_bethe = objective->evaluate(x, grad);
 
-  const CrfModel model = detail::model_from_parameters(x, shape, ids(3), 0.01f);
-  const testing::Exact exact = testing::brute_force(model, scene.descriptors, scene.graph);
-  const double exact_nll = (exact.log_z - exact.score(scene.labels)) / 7.0;
-  EXPECT_NEAR(value_bethe, exact_nll, 1e-4);
-  EXPECT_LT(gradient_error(*objective, x, 1e-4), 2e-3);
+    const CrfModel model = detail::model_from_parameters(x, shape, like);
+    const testing::Exact exact = testing::brute_force(model, scene.descriptors, scene.graph);
+    const double exact_nll = (exact.log_z - exact.score(scene.labels)) / 7.0;
+    EXPECT_NEAR(value_bethe, exact_nll, 1e-4) << knots.size() << " knots";
+    EXPECT_LT(gradient_error(*objective, x, 1e-4), 2e-3) << knots.size() << " knots";
+  }
 }
 
 struct Accuracies {
@@ -189,6 +203,44 @@ TEST(CrfTraining, RejectsInconsistentData) {
   scenes[0].labels[3] = 5;
   EXPECT_THROW(train_crf(scenes, {}, ids(3), {}), std::invalid_argument);
   EXPECT_THROW(train_crf({}, {}, ids(3), {}), std::invalid_argument);
+  TrainingOptions bad_knots;
+  bad_knots.node_knots = {0.0f, 0.5f, 0.5f};
+  const std::vector<LabeledGraph> good = {small_scene(7)};
+  EXPECT_THROW(train_crf(good, {}, ids(3), bad_knots), std::invalid_argument);
+}
+
+// One descriptor value whose class is a band in the middle of its range: a single weight per bin
+// (the paper's linear basis) can only threshold it, a piecewise-linear function can carve it.
+LabeledGraph band_scene(std::uint32_t seed, std::size_t n) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> value(0.0f, 100.0f);
+  LabeledGraph scene;
+  scene.descriptor_dim = 1;
+  scene.graph = graph_from_edges(n, {});
+  for (std::size_t i = 0; i < n; ++i) {
+    const float v = value(rng);
+    scene.descriptors.push_back(v);
+    scene.labels.push_back(v > 30.0f && v < 60.0f ? 1 : 0);
+  }
+  return scene;
+}
+
+TEST(CrfTraining, TentBasisLearnsWhatTheLinearBasisCannot) {
+  const std::vector<LabeledGraph> train = {band_scene(1, 800)};
+  const std::vector<LabeledGraph> test = {band_scene(2, 800)};
+  TrainingOptions options;
+  options.objective = TrainingObjective::kNodeOnly;
+  options.l2 = 1e-6;
+  options.max_iterations = 200;
+  options.node_knots = {};
+  const double linear = labeled_accuracy(train_crf(train, {}, ids(2), options).model, test, {});
+  options.node_knots = {0.0f, 0.2f, 0.4f, 0.6f, 0.8f, 1.0f};
+  const TrainingResult tent = train_crf(train, {}, ids(2), options);
+  EXPECT_EQ(tent.model.node_weights.cols(), 1 * 6 + 1);
+  const double tent_accuracy = labeled_accuracy(tent.model, test, {});
+  std::printf("band: linear basis %.3f, tent basis %.3f\n", linear, tent_accuracy);
+  EXPECT_LT(linear, 0.8);  // about the majority share, 0.7
+  EXPECT_GT(tent_accuracy, 0.93);
 }
 
 }  // namespace

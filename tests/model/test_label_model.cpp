@@ -5,6 +5,7 @@
 #include <zlib.h>
 
 #include <fstream>
+#include <functional>
 
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/model/label_model.hpp"
@@ -119,6 +120,54 @@ TEST(LabelModel, SvmWithBrokenLibsvmTextIsRefusedOnLoad) {
     EXPECT_NE(std::string(e.what()).find("cut.plm: SVM model: libsvm model, line 10: only 1 of 3 "
                                          "support vectors (truncated?)"),
               std::string::npos)
+        << e.what();
+  }
+}
+
+// A file another writer produced: the model message re-encoded under a valid envelope.
+std::string rewrap(const std::string& bytes, const std::function<void(v1::Model&)>& change) {
+  v1::ModelEnvelope envelope;
+  EXPECT_TRUE(envelope.ParseFromString(bytes.substr(16)));
+  v1::Model model;
+  EXPECT_TRUE(model.ParseFromString(envelope.model()));
+  change(model);
+  envelope.set_model(model.SerializeAsString());
+  envelope.set_model_crc32(
+      static_cast<std::uint32_t>(crc32(0L, reinterpret_cast<const Bytef*>(envelope.model().data()),
+                                       static_cast<uInt>(envelope.model().size()))));
+  return bytes.substr(0, 16) + envelope.SerializeAsString();
+}
+
+TEST(LabelModel, TentBasisRoundTripAndMismatchedKnotsAreRefused) {
+  LabelModel saved = sample_crf();
+  saved.weights =
+      crf::CrfModel::zeros(saved.weights.class_ids, kFpfhSize, 0.01f, crf::default_node_knots());
+  saved.weights.node_weights.setRandom();
+  ASSERT_EQ(saved.weights.node_weights.cols(),
+            kFpfhSize * int(crf::default_node_knots().size()) + 1);
+  const std::string bytes = serialize_model(saved);
+  const LabelModel loaded = parse_model(bytes, "tent.plm");
+  EXPECT_EQ(loaded.weights.node_knots, crf::default_node_knots());
+  EXPECT_TRUE(loaded.weights.node_weights == saved.weights.node_weights);
+
+  // One knot dropped: the weights no longer fit the basis.
+  const std::string dropped =
+      rewrap(bytes, [](v1::Model& m) { m.mutable_crf()->mutable_node_knots()->RemoveLast(); });
+  try {
+    parse_model(dropped, "dropped.plm");
+    FAIL() << "accepted weights that do not fit the knots";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("dropped.plm"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("node_weights"), std::string::npos) << e.what();
+  }
+  // Knots out of order.
+  const std::string unordered =
+      rewrap(bytes, [](v1::Model& m) { m.mutable_crf()->set_node_knots(1, 2.0f); });
+  try {
+    parse_model(unordered, "unordered.plm");
+    FAIL() << "accepted knots that do not increase";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("not finite and increasing"), std::string::npos)
         << e.what();
   }
 }

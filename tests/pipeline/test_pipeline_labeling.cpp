@@ -55,8 +55,8 @@ double accuracy(const LabelModel& model, const PointCloud& truth,
 LabelModel with_coupling(LabelModel model, float coupling) {
   model.kind = ModelKind::kCrf;
   crf::CrfModel& w = model.weights;
-  w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.feature_dim());
-  w.edge_weights.col(w.feature_dim() - 1).setConstant(coupling);
+  w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.edge_feature_dim());
+  w.edge_weights.col(w.edge_feature_dim() - 1).setConstant(coupling);
   return model;
 }
 

@@ -36,10 +36,12 @@ class BetheLikelihood final : public Objective {
 
   double evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) override {
     const int k_count = shape_.classes;
-    const int row = shape_.row();
-    const Eigen::Index half = Eigen::Index(k_count) * row;
+    const int row = shape_.node_row();
+    const int edge_row = shape_.edge_row();
+    const int d = shape_.edge_dim;
+    const Eigen::Index half = shape_.node_size();
     const Eigen::Map<const RowMatrixXd> w(x.data(), k_count, row);
-    const Eigen::Map<const RowMatrixXd> v(x.data() + half, k_count, row);
+    const Eigen::Map<const RowMatrixXd> v(x.data() + half, k_count, edge_row);
     const int threads = bp_.threads;
 
     // Log-potentials in double; BP runs on their float images.
@@ -53,17 +55,16 @@ class BetheLikelihood final : public Objective {
       edge_theta[s].setZero(g.num_slots(), k_count);
 #pragma omp parallel num_threads(threads)
       {
-        Eigen::RowVectorXd e(row);
+        Eigen::RowVectorXd e(edge_row);
 #pragma omp for schedule(dynamic, 256)
         for (long long i = 0; i < n; ++i) {
           node_theta[s].row(i).noalias() = scene.features.row(i) * w.transpose();
           for (std::uint32_t p = g.offsets[i]; p < g.offsets[i + 1]; ++p) {
             const std::uint32_t j = g.neighbors[p];
             if (j < i) continue;
-            e.head(shape_.dim) = scene.features.row(i)
-                                     .head(shape_.dim)
-                                     .cwiseProduct(scene.features.row(j).head(shape_.dim));
-            e(shape_.dim) = 1.0;
+            e.head(d) =
+                scene.edge_features.row(i).head(d).cwiseProduct(scene.edge_features.row(j).head(d));
+            e(d) = 1.0;
             edge_theta[s].row(p).noalias() = e * v.transpose();
             edge_theta[s].row(g.reverse[p]) = edge_theta[s].row(p);
           }
@@ -95,7 +96,7 @@ class BetheLikelihood final : public Objective {
 #pragma omp parallel num_threads(threads)
     {
       Eigen::ArrayXd hi(k_count), hj(k_count), a(k_count), c(k_count), psi_m1(k_count);
-      Eigen::RowVectorXd e(row);
+      Eigen::RowVectorXd e(edge_row);
 #pragma omp for schedule(dynamic, 1)
       for (long long b = 0; b < block_count; ++b) {
         const NodeBlock& block = blocks_[b];
@@ -106,7 +107,7 @@ class BetheLikelihood final : public Objective {
         const RowMatrixXd& theta_e = edge_theta[block.scene];
         const LoopyBp& bp = *bps_[block.scene];
         Eigen::Map<RowMatrixXd> grad_w(partial_grad_.col(b).data(), k_count, row);
-        Eigen::Map<RowMatrixXd> grad_v(partial_grad_.col(b).data() + half, k_count, row);
+        Eigen::Map<RowMatrixXd> grad_v(partial_grad_.col(b).data() + half, k_count, edge_row);
         double loss = 0.0;  // -log-likelihood = -(empirical score) - F
         for (long long i = block.first; i < block.first + block.count; ++i) {
           const int yi = scene.labels[i];
@@ -142,9 +143,9 @@ class BetheLikelihood final : public Objective {
             loss -= pair_term;  // log Z ≈ -F, F has +pair_term
             const int yj = scene.labels[j];
             if (yi == yj) loss -= theta_e(p, yi);
-            e.head(shape_.dim) =
-                xi.head(shape_.dim).cwiseProduct(scene.features.row(j).head(shape_.dim));
-            e(shape_.dim) = 1.0;
+            e.head(d) =
+                scene.edge_features.row(i).head(d).cwiseProduct(scene.edge_features.row(j).head(d));
+            e(d) = 1.0;
             for (int k = 0; k < k_count; ++k) {
               const double mu_kk = hi(k) * (psi_m1(k) + 1.0) * hj(k) / z;
               grad_v.row(k) += (mu_kk - (yi == k && yj == k ? 1.0 : 0.0)) * e;

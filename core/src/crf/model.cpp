@@ -14,13 +14,14 @@ std::optional<int> CrfModel::class_index(std::uint32_t id) const {
 }
 
 CrfModel CrfModel::zeros(std::vector<std::uint32_t> class_ids, int descriptor_dim,
-                         float feature_scale) {
+                         float feature_scale, std::vector<float> node_knots) {
   CrfModel m;
   m.class_ids = std::move(class_ids);
   m.descriptor_dim = descriptor_dim;
   m.feature_scale = feature_scale;
-  m.node_weights = Eigen::MatrixXf::Zero(m.num_classes(), descriptor_dim + 1);
-  m.edge_weights = Eigen::MatrixXf::Zero(m.num_classes(), descriptor_dim + 1);
+  m.node_knots = std::move(node_knots);
+  m.node_weights = Eigen::MatrixXf::Zero(m.num_classes(), m.node_feature_dim());
+  m.edge_weights = Eigen::MatrixXf::Zero(m.num_classes(), m.edge_feature_dim());
   m.validate();
   return m;
 }
@@ -32,14 +33,26 @@ void CrfModel::validate() const {
   std::sort(sorted.begin(), sorted.end());
   if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
     throw std::invalid_argument("CRF model: repeated class id");
-  const auto check = [&](const Eigen::MatrixXf& w, const char* what) {
-    if (w.rows() != num_classes() || w.cols() != feature_dim())
-      throw std::invalid_argument(std::string("CRF model: ") + what + " is not K x (d + 1)");
+  if (!node_knots.empty()) {
+    if (node_knots.size() < 2 || node_knots.size() > std::size_t(kMaxNodeKnots))
+      throw std::invalid_argument("CRF model: " + std::to_string(node_knots.size()) +
+                                  " node knots (2.." + std::to_string(kMaxNodeKnots) + " or none)");
+    for (std::size_t a = 0; a < node_knots.size(); ++a)
+      if (!std::isfinite(node_knots[a]) || (a > 0 && !(node_knots[a] > node_knots[a - 1])))
+        throw std::invalid_argument("CRF model: node knots are not finite and increasing (knot " +
+                                    std::to_string(a) + ")");
+  }
+  const auto check = [&](const Eigen::MatrixXf& w, const char* what, int cols) {
+    if (w.rows() != num_classes() || w.cols() != cols)
+      throw std::invalid_argument(std::string("CRF model: ") + what + " is " +
+                                  std::to_string(w.rows()) + " x " + std::to_string(w.cols()) +
+                                  ", not " + std::to_string(num_classes()) + " x " +
+                                  std::to_string(cols));
     if (!w.allFinite())
       throw std::invalid_argument(std::string("CRF model: ") + what + " has a non-finite weight");
   };
-  check(node_weights, "node_weights");
-  check(edge_weights, "edge_weights");
+  check(node_weights, "node_weights", node_feature_dim());
+  check(edge_weights, "edge_weights", edge_feature_dim());
   if (!(feature_scale > 0.0f) || !std::isfinite(feature_scale))
     throw std::invalid_argument("CRF model: feature_scale must be positive");
 }

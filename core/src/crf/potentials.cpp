@@ -5,6 +5,7 @@
 #include <string>
 
 #include "../parallel.hpp"
+#include "node_features.hpp"
 #include "primlabel/core/cancellation.hpp"
 
 namespace primlabel::crf::detail {
@@ -83,14 +84,42 @@ void node_scores_padded(const CrfModel& model, std::span<const float> descriptor
                         const Graph& graph, int threads, float* out, const std::stop_token& stop) {
   const long long n = static_cast<long long>(graph.num_nodes());
   const int d = model.descriptor_dim;
+  const int dim = model.node_feature_dim();
   const int k_count = model.num_classes();
   const int kp = padded_classes(k_count);
-  const float scale = model.feature_scale;
-  const Eigen::MatrixXf weights_t = model.node_weights.transpose();  // (d + 1) x K
   const long long blocks = (n + kNodeBlock - 1) / kNodeBlock;
+  if (!model.node_knots.empty()) {
+    // Tent basis: two non-zero values per bin, so a score row is 2d short axpy's over a padded
+    // transposed weight table instead of a dense product over d * knots values.
+    RowMatrixXf table = RowMatrixXf::Zero(dim, kp);  // node_feature_dim x padded K
+    table.leftCols(k_count) = model.node_weights.transpose();
+    const float* bias = table.row(dim - 1).data();
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (long long b = 0; b < blocks; ++b) {
+      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
+      const long long last = std::min(n, (b + 1) * kNodeBlock);
+      for (long long i = b * kNodeBlock; i < last; ++i) {
+        float* row = out + i * kp;
+        if (!graph.active[i]) {
+          std::fill_n(row, kp, 0.0f);
+          continue;
+        }
+        std::copy_n(bias, kp, row);
+        const float* descriptor = descriptors.data() + i * d;
+        for (int f = 0; f < d; ++f) {
+          const TentPair p = tent_pair(model.feature_scale * descriptor[f], f, model.node_knots);
+          const float* lo = table.data() + std::size_t(p.column) * kp;
+          for (int k = 0; k < kp; ++k) row[k] += p.lower * lo[k] + p.upper * lo[k + kp];
+        }
+      }
+    }
+    throw_if_stopped(stop, kWhat);
+    return;
+  }
+  const Eigen::MatrixXf weights_t = model.node_weights.transpose();  // node_feature_dim x K
 #pragma omp parallel num_threads(threads)
   {
-    RowMatrixXf features(kNodeBlock, d + 1);
+    RowMatrixXf features(kNodeBlock, dim);
     RowMatrixXf scores(kNodeBlock, k_count);
 #pragma omp for schedule(static)
     for (long long b = 0; b < blocks; ++b) {
@@ -99,12 +128,10 @@ void node_scores_padded(const CrfModel& model, std::span<const float> descriptor
       const long long count = std::min(kNodeBlock, n - first);
       for (long long r = 0; r < count; ++r) {
         const long long i = first + r;
-        if (graph.active[i]) {
-          features.row(r).head(d) = scale * ConstRowMap(descriptors.data() + i * d, d);
-          features(r, d) = 1.0f;
-        } else {
+        if (graph.active[i])
+          node_features(model, descriptors.data() + i * d, features.row(r).data());
+        else
           features.row(r).setZero();
-        }
       }
       scores.topRows(count).noalias() = features.topRows(count) * weights_t;
       for (long long r = 0; r < count; ++r) {

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "../parallel.hpp"
+#include "node_features.hpp"
 #include "objectives.hpp"
 
 namespace primlabel::crf {
@@ -22,34 +23,44 @@ constexpr long long kBlockNodes = 512;
 }
 
 CrfModel model_from_parameters(const Eigen::VectorXd& x, const ParameterShape& shape,
-                               const std::vector<std::uint32_t>& class_ids, float feature_scale) {
-  CrfModel model = CrfModel::zeros(class_ids, shape.dim, feature_scale);
-  const Eigen::Index half = Eigen::Index(shape.classes) * shape.row();
+                               const CrfModel& like) {
+  CrfModel model = like;
   model.node_weights =
-      Eigen::Map<const RowMatrixXd>(x.data(), shape.classes, shape.row()).cast<float>();
+      Eigen::Map<const RowMatrixXd>(x.data(), shape.classes, shape.node_row()).cast<float>();
+  model.edge_weights.setZero(shape.classes, shape.edge_row());
   if (shape.edges)
     model.edge_weights =
-        Eigen::Map<const RowMatrixXd>(x.data() + half, shape.classes, shape.row()).cast<float>();
+        Eigen::Map<const RowMatrixXd>(x.data() + shape.node_size(), shape.classes, shape.edge_row())
+            .cast<float>();
   return model;
 }
 
 std::vector<PreparedScene> prepare_scenes(std::span<const LabeledGraph> scenes,
-                                          float feature_scale) {
+                                          const CrfModel& like, bool edge_features) {
   std::vector<PreparedScene> prepared(scenes.size());
+  const int d = like.descriptor_dim;
   for (std::size_t s = 0; s < scenes.size(); ++s) {
     const LabeledGraph& in = scenes[s];
     PreparedScene& out = prepared[s];
     const long long n = static_cast<long long>(in.graph.num_nodes());
-    const int d = in.descriptor_dim;
+    const bool compact = !edge_features && !like.node_knots.empty();
     out.graph = &in.graph;
-    out.features.setZero(n, d + 1);
+    if (compact)
+      out.tents.assign(std::size_t(n) * d, TentPair{0, 0.0f, 0.0f});
+    else
+      out.features.setZero(n, like.node_feature_dim());
+    if (edge_features) out.edge_features.setZero(n, like.edge_feature_dim());
     out.labels.assign(n, kIgnoreLabel);
     for (long long i = 0; i < n; ++i) {
       if (!in.graph.active[i]) continue;
-      out.features.row(i).head(d) =
-          feature_scale *
-          Eigen::Map<const Eigen::RowVectorXf>(in.descriptors.data() + i * d, d).cast<double>();
-      out.features(i, d) = 1.0;
+      const float* descriptor = in.descriptors.data() + i * d;
+      if (compact)
+        tent_pairs(descriptor, d, like.feature_scale, like.node_knots,
+                   &out.tents[std::size_t(i) * d]);
+      else
+        node_features(like, descriptor, out.features.row(i).data());
+      if (edge_features)
+        node_features(descriptor, d, like.feature_scale, {}, out.edge_features.row(i).data());
       out.labels[i] = in.labels[i];
     }
   }
@@ -95,8 +106,12 @@ class Problem {
   Problem(detail::Objective& objective, const detail::ParameterShape& shape, double l2)
       : objective_(objective), shape_(shape), l2_(l2) {
     regularised_ = Vector::Ones(shape.size());
-    for (Eigen::Index r = 0; r < shape.size() / shape.row(); ++r)
-      regularised_((r + 1) * shape.row() - 1) = 0.0;  // biases are free
+    // Biases (the last column of W and of V) are free.
+    for (int k = 0; k < shape.classes; ++k) {
+      regularised_((k + 1) * Eigen::Index(shape.node_row()) - 1) = 0.0;
+      if (shape.edges)
+        regularised_(shape.node_size() + (k + 1) * Eigen::Index(shape.edge_row()) - 1) = 0.0;
+    }
   }
 
   double operator()(const Vector& x, Vector& grad) {
@@ -185,14 +200,16 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
   const int threads = detail::useful_threads(options.threads, total_nodes);
   const auto started = std::chrono::steady_clock::now();
 
+  // The zero model fixes the shapes (and checks the scale and knots).
+  const CrfModel like = CrfModel::zeros(class_ids, dim, options.feature_scale, options.node_knots);
   detail::ParameterShape shape;
   shape.classes = classes;
-  shape.dim = dim;
+  shape.node_dim = like.node_feature_dim() - 1;
+  shape.edge_dim = dim;
   shape.edges = options.objective != TrainingObjective::kNodeOnly &&
                 options.objective != TrainingObjective::kPiecewise;
 
-  std::vector<detail::PreparedScene> scenes =
-      detail::prepare_scenes(training, options.feature_scale);
+  std::vector<detail::PreparedScene> scenes = detail::prepare_scenes(training, like, shape.edges);
   std::vector<Graph> restricted;  // Bethe: the graph over the labelled nodes only
   std::unique_ptr<detail::Objective> objective;
   if (options.objective == TrainingObjective::kBetheBp) {
@@ -228,8 +245,7 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
     it.objective = fx;
     it.validation_accuracy = std::numeric_limits<double>::quiet_NaN();
     if (options.on_iteration) {
-      const CrfModel model =
-          detail::model_from_parameters(x, shape, class_ids, options.feature_scale);
+      const CrfModel model = detail::model_from_parameters(x, shape, like);
       it.train_accuracy = labeled_accuracy(model, training, inference);
       if (!validation.empty())
         it.validation_accuracy = labeled_accuracy(model, validation, inference);
@@ -270,8 +286,7 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
     result.message = std::string("line search failed: ") + e.what();
   }
   result.objective = problem.best_fx();
-  result.model =
-      detail::model_from_parameters(problem.best_x(), shape, class_ids, options.feature_scale);
+  result.model = detail::model_from_parameters(problem.best_x(), shape, like);
   return result;
 }
 

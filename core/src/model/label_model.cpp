@@ -117,6 +117,7 @@ v1::Model to_proto(const LabelModel& m) {
     to_proto(m.weights.node_weights, w->mutable_node_weights());
     if (m.kind == ModelKind::kCrf) to_proto(m.weights.edge_weights, w->mutable_edge_weights());
     w->set_feature_scale(m.weights.feature_scale);
+    w->mutable_node_knots()->Assign(m.weights.node_knots.begin(), m.weights.node_knots.end());
   }
 
   v1::InferenceParameters* inf = out.mutable_inference();
@@ -208,11 +209,12 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
     m.weights.class_ids = ids;
     m.weights.descriptor_dim = m.features.descriptor_dim();
     m.weights.feature_scale = in.crf().feature_scale();
+    m.weights.node_knots.assign(in.crf().node_knots().begin(), in.crf().node_knots().end());
     m.weights.node_weights = from_proto(in.crf().node_weights(), source, "node weights");
     m.weights.edge_weights =
         m.kind == ModelKind::kCrf
             ? from_proto(in.crf().edge_weights(), source, "edge weights")
-            : Eigen::MatrixXf::Zero(m.weights.node_weights.rows(), m.weights.node_weights.cols());
+            : Eigen::MatrixXf::Zero(m.weights.node_weights.rows(), m.weights.edge_feature_dim());
   }
 
   const v1::InferenceParameters& inf = in.inference();

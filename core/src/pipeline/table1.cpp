@@ -77,6 +77,7 @@ std::vector<Table1Row> rows_for(const FeatureSettings& features, const std::stri
     training.kind = kind;
     training.l2 = options.l2;
     training.iterations = options.iterations;
+    training.node_knots = options.node_knots;
     training.threads = options.threads;
     const ModelTrainingResult trained =
         train_label_model(train, {}, class_ids, features, graph, training);

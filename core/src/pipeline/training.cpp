@@ -58,13 +58,13 @@ Calibration calibrate_potts_coupling(LabelModel& model, std::span<const SceneDat
   float best_coupling = 0.0f;
   double best_accuracy = -1.0;
   for (float beta : kCouplings) {
-    w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.feature_dim());
-    w.edge_weights.col(w.feature_dim() - 1).setConstant(beta);
+    w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.edge_feature_dim());
+    w.edge_weights.col(w.edge_feature_dim() - 1).setConstant(beta);
     const double accuracy = evaluate_scenes(model, scenes, threads).accuracy();
     if (accuracy > best_accuracy) best_accuracy = accuracy, best_coupling = beta;
   }
-  w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.feature_dim());
-  w.edge_weights.col(w.feature_dim() - 1).setConstant(best_coupling);
+  w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.edge_feature_dim());
+  w.edge_weights.col(w.edge_feature_dim() - 1).setConstant(best_coupling);
   return {best_coupling, best_accuracy};
 }
 
@@ -189,6 +189,7 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
   training_options.l2 = options.l2;
   training_options.max_iterations = options.iterations;
   training_options.threads = options.threads;
+  training_options.node_knots = options.node_knots;
   training_options.inference.threads = options.threads;
   training_options.on_iteration = options.on_iteration;
 

@@ -56,6 +56,8 @@ struct TrainingOptions {
   double epsilon = 1e-5;  // stop when |gradient| <= epsilon * max(1, |weights|)
   int threads = 0;        // 0 = OpenMP default; the model does not depend on it
   float feature_scale = 0.01f;
+  // The node feature basis (crf/model.hpp): tent knots, or empty for the paper's identity.
+  std::vector<float> node_knots = default_node_knots();
   // BP used by kBetheBp (sum-product) and to measure accuracies for on_iteration.
   InferenceOptions inference;
   // Called after every L-BFGS iteration with accuracies measured by inference; when empty, no

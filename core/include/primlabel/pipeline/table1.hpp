@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "primlabel/crf/model.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/synth/generate.hpp"
 
@@ -28,6 +29,8 @@ struct Table1Options {
   int pfh_max_neighbors = 40;
   int iterations = 200;
   double l2 = 1e-6;
+  // CRF and node-only node features: tent knots (crf/model.hpp), empty for the paper's identity.
+  std::vector<float> node_knots = crf::default_node_knots();
   bool with_pfh = true;
   bool with_svm = true;
   int threads = 0;

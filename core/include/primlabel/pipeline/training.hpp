@@ -47,6 +47,8 @@ struct ModelTrainingOptions {
   double l2 = 1e-6;
   int iterations = 200;
   int threads = 0;
+  // CRF and node-only: the tent basis of the node features (crf/model.hpp); empty = identity.
+  std::vector<float> node_knots = crf::default_node_knots();
   // CRF: scale the learnt couplings down to what labels the validation scenes (or, without them,
   // the training scenes) best, as pseudo-likelihood overestimates them; and keep instead
   // node-only terms with a calibrated Potts coupling when that validates better (training.cpp).
