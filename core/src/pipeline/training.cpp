@@ -224,7 +224,7 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
       training_options.objective == crf::TrainingObjective::kPiecewise) {
     // Node factors trained alone; the coupling is the one edge factor, chosen on validation.
     // With one uniform coupling, mean-field labels like loopy BP (97.92% both on the default test
-    // scenes) at about three times the speed, so such models infer with it.
+    // scenes, linear node basis) at about three times the speed, so such models infer with it.
     m.inference.method = crf::InferenceMethod::kMeanField;
     const Calibration coupling = calibrate_potts_coupling(m, calibration, options.threads);
     out.potts_coupling = coupling.value;
