@@ -76,4 +76,10 @@ struct NodeBlock {
 };
 std::vector<NodeBlock> node_blocks(const std::vector<PreparedScene>& scenes);
 
+// The objective from per-block partial results (one gradient column and loss per block), added in
+// block order, not thread order, so it is identical for any thread count; divided by the number
+// of labelled points. Writes `gradient`, returns the value.
+double sum_blocks(const Eigen::MatrixXd& partial_grad, const Eigen::VectorXd& partial_loss,
+                  std::size_t labelled, Eigen::VectorXd& gradient);
+
 }  // namespace primlabel::crf::detail

@@ -31,16 +31,7 @@ class PseudoLikelihood final : public Objective {
       evaluate_blocks_with_edges(x);
     else
       evaluate_blocks_node_only(x);
-    // Block order, not thread order: identical for any thread count.
-    gradient.setZero(x.size());
-    double loss = 0.0;
-    for (long long b = 0; b < block_count; ++b) {
-      gradient += partial_grad_.col(b);
-      loss += partial_loss_(b);
-    }
-    const double scale = labelled_ > 0 ? 1.0 / double(labelled_) : 0.0;
-    gradient *= scale;
-    return loss * scale;
+    return sum_blocks(partial_grad_, partial_loss_, labelled_, gradient);
   }
 
  private:

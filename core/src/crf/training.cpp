@@ -77,6 +77,19 @@ std::vector<NodeBlock> node_blocks(const std::vector<PreparedScene>& scenes) {
   return blocks;
 }
 
+double sum_blocks(const Eigen::MatrixXd& partial_grad, const Eigen::VectorXd& partial_loss,
+                  std::size_t labelled, Eigen::VectorXd& gradient) {
+  gradient.setZero(partial_grad.rows());
+  double loss = 0.0;
+  for (Eigen::Index b = 0; b < partial_grad.cols(); ++b) {
+    gradient += partial_grad.col(b);
+    loss += partial_loss(b);
+  }
+  const double scale = labelled > 0 ? 1.0 / double(labelled) : 0.0;
+  gradient *= scale;
+  return loss * scale;
+}
+
 }  // namespace detail
 
 namespace {
