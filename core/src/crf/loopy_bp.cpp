@@ -226,12 +226,7 @@ BpRun LoopyBp::run(const RowMatrixXd& phi, const RowMatrixXf& psi_minus_one,
                                 settings.max_product};
     const float max_change = update_all_dispatch(context, num_classes_, settings.threads);
     messages_.swap(next_);
-    report.iterations = iteration;
-    report.final_change = max_change;
-    if (max_change < settings.tolerance) {
-      report.converged = true;
-      break;
-    }
+    if (report.record(iteration, max_change, settings.tolerance)) break;
   }
   return report;
 }
@@ -496,12 +491,8 @@ BpRun run_fast_bp(const FastBpProblem& problem, const BpSettings& settings,
     const float change = fast_update_dispatch(it, settings.threads);
     std::swap(buffers.messages, buffers.next);
     std::swap(moved_a, moved_b);
-    report.iterations = iteration;
-    report.final_change = change;
-    if (iteration > 1 && change < settings.tolerance) {
-      report.converged = true;
-      break;
-    }
+    // The first sweep reads no message and reports no change (0), so it cannot converge.
+    if (report.record(iteration, change, iteration > 1 ? settings.tolerance : 0.0f)) break;
   }
   if (report.iterations == 0) {
     // No iteration: the messages are the uniform start.

@@ -32,6 +32,14 @@ struct BpRun {
   int iterations = 0;
   bool converged = false;
   float final_change = 0.0f;
+
+  // Records an iteration's largest change; true (converged) once it is below the tolerance.
+  bool record(int iteration, float change, float tolerance) {
+    iterations = iteration;
+    final_change = change;
+    converged = change < tolerance;
+    return converged;
+  }
 };
 
 // phi_i(k) = exp(theta_i(k) - max_k theta_i(k)): num_nodes x K, max 1 per row.

@@ -117,12 +117,7 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, MeanFieldBuffe
     std::swap(q_buf, next_buf);
     std::swap(q, next);
     std::swap(moved_before, moved);
-    report.iterations = iteration;
-    report.final_change = max_change;
-    if (max_change < settings.tolerance) {
-      report.converged = true;
-      break;
-    }
+    if (report.record(iteration, max_change, settings.tolerance)) break;
   }
   return report;
 }
