@@ -3,7 +3,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <stop_token>
 
+#include "primlabel/core/cancellation.hpp"
 #include "primlabel/crf/svm_baseline.hpp"
 #include "synthetic.hpp"
 #include "test_util.hpp"
@@ -84,6 +86,21 @@ TEST(CrfSvm, LibsvmTextRoundTripPredictsIdentically) {
   EXPECT_TRUE(before.probabilities == after.probabilities);
   // Not trivially separable: the round trip is tested on uncertain points too.
   EXPECT_LT(before.probabilities.rowwise().maxCoeff().minCoeff(), 0.9f);
+}
+
+TEST(CrfSvm, AStopRequestCancelsPrediction) {
+  const NoisyProblem p = noisy_problem();
+  std::stop_source never;
+  const SvmPrediction plain = p.svm.predict(p.test.descriptors, 0, 2);
+  EXPECT_EQ(p.svm.predict(p.test.descriptors, 0, 2, never.get_token()).labels, plain.labels);
+  std::stop_source stopped;
+  stopped.request_stop();
+  try {
+    p.svm.predict(p.test.descriptors, 0, 2, stopped.get_token());
+    FAIL() << "a stopped prediction returned labels";
+  } catch (const Cancelled& e) {
+    EXPECT_STREQ(e.what(), "SVM prediction cancelled");
+  }
 }
 
 TEST(CrfSvm, LibsvmReadsOurTextAndWeReadLibsvms) {

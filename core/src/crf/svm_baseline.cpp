@@ -13,6 +13,7 @@
 
 #include "../parallel.hpp"
 #include "libsvm_model.hpp"
+#include "primlabel/core/cancellation.hpp"
 
 namespace primlabel::crf {
 namespace {
@@ -175,7 +176,8 @@ SvmClassifier SvmClassifier::from_libsvm_text(const std::string& text,
 std::string SvmClassifier::to_libsvm_text() const { return impl_->model->to_text(); }
 
 SvmPrediction SvmClassifier::predict(std::span<const float> descriptors,
-                                     std::uint32_t unknown_label, int threads) const {
+                                     std::uint32_t unknown_label, int threads,
+                                     const std::stop_token& stop) const {
   const Impl& m = *impl_;
   const svm_model* model = &m.model->model();
   const long long n = static_cast<long long>(descriptors.size() / m.dim);
@@ -190,6 +192,7 @@ SvmPrediction SvmClassifier::predict(std::span<const float> descriptors,
     std::vector<double> estimates(m.column_of_label.size());
 #pragma omp for schedule(dynamic, 64)
     for (long long i = 0; i < n; ++i) {
+      if (stop.stop_requested()) continue;  // cancelled: skip the remaining points
       const float* d = descriptors.data() + i * m.dim;
       if (!std::all_of(d, d + m.dim, [](float v) { return std::isfinite(v); })) {
         out.probabilities.row(i).setConstant(std::numeric_limits<float>::quiet_NaN());
@@ -208,6 +211,7 @@ SvmPrediction SvmClassifier::predict(std::span<const float> descriptors,
       out.labels[i] = m.class_ids[static_cast<int>(label)];
     }
   }
+  throw_if_stopped(stop, "SVM prediction");
   return out;
 }
 

@@ -74,8 +74,8 @@ void classify_with_svm(const LabelModel& model, DescribedCloud&& described,
                        const LabelingOptions& options, LabelingResult& result) {
   const auto start = std::chrono::steady_clock::now();
   const crf::SvmClassifier svm = svm_classifier_of(model);
-  crf::SvmPrediction predicted =
-      svm.predict(described.descriptors, class_id(PrimitiveClass::kUnknown), options.threads);
+  crf::SvmPrediction predicted = svm.predict(
+      described.descriptors, class_id(PrimitiveClass::kUnknown), options.threads, options.stop);
   result.class_ids = model.class_ids();
   result.labels = std::move(predicted.labels);
   if (options.want_probabilities) result.probabilities = std::move(predicted.probabilities);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <stop_token>
 #include <string>
 #include <vector>
 
@@ -54,9 +55,11 @@ class SvmClassifier {
 
   // `descriptors` is row-major points x descriptor_dim; rows that are not finite get
   // `unknown_label` (and NaN probabilities). Parallel over points; same result for any threads.
-  // Without a probability model (or with one class) the probabilities are one-hot.
+  // Without a probability model (or with one class) the probabilities are one-hot. Once `stop` is
+  // requested the remaining points are skipped and primlabel::Cancelled is thrown (an RBF SVM
+  // labels only ~35k points/s, so a large cloud would otherwise run on for minutes).
   SvmPrediction predict(std::span<const float> descriptors, std::uint32_t unknown_label = 0,
-                        int threads = 0) const;
+                        int threads = 0, const std::stop_token& stop = {}) const;
 
   double gamma() const;
   float feature_scale() const;
