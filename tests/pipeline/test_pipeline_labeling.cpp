@@ -86,6 +86,8 @@ double majority_fraction(const PointCloud& cloud) {
 TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRoundTrip) {
   const Trained trained = train_on_two_scenes();
   const LabelModel& model = trained.model;
+  // Trained with the default tent node basis, so its sparse scoring path is what runs below.
+  ASSERT_EQ(model.weights.node_knots, crf::default_node_knots());
 
   // Node-only, with probabilities: far above chance (the majority class, the table, ~60%).
   PointCloud cloud = trained.test_scene;
