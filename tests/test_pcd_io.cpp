@@ -3,36 +3,27 @@
 
 #include <gtest/gtest.h>
 
-#include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <string>
 #include <vector>
 
-#include "allocation_guard.hpp"
+#include "cloud_io_test_util.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
 namespace {
 
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-constexpr float kInf = std::numeric_limits<float>::infinity();
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  ASSERT_TRUE(out.good()) << path;
-}
-
-template <typename T>
-void put(std::string& out, T value) {
-  out.append(reinterpret_cast<const char*>(&value), sizeof value);
-}
+using test::awkward_cloud;
+using test::expect_same_attributes;
+using test::kInf;
+using test::kNaN;
+using test::MalformedFile;
+using test::put;
+using test::write_bytes;
 
 // A valid LZF stream made only of literal runs (control byte n < 32 copies n + 1 bytes), so the
 // tests can build binary_compressed files without linking liblzf.
@@ -54,63 +45,6 @@ std::string compressed_payload(const std::string& planes) {
   return out + lzf;
 }
 
-bool same_float(float a, float b) {
-  return (std::isnan(a) && std::isnan(b)) ||
-         std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b);
-}
-
-void expect_same_floats(const float* a, const float* b, std::size_t n, const std::string& what) {
-  for (std::size_t i = 0; i < n; ++i)
-    ASSERT_TRUE(same_float(a[i], b[i])) << what << "[" << i << "]: " << a[i] << " vs " << b[i];
-}
-
-// An organised 4x3 cloud with invalid (NaN) pixels and awkward float values in every attribute.
-PointCloud awkward_cloud() {
-  const float specials[] = {0.1f,          -0.0f, 1e-40f /* subnormal */,
-                            3.4028235e38f, -kInf, 1.17549435e-38f,
-                            123456.789f,   1e-7f, 3.14159265f};
-  PointCloud cloud;
-  cloud.width = 4;
-  cloud.height = 3;
-  for (int i = 0; i < 12; ++i) {
-    const float s = specials[i % 9];
-    const bool invalid = i == 1 || i == 6 || i == 11;
-    cloud.xyz.push_back(invalid ? Vec3f(kNaN, kNaN, kNaN) : Vec3f(s, -s * 0.5f, 1.0f + i));
-    cloud.normals.push_back(invalid ? Vec3f(kNaN, kNaN, kNaN) : Vec3f(0.6f, -0.8f, s));
-    cloud.curvature.push_back(invalid ? kNaN : s);
-    cloud.labels.push_back(i == 0 ? 0u : i == 5 ? 0xffffffffu : static_cast<std::uint32_t>(i * 7));
-    cloud.rgba.push_back(i == 3 ? 0xffffffffu : 0xff102030u + static_cast<std::uint32_t>(i));
-  }
-  FloatField& fpfh = cloud.set_field("fpfh", 33);
-  for (std::size_t v = 0; v < fpfh.values.size(); ++v)
-    fpfh.values[v] = v % 17 == 0 ? kNaN : static_cast<float>(v) / 7.0f;
-  FloatField& intensity = cloud.set_field("intensity", 1);
-  for (std::size_t v = 0; v < intensity.values.size(); ++v) intensity.values[v] = specials[v % 9];
-  cloud.viewpoint.origin = Vec3f(0.25f, -1.5f, 3.0f);
-  cloud.viewpoint.orientation = Eigen::Quaternionf(0.5f, 0.5f, -0.5f, 0.5f);
-  return cloud;
-}
-
-void expect_same_attributes(const PointCloud& a, const PointCloud& b) {
-  ASSERT_EQ(a.size(), b.size());
-  expect_same_floats(a.xyz.data()->data(), b.xyz.data()->data(), 3 * a.size(), "xyz");
-  ASSERT_EQ(a.normals.size(), b.normals.size());
-  if (a.has_normals())
-    expect_same_floats(a.normals.data()->data(), b.normals.data()->data(), 3 * a.size(), "normal");
-  ASSERT_EQ(a.curvature.size(), b.curvature.size());
-  expect_same_floats(a.curvature.data(), b.curvature.data(), a.curvature.size(), "curvature");
-  EXPECT_EQ(a.labels, b.labels);
-  EXPECT_EQ(a.rgba, b.rgba);
-  ASSERT_EQ(a.fields.size(), b.fields.size());
-  for (std::size_t f = 0; f < a.fields.size(); ++f) {
-    EXPECT_EQ(a.fields[f].name, b.fields[f].name);
-    EXPECT_EQ(a.fields[f].count, b.fields[f].count);
-    ASSERT_EQ(a.fields[f].values.size(), b.fields[f].values.size());
-    expect_same_floats(a.fields[f].values.data(), b.fields[f].values.data(),
-                       a.fields[f].values.size(), a.fields[f].name);
-  }
-}
-
 void expect_same_cloud(const PointCloud& a, const PointCloud& b) {
   EXPECT_EQ(a.width, b.width);
   EXPECT_EQ(a.height, b.height);
@@ -119,17 +53,8 @@ void expect_same_cloud(const PointCloud& a, const PointCloud& b) {
   expect_same_attributes(a, b);
 }
 
-// Asserts that reading `path` throws an IoError that starts with the path and mentions `needle`.
 void expect_read_error(const std::string& path, const std::string& needle) {
-  try {
-    read_pcd(path);
-    ADD_FAILURE() << "no IoError for " << path << " (expected '" << needle << "')";
-  } catch (const IoError& error) {
-    const std::string message = error.what();
-    EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
-    EXPECT_NE(message.find(needle), std::string::npos)
-        << "message: " << message << "\nexpected to contain: " << needle;
-  }
+  test::expect_read_error(read_pcd, path, needle);
 }
 
 std::string header(const std::string& fields, const std::string& sizes, const std::string& types,
@@ -549,22 +474,7 @@ TEST(CloudIo, DispatchesOnExtensionCaseInsensitively) {
 // ---------------------------------------------------------------------------------------------
 // Malformed input
 
-struct MalformedPcd {
-  const char* name;
-  std::string contents;
-  const char* expected;
-};
-
-// Names the case in gtest output instead of dumping its bytes.
-void PrintTo(const MalformedPcd& c, std::ostream* out) { *out << c.name; }
-
-std::string binary_points(int points) {
-  std::string out;
-  for (int i = 0; i < 3 * points; ++i) put(out, static_cast<float>(i));
-  return out;
-}
-
-std::vector<MalformedPcd> malformed_cases() {
+std::vector<MalformedFile> malformed_cases() {
   const std::string v7 = "# .PCD v0.7\nVERSION 0.7\n";
   std::string three_planes;
   for (int i = 0; i < 9; ++i) put(three_planes, static_cast<float>(i));
@@ -665,7 +575,7 @@ std::vector<MalformedPcd> malformed_cases() {
       {"FractionalLabel",
        header("x y z label", "4 4 4 4", "F F F F", "1 1 1 1", 1, "ascii") + "1 2 3 1.5\n",
        "value 1.5 is not a label"},
-      {"TruncatedBinary", xyz_header(3, "binary") + binary_points(1) + "abcdefgh",
+      {"TruncatedBinary", xyz_header(3, "binary") + test::xyz_floats(1) + "abcdefgh",
        "truncated binary data: expected 36 bytes for 3 points, found 20"},
       {"HugePointsBinary",
        header("x y z", "4 4 4", "F F F", "1 1 1", 4000000000ull, "binary") + std::string(100, 'x'),
@@ -683,17 +593,14 @@ std::vector<MalformedPcd> malformed_cases() {
   };
 }
 
-class PcdMalformed : public ::testing::TestWithParam<MalformedPcd> {};
+class PcdMalformed : public ::testing::TestWithParam<MalformedFile> {};
 
 TEST_P(PcdMalformed, ThrowsIoErrorNamingFileAndProblem) {
-  test::TempDir dir;
-  const std::string path = dir.file(std::string(GetParam().name) + ".pcd");
-  write_bytes(path, GetParam().contents);
-  expect_read_error(path, GetParam().expected);
+  test::expect_rejected(read_pcd, GetParam(), ".pcd");
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, PcdMalformed, ::testing::ValuesIn(malformed_cases()),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         test::malformed_file_name);
 
 TEST(PcdMalformedFiles, MissingFileReportsErrno) {
   test::TempDir dir;
@@ -708,25 +615,13 @@ TEST(PcdMalformedFiles, DirectoryIsNotARegularFile) {
 }
 
 // Absurd sizes in tiny files must fail on the size check, before allocating anything like them.
-class PcdHugeHeader : public ::testing::TestWithParam<MalformedPcd> {};
-
-TEST(AllocationGuard, SeesLargeAllocations) {  // else the test below would prove nothing
-  test::reset_largest_allocation();
-  std::vector<char> big(std::size_t{2} << 20);
-  EXPECT_GE(test::largest_allocation(), big.size());
-}
+class PcdHugeHeader : public ::testing::TestWithParam<MalformedFile> {};
 
 TEST_P(PcdHugeHeader, FailsWithoutAllocatingTheDeclaredSize) {
-  test::TempDir dir;
-  const std::string path = dir.file(std::string(GetParam().name) + ".pcd");
-  write_bytes(path, GetParam().contents);
-  test::reset_largest_allocation();
-  expect_read_error(path, GetParam().expected);
-  EXPECT_LT(test::largest_allocation(), std::size_t{1} << 20)
-      << "largest allocation while reading a " << GetParam().contents.size() << "-byte file";
+  test::expect_rejected_without_allocating(read_pcd, GetParam(), ".pcd");
 }
 
-std::vector<MalformedPcd> huge_cases() {
+std::vector<MalformedFile> huge_cases() {
   const std::string huge = "4000000000";
   std::string consistent_sizes;  // 300M points x 12 bytes fit the uint32 size field
   put<std::uint32_t>(consistent_sizes, 4);
@@ -756,7 +651,7 @@ std::vector<MalformedPcd> huge_cases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, PcdHugeHeader, ::testing::ValuesIn(huge_cases()),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         test::malformed_file_name);
 
 }  // namespace
 }  // namespace primlabel
