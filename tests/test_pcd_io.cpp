@@ -69,6 +69,19 @@ std::string xyz_header(std::uint64_t points, const std::string& data) {
   return header("x y z", "4 4 4", "F F F", "1 1 1", points, data);
 }
 
+// The header of a one-point ascii file with this field layout.
+std::string ascii_header(const std::string& fields, const std::string& sizes,
+                         const std::string& types, const std::string& counts) {
+  return header(fields, sizes, types, counts, 1, "ascii");
+}
+
+// An ascii file of x y z and a label of this SIZE and TYPE, then the data lines.
+std::string ascii_with_label(const std::string& size, const std::string& type, std::uint64_t points,
+                             const std::string& lines) {
+  return header("x y z label", "4 4 4 " + size, "F F F " + type, "1 1 1 1", points, "ascii") +
+         lines;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Round trips
 
@@ -111,6 +124,9 @@ TEST_P(PcdRoundTrip, XyzOnlyCloudHasNoOptionalAttributes) {
   EXPECT_TRUE(loaded.fields.empty());
 }
 
+constexpr PcdEncoding kEncodings[] = {PcdEncoding::kAscii, PcdEncoding::kBinary,
+                                      PcdEncoding::kBinaryCompressed};
+
 std::string encoding_name(const ::testing::TestParamInfo<PcdEncoding>& info) {
   switch (info.param) {
     case PcdEncoding::kAscii:
@@ -122,9 +138,7 @@ std::string encoding_name(const ::testing::TestParamInfo<PcdEncoding>& info) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdRoundTrip,
-                         ::testing::Values(PcdEncoding::kAscii, PcdEncoding::kBinary,
-                                           PcdEncoding::kBinaryCompressed),
+INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdRoundTrip, ::testing::ValuesIn(kEncodings),
                          encoding_name);
 
 TEST(PcdWrite, HeaderListsFieldsLikePcl) {
@@ -301,8 +315,7 @@ TEST(PcdSharedData, PclFileSurvivesOurRoundTrip) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
   const PointCloud cloud = read_pcd(path);
   test::TempDir dir;
-  for (PcdEncoding encoding :
-       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+  for (PcdEncoding encoding : kEncodings) {
     const std::string copy = dir.file("copy.pcd");
     write_pcd(copy, cloud, encoding);
     expect_same_cloud(cloud, read_pcd(copy));
@@ -368,9 +381,7 @@ TEST_P(PcdFieldOrder, AnyOrderWithPaddingMapsByName) {
   EXPECT_TRUE(cloud.fields.empty()) << "padding must not become a field";
 }
 
-INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdFieldOrder,
-                         ::testing::Values(PcdEncoding::kAscii, PcdEncoding::kBinary,
-                                           PcdEncoding::kBinaryCompressed),
+INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdFieldOrder, ::testing::ValuesIn(kEncodings),
                          encoding_name);
 
 TEST(PcdRead, IntegerTypesOfEverySizeAndMultiValueFields) {
@@ -445,8 +456,8 @@ TEST(PcdRead, OldHeaderWithoutCountOrViewpoint) {
 TEST(PcdRead, PartialNormalsBecomeOrdinaryFields) {
   test::TempDir dir;
   const std::string path = dir.file("partial.pcd");
-  write_bytes(
-      path, header("x y z normal_x", "4 4 4 4", "F F F F", "1 1 1 1", 1, "ascii") + "1 2 3 0.5\n");
+  write_bytes(path,
+              ascii_header("x y z normal_x", "4 4 4 4", "F F F F", "1 1 1 1") + "1 2 3 0.5\n");
   const PointCloud cloud = read_pcd(path);
   EXPECT_FALSE(cloud.has_normals());
   ASSERT_NE(cloud.find_field("normal_x"), nullptr);
@@ -505,23 +516,23 @@ std::vector<MalformedFile> malformed_cases() {
        "header line 5: TYPE has 2 entries but FIELDS has 3"},
       {"CountEntries", v7 + "FIELDS x y z\nCOUNT 1\nPOINTS 1\nDATA ascii\n",
        "COUNT has 1 entries but FIELDS has 3"},
-      {"FloatOfSizeTwo", header("x y z", "4 2 4", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n",
+      {"FloatOfSizeTwo", ascii_header("x y z", "4 2 4", "F F F", "1 1 1") + "1 2 3\n",
        "field 'y' has TYPE F with SIZE 2 (F needs SIZE 4 or 8)"},
-      {"SizeZero", header("x y z", "4 4 0", "F F F", "1 1 1", 1, "ascii"),
+      {"SizeZero", ascii_header("x y z", "4 4 0", "F F F", "1 1 1"),
        "SIZE of field 'z' is '0', expected 1, 2, 4 or 8"},
-      {"SizeNegative", header("x y z", "4 4 -4", "F F F", "1 1 1", 1, "ascii"),
+      {"SizeNegative", ascii_header("x y z", "4 4 -4", "F F F", "1 1 1"),
        "SIZE of field 'z' is '-4'"},
-      {"UnknownType", header("x y z", "4 4 4", "F D F", "1 1 1", 1, "ascii"),
+      {"UnknownType", ascii_header("x y z", "4 4 4", "F D F", "1 1 1"),
        "TYPE of field 'y' is 'D', expected F, I or U"},
-      {"CountZero", header("x y z", "4 4 4", "F F F", "1 0 1", 1, "ascii"),
+      {"CountZero", ascii_header("x y z", "4 4 4", "F F F", "1 0 1"),
        "COUNT of field 'y' is '0', expected a positive integer"},
-      {"CountOnCoordinate", header("x y z", "4 4 4", "F F F", "1 1 2", 1, "ascii"),
+      {"CountOnCoordinate", ascii_header("x y z", "4 4 4", "F F F", "1 1 2"),
        "field 'z' must have COUNT 1, got 2"},
-      {"RgbOfSizeTwo", header("x y z rgb", "4 4 4 2", "F F F U", "1 1 1 1", 1, "ascii"),
+      {"RgbOfSizeTwo", ascii_header("x y z rgb", "4 4 4 2", "F F F U", "1 1 1 1"),
        "field 'rgb' is a packed colour and needs SIZE 4"},
-      {"DuplicateField", header("x y z y", "4 4 4 4", "F F F F", "1 1 1 1", 1, "ascii"),
+      {"DuplicateField", ascii_header("x y z y", "4 4 4 4", "F F F F", "1 1 1 1"),
        "field 'y' is listed twice"},
-      {"MissingY", header("x z", "4 4", "F F", "1 1", 1, "ascii") + "1 2\n",
+      {"MissingY", ascii_header("x z", "4 4", "F F", "1 1") + "1 2\n",
        "missing field 'y' (x, y and z are required)"},
       {"MissingFields", v7 + "WIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n", "missing FIELDS line"},
       {"UnknownDataKind", xyz_header(1, "binary_lzma") + "...", "unknown DATA kind 'binary_lzma'"},
@@ -559,22 +570,17 @@ std::vector<MalformedFile> malformed_cases() {
        "line 13: value 'abc' of field 'y' is not a valid F 4 number"},
       {"AsciiTrailingGarbage", xyz_header(1, "ascii") + "1 2 3x\n",
        "value '3x' of field 'z' is not a valid F 4 number"},
-      {"AsciiIntegerOutOfRange",
-       header("x y z label", "4 4 4 1", "F F F U", "1 1 1 1", 1, "ascii") + "1 2 3 256\n",
+      {"AsciiIntegerOutOfRange", ascii_with_label("1", "U", 1, "1 2 3 256\n"),
        "value '256' of field 'label' is not a valid U 1 number"},
-      {"AsciiNegativeUnsigned",
-       header("x y z label", "4 4 4 4", "F F F U", "1 1 1 1", 1, "ascii") + "1 2 3 -1\n",
+      {"AsciiNegativeUnsigned", ascii_with_label("4", "U", 1, "1 2 3 -1\n"),
        "value '-1' of field 'label' is not a valid U 4 number"},
       {"AsciiTooFewLines", xyz_header(3, "ascii") + "1 2 3\n4 5 6\n\n",
        "ascii data ends after 2 points, POINTS declares 3"},
       {"AsciiTooManyLines", xyz_header(1, "ascii") + "1 2 3\n4 5 6\n",
        "line 13: more data lines than POINTS (1)"},
-      {"NegativeLabel",
-       header("x y z label", "4 4 4 4", "F F F I", "1 1 1 1", 2, "ascii") + "1 2 3 5\n1 2 3 -1\n",
+      {"NegativeLabel", ascii_with_label("4", "I", 2, "1 2 3 5\n1 2 3 -1\n"),
        "field 'label' of point 1: value -1 is not a label"},
-      {"FractionalLabel",
-       header("x y z label", "4 4 4 4", "F F F F", "1 1 1 1", 1, "ascii") + "1 2 3 1.5\n",
-       "value 1.5 is not a label"},
+      {"FractionalLabel", ascii_with_label("4", "F", 1, "1 2 3 1.5\n"), "value 1.5 is not a label"},
       {"TruncatedBinary", xyz_header(3, "binary") + test::xyz_floats(1) + "abcdefgh",
        "truncated binary data: expected 36 bytes for 3 points, found 20"},
       {"HugePointsBinary",
@@ -645,7 +651,7 @@ std::vector<MalformedFile> huge_cases() {
       {"Ascii", xyz_header(4000000000ull, "ascii") + "1 2 3\n4 5 6\n",
        "ascii data ends after 2 points, POINTS declares 4000000000"},
       {"AsciiHugeCount",
-       header("x y z h", "4 4 4 4", "F F F F", "1 1 1 4000000000", 1, "ascii") + "1 2 3 4\n",
+       ascii_header("x y z h", "4 4 4 4", "F F F F", "1 1 1 4000000000") + "1 2 3 4\n",
        "expected 4000000003 values for point 0, found 4"},
   };
 }
