@@ -62,6 +62,12 @@ client::upload::UploaderOptions uploader_options(const test::TempDir& dir) {
   return options;
 }
 
+// Waits (30 s at most) until every queued scan is uploaded or failed; true when it is.
+bool wait_idle(Uploader& uploader) {
+  const std::atomic<bool> stop{false};
+  return uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Spool
 
@@ -172,9 +178,7 @@ TEST(Uploader, LabelsEachScanOnceIntoItsOwnOutput) {
   std::string id;
   EXPECT_EQ(uploader.submit(scan_bytes(1), ".pcd", &id), Uploader::Submitted::kAccepted);
   uploader.submit(scan_bytes(2), ".pcd");
-  std::atomic<bool> stop{false};
-  ASSERT_TRUE(
-      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  ASSERT_TRUE(wait_idle(uploader));
   const PointCloud out = read_cloud(dir.file("out/" + id + ".pcd"));
   ASSERT_EQ(out.labels.size(), 200u);
   for (std::size_t i = 0; i < 200; ++i) ASSERT_EQ(out.labels[i], (i + 1) % 4);
@@ -197,9 +201,7 @@ TEST(Uploader, RetriesWithBackoffWhileTheServerIsUnavailable) {
   uploader.start();
   std::string id;
   uploader.submit(scan_bytes(3), ".pcd", &id);
-  std::atomic<bool> stop{false};
-  ASSERT_TRUE(
-      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  ASSERT_TRUE(wait_idle(uploader));
   EXPECT_EQ(uploader.counters().retries, 4u);
   EXPECT_EQ(uploader.counters().uploaded, 1u);
   EXPECT_TRUE(fs::exists(dir.file("out/" + id + ".pcd")));
@@ -225,9 +227,7 @@ TEST(Uploader, StartupResumesTheSpoolAndSkipsScansAlreadyWritten) {
   Uploader uploader(client, options);
   EXPECT_EQ(uploader.queued(), 1u);
   uploader.start();
-  std::atomic<bool> stop{false};
-  ASSERT_TRUE(
-      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  ASSERT_TRUE(wait_idle(uploader));
   EXPECT_EQ(server.service.label_calls, 1);
   EXPECT_EQ(uploader.counters().already_labeled, 1u);
   EXPECT_EQ(files_in(options.output_dir), 2u);  // the crash's temp file is gone
@@ -243,9 +243,7 @@ TEST(Uploader, ARefusedScanMovesToFailedAndTheRestGoOn) {
   std::string empty_id;
   uploader.submit(scan_bytes(6, 0), ".pcd", &empty_id);  // the server refuses zero points
   uploader.submit(scan_bytes(7), ".pcd");
-  std::atomic<bool> stop{false};
-  ASSERT_TRUE(
-      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  ASSERT_TRUE(wait_idle(uploader));
   EXPECT_EQ(uploader.counters().failed, 1u);
   EXPECT_EQ(uploader.counters().uploaded, 1u);
   EXPECT_TRUE(fs::exists(dir.file("spool/failed/" + empty_id + ".pcd")));
