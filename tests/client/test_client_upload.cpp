@@ -22,6 +22,7 @@ using client::upload::Spool;
 using client::upload::SpoolFull;
 using client::upload::Uploader;
 using test::FakeServer;
+using test::write_bytes;
 
 // The bytes of a small PCD scan whose fake labels are (i + seed) % 4.
 std::string scan_bytes(int seed, std::size_t n = 200) {
@@ -34,10 +35,6 @@ std::string scan_bytes(int seed, std::size_t n = 200) {
   std::stringstream bytes;
   bytes << in.rdbuf();
   return bytes.str();
-}
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary) << bytes;
 }
 
 std::size_t files_in(const fs::path& dir) {
