@@ -107,6 +107,17 @@ TinyProblem tiny_problem(std::size_t n,
   return t;
 }
 
+// Loopy BP to a tight fixed point, to be compared with the brute-force answer: sum-product with
+// marginals, or max-product labels.
+InferenceResult infer_tightly(const TinyProblem& t, bool max_product) {
+  InferenceOptions options;
+  options.max_product = max_product;
+  options.compute_marginals = !max_product;
+  options.max_iterations = 200;
+  options.tolerance = 1e-7f;
+  return infer(t.model, t.descriptors, t.graph, options);
+}
+
 const std::vector<std::pair<std::uint32_t, std::uint32_t>> kTree = {{0, 1}, {1, 2}, {1, 3},
                                                                     {3, 4}, {3, 5}, {0, 6}};
 const std::vector<std::pair<std::uint32_t, std::uint32_t>> kLoopy = {{0, 1}, {1, 2}, {2, 3},
@@ -119,11 +130,7 @@ TEST(CrfInference, SumProductIsExactOnATree) {
     for (std::uint32_t seed = 1; seed <= 5; ++seed) {
       const TinyProblem t = tiny_problem(7, kTree, 3, seed, 2.0f, knots);
       const testing::Exact exact = testing::brute_force(t.model, t.descriptors, t.graph);
-      InferenceOptions options;
-      options.compute_marginals = true;
-      options.max_iterations = 200;
-      options.tolerance = 1e-7f;
-      const InferenceResult r = infer(t.model, t.descriptors, t.graph, options);
+      const InferenceResult r = infer_tightly(t, /*max_product=*/false);
       EXPECT_TRUE(r.converged);
       for (std::size_t i = 0; i < 7; ++i)
         for (int k = 0; k < 3; ++k)
@@ -138,11 +145,7 @@ TEST(CrfInference, MaxProductFindsTheMapLabelling) {
     for (std::uint32_t seed = 1; seed <= 8; ++seed) {
       const TinyProblem t = tiny_problem(n, *edges, 3, seed, 2.0f);
       const testing::Exact exact = testing::brute_force(t.model, t.descriptors, t.graph);
-      InferenceOptions options;
-      options.max_product = true;
-      options.max_iterations = 200;
-      options.tolerance = 1e-7f;
-      const InferenceResult r = infer(t.model, t.descriptors, t.graph, options);
+      const InferenceResult r = infer_tightly(t, /*max_product=*/true);
       for (std::size_t i = 0; i < n; ++i)
         EXPECT_EQ(r.labels[i], t.model.class_ids[exact.map[i]])
             << (edges == &kTree ? "tree" : "loopy") << " seed " << seed << " node " << i;
