@@ -88,31 +88,37 @@ class BunnyConformance : public ::testing::Test {
     return worst;
   }
 
+  // FPFH / PFH of the bunny with this neighbourhood, against PCL's in `fixture`.
+  float fpfh_difference(const Neighborhood& neighborhood, const std::string& fixture) {
+    return max_difference(compute_fpfh(cloud_, with(neighborhood)), kFpfhSize, fixture);
+  }
+  float pfh_difference(const Neighborhood& neighborhood, const std::string& fixture) {
+    return max_difference(compute_pfh(cloud_, with(neighborhood)), kPfhSize, fixture);
+  }
+
+  static FeatureOptions with(const Neighborhood& neighborhood) {
+    FeatureOptions options;
+    options.neighborhood = neighborhood;
+    return options;
+  }
+
   PointCloud cloud_;
 };
 
 TEST_F(BunnyConformance, FpfhK10) {
-  FeatureOptions options;
-  options.neighborhood = Neighborhood::Knn(10);
-  EXPECT_LE(max_difference(compute_fpfh(cloud_, options), kFpfhSize, "bun0_fpfh_k10.csv"), 1e-4f);
+  EXPECT_LE(fpfh_difference(Neighborhood::Knn(10), "bun0_fpfh_k10.csv"), 1e-4f);
 }
 
 TEST_F(BunnyConformance, FpfhRadius001) {
-  FeatureOptions options;
-  options.neighborhood = Neighborhood::Radius(0.01f);
-  EXPECT_LE(max_difference(compute_fpfh(cloud_, options), kFpfhSize, "bun0_fpfh_r0.01.csv"), 1e-4f);
+  EXPECT_LE(fpfh_difference(Neighborhood::Radius(0.01f), "bun0_fpfh_r0.01.csv"), 1e-4f);
 }
 
 TEST_F(BunnyConformance, FpfhRadius002) {
-  FeatureOptions options;
-  options.neighborhood = Neighborhood::Radius(0.02f);
-  EXPECT_LE(max_difference(compute_fpfh(cloud_, options), kFpfhSize, "bun0_fpfh_r0.02.csv"), 1e-4f);
+  EXPECT_LE(fpfh_difference(Neighborhood::Radius(0.02f), "bun0_fpfh_r0.02.csv"), 1e-4f);
 }
 
 TEST_F(BunnyConformance, PfhK10) {
-  FeatureOptions options;
-  options.neighborhood = Neighborhood::Knn(10);
-  EXPECT_LE(max_difference(compute_pfh(cloud_, options), kPfhSize, "bun0_pfh_k10.csv"), 1e-4f);
+  EXPECT_LE(pfh_difference(Neighborhood::Knn(10), "bun0_pfh_k10.csv"), 1e-4f);
 }
 
 // ---- histogram properties ----------------------------------------------------------------------

@@ -3,36 +3,27 @@
 
 #include <gtest/gtest.h>
 
-#include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <string>
 #include <vector>
 
-#include "allocation_guard.hpp"
+#include "cloud_io_test_util.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
 namespace {
 
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-constexpr float kInf = std::numeric_limits<float>::infinity();
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  ASSERT_TRUE(out.good()) << path;
-}
-
-template <typename T>
-void put(std::string& out, T value) {
-  out.append(reinterpret_cast<const char*>(&value), sizeof value);
-}
+using test::awkward_cloud;
+using test::expect_same_attributes;
+using test::kInf;
+using test::kNaN;
+using test::MalformedFile;
+using test::put;
+using test::write_bytes;
 
 // A valid LZF stream made only of literal runs (control byte n < 32 copies n + 1 bytes), so the
 // tests can build binary_compressed files without linking liblzf.
@@ -54,63 +45,6 @@ std::string compressed_payload(const std::string& planes) {
   return out + lzf;
 }
 
-bool same_float(float a, float b) {
-  return (std::isnan(a) && std::isnan(b)) ||
-         std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b);
-}
-
-void expect_same_floats(const float* a, const float* b, std::size_t n, const std::string& what) {
-  for (std::size_t i = 0; i < n; ++i)
-    ASSERT_TRUE(same_float(a[i], b[i])) << what << "[" << i << "]: " << a[i] << " vs " << b[i];
-}
-
-// An organised 4x3 cloud with invalid (NaN) pixels and awkward float values in every attribute.
-PointCloud awkward_cloud() {
-  const float specials[] = {0.1f,          -0.0f, 1e-40f /* subnormal */,
-                            3.4028235e38f, -kInf, 1.17549435e-38f,
-                            123456.789f,   1e-7f, 3.14159265f};
-  PointCloud cloud;
-  cloud.width = 4;
-  cloud.height = 3;
-  for (int i = 0; i < 12; ++i) {
-    const float s = specials[i % 9];
-    const bool invalid = i == 1 || i == 6 || i == 11;
-    cloud.xyz.push_back(invalid ? Vec3f(kNaN, kNaN, kNaN) : Vec3f(s, -s * 0.5f, 1.0f + i));
-    cloud.normals.push_back(invalid ? Vec3f(kNaN, kNaN, kNaN) : Vec3f(0.6f, -0.8f, s));
-    cloud.curvature.push_back(invalid ? kNaN : s);
-    cloud.labels.push_back(i == 0 ? 0u : i == 5 ? 0xffffffffu : static_cast<std::uint32_t>(i * 7));
-    cloud.rgba.push_back(i == 3 ? 0xffffffffu : 0xff102030u + static_cast<std::uint32_t>(i));
-  }
-  FloatField& fpfh = cloud.set_field("fpfh", 33);
-  for (std::size_t v = 0; v < fpfh.values.size(); ++v)
-    fpfh.values[v] = v % 17 == 0 ? kNaN : static_cast<float>(v) / 7.0f;
-  FloatField& intensity = cloud.set_field("intensity", 1);
-  for (std::size_t v = 0; v < intensity.values.size(); ++v) intensity.values[v] = specials[v % 9];
-  cloud.viewpoint.origin = Vec3f(0.25f, -1.5f, 3.0f);
-  cloud.viewpoint.orientation = Eigen::Quaternionf(0.5f, 0.5f, -0.5f, 0.5f);
-  return cloud;
-}
-
-void expect_same_attributes(const PointCloud& a, const PointCloud& b) {
-  ASSERT_EQ(a.size(), b.size());
-  expect_same_floats(a.xyz.data()->data(), b.xyz.data()->data(), 3 * a.size(), "xyz");
-  ASSERT_EQ(a.normals.size(), b.normals.size());
-  if (a.has_normals())
-    expect_same_floats(a.normals.data()->data(), b.normals.data()->data(), 3 * a.size(), "normal");
-  ASSERT_EQ(a.curvature.size(), b.curvature.size());
-  expect_same_floats(a.curvature.data(), b.curvature.data(), a.curvature.size(), "curvature");
-  EXPECT_EQ(a.labels, b.labels);
-  EXPECT_EQ(a.rgba, b.rgba);
-  ASSERT_EQ(a.fields.size(), b.fields.size());
-  for (std::size_t f = 0; f < a.fields.size(); ++f) {
-    EXPECT_EQ(a.fields[f].name, b.fields[f].name);
-    EXPECT_EQ(a.fields[f].count, b.fields[f].count);
-    ASSERT_EQ(a.fields[f].values.size(), b.fields[f].values.size());
-    expect_same_floats(a.fields[f].values.data(), b.fields[f].values.data(),
-                       a.fields[f].values.size(), a.fields[f].name);
-  }
-}
-
 void expect_same_cloud(const PointCloud& a, const PointCloud& b) {
   EXPECT_EQ(a.width, b.width);
   EXPECT_EQ(a.height, b.height);
@@ -119,17 +53,8 @@ void expect_same_cloud(const PointCloud& a, const PointCloud& b) {
   expect_same_attributes(a, b);
 }
 
-// Asserts that reading `path` throws an IoError that starts with the path and mentions `needle`.
 void expect_read_error(const std::string& path, const std::string& needle) {
-  try {
-    read_pcd(path);
-    ADD_FAILURE() << "no IoError for " << path << " (expected '" << needle << "')";
-  } catch (const IoError& error) {
-    const std::string message = error.what();
-    EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
-    EXPECT_NE(message.find(needle), std::string::npos)
-        << "message: " << message << "\nexpected to contain: " << needle;
-  }
+  test::expect_read_error(read_pcd, path, needle);
 }
 
 std::string header(const std::string& fields, const std::string& sizes, const std::string& types,
@@ -142,6 +67,19 @@ std::string header(const std::string& fields, const std::string& sizes, const st
 
 std::string xyz_header(std::uint64_t points, const std::string& data) {
   return header("x y z", "4 4 4", "F F F", "1 1 1", points, data);
+}
+
+// The header of a one-point ascii file with this field layout.
+std::string ascii_header(const std::string& fields, const std::string& sizes,
+                         const std::string& types, const std::string& counts) {
+  return header(fields, sizes, types, counts, 1, "ascii");
+}
+
+// An ascii file of x y z and a label of this SIZE and TYPE, then the data lines.
+std::string ascii_with_label(const std::string& size, const std::string& type, std::uint64_t points,
+                             const std::string& lines) {
+  return header("x y z label", "4 4 4 " + size, "F F F " + type, "1 1 1 1", points, "ascii") +
+         lines;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -186,6 +124,9 @@ TEST_P(PcdRoundTrip, XyzOnlyCloudHasNoOptionalAttributes) {
   EXPECT_TRUE(loaded.fields.empty());
 }
 
+constexpr PcdEncoding kEncodings[] = {PcdEncoding::kAscii, PcdEncoding::kBinary,
+                                      PcdEncoding::kBinaryCompressed};
+
 std::string encoding_name(const ::testing::TestParamInfo<PcdEncoding>& info) {
   switch (info.param) {
     case PcdEncoding::kAscii:
@@ -197,9 +138,7 @@ std::string encoding_name(const ::testing::TestParamInfo<PcdEncoding>& info) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdRoundTrip,
-                         ::testing::Values(PcdEncoding::kAscii, PcdEncoding::kBinary,
-                                           PcdEncoding::kBinaryCompressed),
+INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdRoundTrip, ::testing::ValuesIn(kEncodings),
                          encoding_name);
 
 TEST(PcdWrite, HeaderListsFieldsLikePcl) {
@@ -376,8 +315,7 @@ TEST(PcdSharedData, PclFileSurvivesOurRoundTrip) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
   const PointCloud cloud = read_pcd(path);
   test::TempDir dir;
-  for (PcdEncoding encoding :
-       {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+  for (PcdEncoding encoding : kEncodings) {
     const std::string copy = dir.file("copy.pcd");
     write_pcd(copy, cloud, encoding);
     expect_same_cloud(cloud, read_pcd(copy));
@@ -443,9 +381,7 @@ TEST_P(PcdFieldOrder, AnyOrderWithPaddingMapsByName) {
   EXPECT_TRUE(cloud.fields.empty()) << "padding must not become a field";
 }
 
-INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdFieldOrder,
-                         ::testing::Values(PcdEncoding::kAscii, PcdEncoding::kBinary,
-                                           PcdEncoding::kBinaryCompressed),
+INSTANTIATE_TEST_SUITE_P(AllEncodings, PcdFieldOrder, ::testing::ValuesIn(kEncodings),
                          encoding_name);
 
 TEST(PcdRead, IntegerTypesOfEverySizeAndMultiValueFields) {
@@ -520,8 +456,8 @@ TEST(PcdRead, OldHeaderWithoutCountOrViewpoint) {
 TEST(PcdRead, PartialNormalsBecomeOrdinaryFields) {
   test::TempDir dir;
   const std::string path = dir.file("partial.pcd");
-  write_bytes(
-      path, header("x y z normal_x", "4 4 4 4", "F F F F", "1 1 1 1", 1, "ascii") + "1 2 3 0.5\n");
+  write_bytes(path,
+              ascii_header("x y z normal_x", "4 4 4 4", "F F F F", "1 1 1 1") + "1 2 3 0.5\n");
   const PointCloud cloud = read_pcd(path);
   EXPECT_FALSE(cloud.has_normals());
   ASSERT_NE(cloud.find_field("normal_x"), nullptr);
@@ -549,22 +485,7 @@ TEST(CloudIo, DispatchesOnExtensionCaseInsensitively) {
 // ---------------------------------------------------------------------------------------------
 // Malformed input
 
-struct MalformedPcd {
-  const char* name;
-  std::string contents;
-  const char* expected;
-};
-
-// Names the case in gtest output instead of dumping its bytes.
-void PrintTo(const MalformedPcd& c, std::ostream* out) { *out << c.name; }
-
-std::string binary_points(int points) {
-  std::string out;
-  for (int i = 0; i < 3 * points; ++i) put(out, static_cast<float>(i));
-  return out;
-}
-
-std::vector<MalformedPcd> malformed_cases() {
+std::vector<MalformedFile> malformed_cases() {
   const std::string v7 = "# .PCD v0.7\nVERSION 0.7\n";
   std::string three_planes;
   for (int i = 0; i < 9; ++i) put(three_planes, static_cast<float>(i));
@@ -595,23 +516,23 @@ std::vector<MalformedPcd> malformed_cases() {
        "header line 5: TYPE has 2 entries but FIELDS has 3"},
       {"CountEntries", v7 + "FIELDS x y z\nCOUNT 1\nPOINTS 1\nDATA ascii\n",
        "COUNT has 1 entries but FIELDS has 3"},
-      {"FloatOfSizeTwo", header("x y z", "4 2 4", "F F F", "1 1 1", 1, "ascii") + "1 2 3\n",
+      {"FloatOfSizeTwo", ascii_header("x y z", "4 2 4", "F F F", "1 1 1") + "1 2 3\n",
        "field 'y' has TYPE F with SIZE 2 (F needs SIZE 4 or 8)"},
-      {"SizeZero", header("x y z", "4 4 0", "F F F", "1 1 1", 1, "ascii"),
+      {"SizeZero", ascii_header("x y z", "4 4 0", "F F F", "1 1 1"),
        "SIZE of field 'z' is '0', expected 1, 2, 4 or 8"},
-      {"SizeNegative", header("x y z", "4 4 -4", "F F F", "1 1 1", 1, "ascii"),
+      {"SizeNegative", ascii_header("x y z", "4 4 -4", "F F F", "1 1 1"),
        "SIZE of field 'z' is '-4'"},
-      {"UnknownType", header("x y z", "4 4 4", "F D F", "1 1 1", 1, "ascii"),
+      {"UnknownType", ascii_header("x y z", "4 4 4", "F D F", "1 1 1"),
        "TYPE of field 'y' is 'D', expected F, I or U"},
-      {"CountZero", header("x y z", "4 4 4", "F F F", "1 0 1", 1, "ascii"),
+      {"CountZero", ascii_header("x y z", "4 4 4", "F F F", "1 0 1"),
        "COUNT of field 'y' is '0', expected a positive integer"},
-      {"CountOnCoordinate", header("x y z", "4 4 4", "F F F", "1 1 2", 1, "ascii"),
+      {"CountOnCoordinate", ascii_header("x y z", "4 4 4", "F F F", "1 1 2"),
        "field 'z' must have COUNT 1, got 2"},
-      {"RgbOfSizeTwo", header("x y z rgb", "4 4 4 2", "F F F U", "1 1 1 1", 1, "ascii"),
+      {"RgbOfSizeTwo", ascii_header("x y z rgb", "4 4 4 2", "F F F U", "1 1 1 1"),
        "field 'rgb' is a packed colour and needs SIZE 4"},
-      {"DuplicateField", header("x y z y", "4 4 4 4", "F F F F", "1 1 1 1", 1, "ascii"),
+      {"DuplicateField", ascii_header("x y z y", "4 4 4 4", "F F F F", "1 1 1 1"),
        "field 'y' is listed twice"},
-      {"MissingY", header("x z", "4 4", "F F", "1 1", 1, "ascii") + "1 2\n",
+      {"MissingY", ascii_header("x z", "4 4", "F F", "1 1") + "1 2\n",
        "missing field 'y' (x, y and z are required)"},
       {"MissingFields", v7 + "WIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n", "missing FIELDS line"},
       {"UnknownDataKind", xyz_header(1, "binary_lzma") + "...", "unknown DATA kind 'binary_lzma'"},
@@ -649,23 +570,18 @@ std::vector<MalformedPcd> malformed_cases() {
        "line 13: value 'abc' of field 'y' is not a valid F 4 number"},
       {"AsciiTrailingGarbage", xyz_header(1, "ascii") + "1 2 3x\n",
        "value '3x' of field 'z' is not a valid F 4 number"},
-      {"AsciiIntegerOutOfRange",
-       header("x y z label", "4 4 4 1", "F F F U", "1 1 1 1", 1, "ascii") + "1 2 3 256\n",
+      {"AsciiIntegerOutOfRange", ascii_with_label("1", "U", 1, "1 2 3 256\n"),
        "value '256' of field 'label' is not a valid U 1 number"},
-      {"AsciiNegativeUnsigned",
-       header("x y z label", "4 4 4 4", "F F F U", "1 1 1 1", 1, "ascii") + "1 2 3 -1\n",
+      {"AsciiNegativeUnsigned", ascii_with_label("4", "U", 1, "1 2 3 -1\n"),
        "value '-1' of field 'label' is not a valid U 4 number"},
       {"AsciiTooFewLines", xyz_header(3, "ascii") + "1 2 3\n4 5 6\n\n",
        "ascii data ends after 2 points, POINTS declares 3"},
       {"AsciiTooManyLines", xyz_header(1, "ascii") + "1 2 3\n4 5 6\n",
        "line 13: more data lines than POINTS (1)"},
-      {"NegativeLabel",
-       header("x y z label", "4 4 4 4", "F F F I", "1 1 1 1", 2, "ascii") + "1 2 3 5\n1 2 3 -1\n",
+      {"NegativeLabel", ascii_with_label("4", "I", 2, "1 2 3 5\n1 2 3 -1\n"),
        "field 'label' of point 1: value -1 is not a label"},
-      {"FractionalLabel",
-       header("x y z label", "4 4 4 4", "F F F F", "1 1 1 1", 1, "ascii") + "1 2 3 1.5\n",
-       "value 1.5 is not a label"},
-      {"TruncatedBinary", xyz_header(3, "binary") + binary_points(1) + "abcdefgh",
+      {"FractionalLabel", ascii_with_label("4", "F", 1, "1 2 3 1.5\n"), "value 1.5 is not a label"},
+      {"TruncatedBinary", xyz_header(3, "binary") + test::xyz_floats(1) + "abcdefgh",
        "truncated binary data: expected 36 bytes for 3 points, found 20"},
       {"HugePointsBinary",
        header("x y z", "4 4 4", "F F F", "1 1 1", 4000000000ull, "binary") + std::string(100, 'x'),
@@ -683,17 +599,14 @@ std::vector<MalformedPcd> malformed_cases() {
   };
 }
 
-class PcdMalformed : public ::testing::TestWithParam<MalformedPcd> {};
+class PcdMalformed : public ::testing::TestWithParam<MalformedFile> {};
 
 TEST_P(PcdMalformed, ThrowsIoErrorNamingFileAndProblem) {
-  test::TempDir dir;
-  const std::string path = dir.file(std::string(GetParam().name) + ".pcd");
-  write_bytes(path, GetParam().contents);
-  expect_read_error(path, GetParam().expected);
+  test::expect_rejected(read_pcd, GetParam(), ".pcd");
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, PcdMalformed, ::testing::ValuesIn(malformed_cases()),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         test::malformed_file_name);
 
 TEST(PcdMalformedFiles, MissingFileReportsErrno) {
   test::TempDir dir;
@@ -708,25 +621,13 @@ TEST(PcdMalformedFiles, DirectoryIsNotARegularFile) {
 }
 
 // Absurd sizes in tiny files must fail on the size check, before allocating anything like them.
-class PcdHugeHeader : public ::testing::TestWithParam<MalformedPcd> {};
-
-TEST(AllocationGuard, SeesLargeAllocations) {  // else the test below would prove nothing
-  test::reset_largest_allocation();
-  std::vector<char> big(std::size_t{2} << 20);
-  EXPECT_GE(test::largest_allocation(), big.size());
-}
+class PcdHugeHeader : public ::testing::TestWithParam<MalformedFile> {};
 
 TEST_P(PcdHugeHeader, FailsWithoutAllocatingTheDeclaredSize) {
-  test::TempDir dir;
-  const std::string path = dir.file(std::string(GetParam().name) + ".pcd");
-  write_bytes(path, GetParam().contents);
-  test::reset_largest_allocation();
-  expect_read_error(path, GetParam().expected);
-  EXPECT_LT(test::largest_allocation(), std::size_t{1} << 20)
-      << "largest allocation while reading a " << GetParam().contents.size() << "-byte file";
+  test::expect_rejected_without_allocating(read_pcd, GetParam(), ".pcd");
 }
 
-std::vector<MalformedPcd> huge_cases() {
+std::vector<MalformedFile> huge_cases() {
   const std::string huge = "4000000000";
   std::string consistent_sizes;  // 300M points x 12 bytes fit the uint32 size field
   put<std::uint32_t>(consistent_sizes, 4);
@@ -750,13 +651,13 @@ std::vector<MalformedPcd> huge_cases() {
       {"Ascii", xyz_header(4000000000ull, "ascii") + "1 2 3\n4 5 6\n",
        "ascii data ends after 2 points, POINTS declares 4000000000"},
       {"AsciiHugeCount",
-       header("x y z h", "4 4 4 4", "F F F F", "1 1 1 4000000000", 1, "ascii") + "1 2 3 4\n",
+       ascii_header("x y z h", "4 4 4 4", "F F F F", "1 1 1 4000000000") + "1 2 3 4\n",
        "expected 4000000003 values for point 0, found 4"},
   };
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, PcdHugeHeader, ::testing::ValuesIn(huge_cases()),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         test::malformed_file_name);
 
 }  // namespace
 }  // namespace primlabel

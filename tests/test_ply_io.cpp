@@ -4,36 +4,24 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <bit>
-#include <cmath>
 #include <cstdint>
-#include <cstdlib>
-#include <filesystem>
 #include <fstream>
-#include <limits>
 #include <string>
 #include <vector>
 
-#include "allocation_guard.hpp"
+#include "cloud_io_test_util.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
 namespace {
 
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-constexpr float kInf = std::numeric_limits<float>::infinity();
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  ASSERT_TRUE(out.good()) << path;
-}
-
-template <typename T>
-void put(std::string& out, T value) {
-  out.append(reinterpret_cast<const char*>(&value), sizeof value);
-}
+using test::expect_same_attributes;
+using test::kNaN;
+using test::MalformedFile;
+using test::put;
+using test::write_bytes;
+using test::xyz_floats;
 
 template <typename T>
 void put_big_endian(std::string& out, T value) {
@@ -49,73 +37,15 @@ std::string ply(const std::string& format, const std::string& declarations) {
 
 const std::string kXyzFloat = "property float x\nproperty float y\nproperty float z\n";
 
-bool same_float(float a, float b) {
-  return (std::isnan(a) && std::isnan(b)) ||
-         std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b);
-}
-
-void expect_same_floats(const std::vector<float>& a, const std::vector<float>& b,
-                        const std::string& what) {
-  ASSERT_EQ(a.size(), b.size()) << what;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    ASSERT_TRUE(same_float(a[i], b[i])) << what << "[" << i << "]: " << a[i] << " vs " << b[i];
-}
-
-std::vector<float> flatten(const std::vector<Vec3f>& points) {
-  std::vector<float> out;
-  for (const Vec3f& p : points) out.insert(out.end(), {p.x(), p.y(), p.z()});
-  return out;
-}
-
-// An organised 4x3 cloud with invalid (NaN) pixels and awkward float values in every attribute.
+// The PCD tests' awkward cloud, but pixel 3 is a transparent white: alpha 0 must survive too.
 PointCloud awkward_cloud() {
-  const float specials[] = {0.1f,        -0.0f, 1e-40f,     3.4028235e38f, -kInf, 1.17549435e-38f,
-                            123456.789f, 1e-7f, 3.14159265f};
-  PointCloud cloud;
-  cloud.width = 4;
-  cloud.height = 3;
-  for (int i = 0; i < 12; ++i) {
-    const float s = specials[i % 9];
-    const bool invalid = i == 1 || i == 6 || i == 11;
-    cloud.xyz.push_back(invalid ? Vec3f(kNaN, kNaN, kNaN) : Vec3f(s, -s * 0.5f, 1.0f + i));
-    cloud.normals.push_back(invalid ? Vec3f(kNaN, kNaN, kNaN) : Vec3f(0.6f, -0.8f, s));
-    cloud.curvature.push_back(invalid ? kNaN : s);
-    cloud.labels.push_back(i == 0 ? 0u : i == 5 ? 0xffffffffu : static_cast<std::uint32_t>(i * 7));
-    cloud.rgba.push_back(i == 3 ? 0x00ffffffu : 0xff102030u + static_cast<std::uint32_t>(i));
-  }
-  FloatField& fpfh = cloud.set_field("fpfh", 33);
-  for (std::size_t v = 0; v < fpfh.values.size(); ++v)
-    fpfh.values[v] = v % 17 == 0 ? kNaN : static_cast<float>(v) / 7.0f;
-  FloatField& intensity = cloud.set_field("intensity", 1);
-  for (std::size_t v = 0; v < intensity.values.size(); ++v) intensity.values[v] = specials[v % 9];
+  PointCloud cloud = test::awkward_cloud();
+  cloud.rgba[3] = 0x00ffffffu;
   return cloud;
 }
 
-void expect_same_attributes(const PointCloud& a, const PointCloud& b) {
-  ASSERT_EQ(a.size(), b.size());
-  expect_same_floats(flatten(a.xyz), flatten(b.xyz), "xyz");
-  expect_same_floats(flatten(a.normals), flatten(b.normals), "normals");
-  expect_same_floats(a.curvature, b.curvature, "curvature");
-  EXPECT_EQ(a.labels, b.labels);
-  EXPECT_EQ(a.rgba, b.rgba);
-  ASSERT_EQ(a.fields.size(), b.fields.size());
-  for (std::size_t f = 0; f < a.fields.size(); ++f) {
-    EXPECT_EQ(a.fields[f].name, b.fields[f].name);
-    EXPECT_EQ(a.fields[f].count, b.fields[f].count);
-    expect_same_floats(a.fields[f].values, b.fields[f].values, a.fields[f].name);
-  }
-}
-
 void expect_read_error(const std::string& path, const std::string& needle) {
-  try {
-    read_ply(path);
-    ADD_FAILURE() << "no IoError for " << path << " (expected '" << needle << "')";
-  } catch (const IoError& error) {
-    const std::string message = error.what();
-    EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
-    EXPECT_NE(message.find(needle), std::string::npos)
-        << "message: " << message << "\nexpected to contain: " << needle;
-  }
+  test::expect_read_error(read_ply, path, needle);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -317,22 +247,7 @@ TEST(PlyRead, CrLfHeaderAndCommentsAnywhere) {
 // ---------------------------------------------------------------------------------------------
 // Malformed input
 
-struct MalformedPly {
-  const char* name;
-  std::string contents;
-  const char* expected;
-};
-
-// Names the case in gtest output instead of dumping its bytes.
-void PrintTo(const MalformedPly& c, std::ostream* out) { *out << c.name; }
-
-std::string xyz_floats(int points) {
-  std::string out;
-  for (int i = 0; i < 3 * points; ++i) put(out, static_cast<float>(i));
-  return out;
-}
-
-std::vector<MalformedPly> malformed_cases() {
+std::vector<MalformedFile> malformed_cases() {
   const std::string vertex1 = "element vertex 1\n" + kXyzFloat;
   std::string negative_list = ply(
       "binary_little_endian", "element face 1\nproperty list char int vertex_indices\n" + vertex1);
@@ -409,17 +324,14 @@ std::vector<MalformedPly> malformed_cases() {
   };
 }
 
-class PlyMalformed : public ::testing::TestWithParam<MalformedPly> {};
+class PlyMalformed : public ::testing::TestWithParam<MalformedFile> {};
 
 TEST_P(PlyMalformed, ThrowsIoErrorNamingFileAndProblem) {
-  test::TempDir dir;
-  const std::string path = dir.file(std::string(GetParam().name) + ".ply");
-  write_bytes(path, GetParam().contents);
-  expect_read_error(path, GetParam().expected);
+  test::expect_rejected(read_ply, GetParam(), ".ply");
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, PlyMalformed, ::testing::ValuesIn(malformed_cases()),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         test::malformed_file_name);
 
 TEST(PlyMalformedFiles, MissingFileReportsErrno) {
   test::TempDir dir;
@@ -427,25 +339,13 @@ TEST(PlyMalformedFiles, MissingFileReportsErrno) {
 }
 
 // Absurd counts in tiny files must fail on the data, before allocating anything like them.
-class PlyHugeHeader : public ::testing::TestWithParam<MalformedPly> {};
-
-TEST(AllocationGuard, SeesLargeAllocations) {  // else the test below would prove nothing
-  test::reset_largest_allocation();
-  std::vector<char> big(std::size_t{2} << 20);
-  EXPECT_GE(test::largest_allocation(), big.size());
-}
+class PlyHugeHeader : public ::testing::TestWithParam<MalformedFile> {};
 
 TEST_P(PlyHugeHeader, FailsWithoutAllocatingTheDeclaredSize) {
-  test::TempDir dir;
-  const std::string path = dir.file(std::string(GetParam().name) + ".ply");
-  write_bytes(path, GetParam().contents);
-  test::reset_largest_allocation();
-  expect_read_error(path, GetParam().expected);
-  EXPECT_LT(test::largest_allocation(), std::size_t{1} << 20)
-      << "largest allocation while reading a " << GetParam().contents.size() << "-byte file";
+  test::expect_rejected_without_allocating(read_ply, GetParam(), ".ply");
 }
 
-std::vector<MalformedPly> huge_cases() {
+std::vector<MalformedFile> huge_cases() {
   const std::string huge_vertex = "element vertex 4000000000\n" + kXyzFloat;
   return {
       {"Binary", ply("binary_little_endian", huge_vertex) + std::string(100, 'x'),
@@ -472,7 +372,7 @@ std::vector<MalformedPly> huge_cases() {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, PlyHugeHeader, ::testing::ValuesIn(huge_cases()),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         test::malformed_file_name);
 
 }  // namespace
 }  // namespace primlabel

@@ -1,5 +1,5 @@
 #pragma once
-// Helpers shared by the test executables: fixture paths, CSV fixtures, synthetic clouds.
+// Helpers shared by the test executables: fixture paths and files, CSV fixtures, synthetic clouds.
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -67,6 +67,13 @@ inline CommandResult run_command(const std::string& command) {
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// Writes `bytes` to `path` as they are (a fixture file, possibly malformed on purpose).
+inline void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_TRUE(out.good()) << path;
 }
 
 inline int count_lines(const std::string& text) {

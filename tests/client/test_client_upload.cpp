@@ -22,6 +22,7 @@ using client::upload::Spool;
 using client::upload::SpoolFull;
 using client::upload::Uploader;
 using test::FakeServer;
+using test::write_bytes;
 
 // The bytes of a small PCD scan whose fake labels are (i + seed) % 4.
 std::string scan_bytes(int seed, std::size_t n = 200) {
@@ -34,10 +35,6 @@ std::string scan_bytes(int seed, std::size_t n = 200) {
   std::stringstream bytes;
   bytes << in.rdbuf();
   return bytes.str();
-}
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary) << bytes;
 }
 
 std::size_t files_in(const fs::path& dir) {
@@ -60,6 +57,12 @@ client::upload::UploaderOptions uploader_options(const test::TempDir& dir) {
   options.output_dir = dir.file("out");
   options.backoff = {std::chrono::milliseconds(10), 2.0, std::chrono::milliseconds(50), 0.2};
   return options;
+}
+
+// Waits (30 s at most) until every queued scan is uploaded or failed; true when it is.
+bool wait_idle(Uploader& uploader) {
+  const std::atomic<bool> stop{false};
+  return uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -172,9 +175,7 @@ TEST(Uploader, LabelsEachScanOnceIntoItsOwnOutput) {
   std::string id;
   EXPECT_EQ(uploader.submit(scan_bytes(1), ".pcd", &id), Uploader::Submitted::kAccepted);
   uploader.submit(scan_bytes(2), ".pcd");
-  std::atomic<bool> stop{false};
-  ASSERT_TRUE(
-      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  ASSERT_TRUE(wait_idle(uploader));
   const PointCloud out = read_cloud(dir.file("out/" + id + ".pcd"));
   ASSERT_EQ(out.labels.size(), 200u);
   for (std::size_t i = 0; i < 200; ++i) ASSERT_EQ(out.labels[i], (i + 1) % 4);
@@ -197,9 +198,7 @@ TEST(Uploader, RetriesWithBackoffWhileTheServerIsUnavailable) {
   uploader.start();
   std::string id;
   uploader.submit(scan_bytes(3), ".pcd", &id);
-  std::atomic<bool> stop{false};
-  ASSERT_TRUE(
-      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  ASSERT_TRUE(wait_idle(uploader));
   EXPECT_EQ(uploader.counters().retries, 4u);
   EXPECT_EQ(uploader.counters().uploaded, 1u);
   EXPECT_TRUE(fs::exists(dir.file("out/" + id + ".pcd")));
@@ -225,9 +224,7 @@ TEST(Uploader, StartupResumesTheSpoolAndSkipsScansAlreadyWritten) {
   Uploader uploader(client, options);
   EXPECT_EQ(uploader.queued(), 1u);
   uploader.start();
-  std::atomic<bool> stop{false};
-  ASSERT_TRUE(
-      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  ASSERT_TRUE(wait_idle(uploader));
   EXPECT_EQ(server.service.label_calls, 1);
   EXPECT_EQ(uploader.counters().already_labeled, 1u);
   EXPECT_EQ(files_in(options.output_dir), 2u);  // the crash's temp file is gone
@@ -243,9 +240,7 @@ TEST(Uploader, ARefusedScanMovesToFailedAndTheRestGoOn) {
   std::string empty_id;
   uploader.submit(scan_bytes(6, 0), ".pcd", &empty_id);  // the server refuses zero points
   uploader.submit(scan_bytes(7), ".pcd");
-  std::atomic<bool> stop{false};
-  ASSERT_TRUE(
-      uploader.wait_idle(stop, std::chrono::steady_clock::now() + std::chrono::seconds(30)));
+  ASSERT_TRUE(wait_idle(uploader));
   EXPECT_EQ(uploader.counters().failed, 1u);
   EXPECT_EQ(uploader.counters().uploaded, 1u);
   EXPECT_TRUE(fs::exists(dir.file("spool/failed/" + empty_id + ".pcd")));

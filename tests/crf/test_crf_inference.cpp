@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <utility>
 
 #include "brute_force.hpp"
 #include "primlabel/crf/inference.hpp"
@@ -18,43 +19,60 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Prints (does not assert) the speed on a 70k-point kNN-8 graph with K = 10, d = 33.
-TEST(CrfInference, Speed70k) {
+// Loopy BP sum- and max-product, and mean-field (max_product is a BP option: one run is enough).
+constexpr std::pair<InferenceMethod, bool> kMethods[] = {{InferenceMethod::kLoopyBp, false},
+                                                         {InferenceMethod::kLoopyBp, true},
+                                                         {InferenceMethod::kMeanField, false}};
+
+// A scan-like grid scene with heavy descriptor noise, and a prototype model that labels it.
+struct NoisyScene {
+  LabeledGraph scene;
+  CrfModel model;
+};
+
+NoisyScene noisy_scene(int width, int height, int num_classes) {
   SceneSpec spec;
-  spec.width = 265;
-  spec.height = 265;
-  spec.num_classes = 10;
+  spec.width = width;
+  spec.height = height;
+  spec.num_classes = num_classes;
   spec.noise = 40.0f;
-  const LabeledGraph scene = testing::make_grid_scene(spec);
-  const CrfModel model = testing::prototype_model(spec, 4.0f, 1.0f);
+  return {testing::make_grid_scene(spec), testing::prototype_model(spec, 4.0f, 1.0f)};
+}
+
+// The fraction of nodes labelled with their true class (class ids are labels + 1).
+double accuracy(const InferenceResult& r, const LabeledGraph& scene) {
   const std::size_t n = scene.graph.num_nodes();
-  std::printf("graph: %zu nodes, %zu edges\n", n, scene.graph.num_edges());
-  for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
-    for (const bool max_product : {false, true}) {
-      if (method == InferenceMethod::kMeanField && max_product) continue;
-      InferenceOptions options;
-      options.method = method;
-      options.max_product = max_product;
-      options.threads = 2;
-      const auto start = std::chrono::steady_clock::now();
-      const InferenceResult result = infer(model, scene.descriptors, scene.graph, options);
-      const double s = seconds_since(start);
-      std::size_t correct = 0;
-      for (std::size_t i = 0; i < n; ++i)
-        correct += result.labels[i] == std::uint32_t(scene.labels[i] + 1);
-      std::printf("%-10s %-11s %6.1f ms  %9.0f points/s  %2d iterations%s  accuracy %.3f\n",
-                  method == InferenceMethod::kLoopyBp ? "loopy-bp" : "mean-field",
-                  max_product ? "max-product" : "sum-product", 1e3 * s, n / s, result.iterations,
-                  result.converged ? " (converged)" : "", double(correct) / n);
-    }
-  }
+  std::size_t correct = 0;
+  for (std::size_t i = 0; i < n; ++i) correct += r.labels[i] == std::uint32_t(scene.labels[i] + 1);
+  return double(correct) / double(n);
+}
+
+// The baseline a CRF must beat: the model without its edge weights labels each node on its own.
+InferenceResult infer_node_only(const CrfModel& model, const LabeledGraph& scene) {
   CrfModel node_only = model;
   node_only.edge_weights.setZero();
-  const InferenceResult plain = infer(node_only, scene.descriptors, scene.graph, {});
-  std::size_t correct = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    correct += plain.labels[i] == std::uint32_t(scene.labels[i] + 1);
-  std::printf("node-only accuracy %.3f\n", double(correct) / n);
+  return infer(node_only, scene.descriptors, scene.graph, {});
+}
+
+// Prints (does not assert) the speed on a 70k-point kNN-8 graph with K = 10, d = 33.
+TEST(CrfInference, Speed70k) {
+  const auto [scene, model] = noisy_scene(265, 265, 10);
+  const std::size_t n = scene.graph.num_nodes();
+  std::printf("graph: %zu nodes, %zu edges\n", n, scene.graph.num_edges());
+  for (const auto& [method, max_product] : kMethods) {
+    InferenceOptions options;
+    options.method = method;
+    options.max_product = max_product;
+    options.threads = 2;
+    const auto start = std::chrono::steady_clock::now();
+    const InferenceResult result = infer(model, scene.descriptors, scene.graph, options);
+    const double s = seconds_since(start);
+    std::printf("%-10s %-11s %6.1f ms  %9.0f points/s  %2d iterations%s  accuracy %.3f\n",
+                method == InferenceMethod::kLoopyBp ? "loopy-bp" : "mean-field",
+                max_product ? "max-product" : "sum-product", 1e3 * s, n / s, result.iterations,
+                result.converged ? " (converged)" : "", accuracy(result, scene));
+  }
+  std::printf("node-only accuracy %.3f\n", accuracy(infer_node_only(model, scene), scene));
 }
 
 // A random model with d = 3 and random descriptors: potentials with no special structure.
@@ -89,6 +107,17 @@ TinyProblem tiny_problem(std::size_t n,
   return t;
 }
 
+// Loopy BP to a tight fixed point, to be compared with the brute-force answer: sum-product with
+// marginals, or max-product labels.
+InferenceResult infer_tightly(const TinyProblem& t, bool max_product) {
+  InferenceOptions options;
+  options.max_product = max_product;
+  options.compute_marginals = !max_product;
+  options.max_iterations = 200;
+  options.tolerance = 1e-7f;
+  return infer(t.model, t.descriptors, t.graph, options);
+}
+
 const std::vector<std::pair<std::uint32_t, std::uint32_t>> kTree = {{0, 1}, {1, 2}, {1, 3},
                                                                     {3, 4}, {3, 5}, {0, 6}};
 const std::vector<std::pair<std::uint32_t, std::uint32_t>> kLoopy = {{0, 1}, {1, 2}, {2, 3},
@@ -101,11 +130,7 @@ TEST(CrfInference, SumProductIsExactOnATree) {
     for (std::uint32_t seed = 1; seed <= 5; ++seed) {
       const TinyProblem t = tiny_problem(7, kTree, 3, seed, 2.0f, knots);
       const testing::Exact exact = testing::brute_force(t.model, t.descriptors, t.graph);
-      InferenceOptions options;
-      options.compute_marginals = true;
-      options.max_iterations = 200;
-      options.tolerance = 1e-7f;
-      const InferenceResult r = infer(t.model, t.descriptors, t.graph, options);
+      const InferenceResult r = infer_tightly(t, /*max_product=*/false);
       EXPECT_TRUE(r.converged);
       for (std::size_t i = 0; i < 7; ++i)
         for (int k = 0; k < 3; ++k)
@@ -120,11 +145,7 @@ TEST(CrfInference, MaxProductFindsTheMapLabelling) {
     for (std::uint32_t seed = 1; seed <= 8; ++seed) {
       const TinyProblem t = tiny_problem(n, *edges, 3, seed, 2.0f);
       const testing::Exact exact = testing::brute_force(t.model, t.descriptors, t.graph);
-      InferenceOptions options;
-      options.max_product = true;
-      options.max_iterations = 200;
-      options.tolerance = 1e-7f;
-      const InferenceResult r = infer(t.model, t.descriptors, t.graph, options);
+      const InferenceResult r = infer_tightly(t, /*max_product=*/true);
       for (std::size_t i = 0; i < n; ++i)
         EXPECT_EQ(r.labels[i], t.model.class_ids[exact.map[i]])
             << (edges == &kTree ? "tree" : "loopy") << " seed " << seed << " node " << i;
@@ -175,22 +196,19 @@ TEST(CrfInference, WorkspaceReuseGivesIdenticalResults) {
   const CrfModel model = testing::prototype_model(big, 3.0f, 0.8f);
   InferenceWorkspace workspace;
   for (const LabeledGraph* scene : {&big_scene, &small_scene}) {
-    for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
-      for (const bool max_product : {false, true}) {
-        if (method == InferenceMethod::kMeanField && max_product) continue;
-        for (const int threads : {1, 2}) {
-          InferenceOptions options;
-          options.method = method;
-          options.max_product = max_product;
-          options.compute_marginals = true;
-          options.threads = threads;
-          const InferenceResult fresh = infer(model, scene->descriptors, scene->graph, options);
-          const InferenceResult kept =
-              infer(model, scene->descriptors, scene->graph, options, workspace);
-          EXPECT_EQ(fresh.labels, kept.labels);
-          EXPECT_EQ(fresh.iterations, kept.iterations);
-          EXPECT_TRUE(fresh.marginals.cwiseEqual(kept.marginals).all());
-        }
+    for (const auto& [method, max_product] : kMethods) {
+      for (const int threads : {1, 2}) {
+        InferenceOptions options;
+        options.method = method;
+        options.max_product = max_product;
+        options.compute_marginals = true;
+        options.threads = threads;
+        const InferenceResult fresh = infer(model, scene->descriptors, scene->graph, options);
+        const InferenceResult kept =
+            infer(model, scene->descriptors, scene->graph, options, workspace);
+        EXPECT_EQ(fresh.labels, kept.labels);
+        EXPECT_EQ(fresh.iterations, kept.iterations);
+        EXPECT_TRUE(fresh.marginals.cwiseEqual(kept.marginals).all());
       }
     }
   }
@@ -202,42 +220,24 @@ TEST(CrfInference, WorkspaceReuseGivesIdenticalResults) {
 // The default stopping rule (belief change, 15 iterations, settled nodes skipped) fires on a
 // scan-like scene and labels as well as running BP / mean-field to a tight fixed point.
 TEST(CrfInference, DefaultStoppingKeepsAccuracy) {
-  SceneSpec spec;
-  spec.width = 120;
-  spec.height = 90;
-  spec.num_classes = 6;
-  spec.noise = 40.0f;
-  const LabeledGraph scene = testing::make_grid_scene(spec);
-  const CrfModel model = testing::prototype_model(spec, 4.0f, 1.0f);
-  const std::size_t n = scene.graph.num_nodes();
-  const auto accuracy = [&](const InferenceResult& r) {
-    std::size_t correct = 0;
-    for (std::size_t i = 0; i < n; ++i)
-      correct += r.labels[i] == std::uint32_t(scene.labels[i] + 1);
-    return double(correct) / double(n);
-  };
-  CrfModel node_only = model;
-  node_only.edge_weights.setZero();
-  const double plain = accuracy(infer(node_only, scene.descriptors, scene.graph, {}));
-  for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
-    for (const bool max_product : {false, true}) {
-      if (method == InferenceMethod::kMeanField && max_product) continue;
-      InferenceOptions options;
-      options.method = method;
-      options.max_product = max_product;
-      const InferenceResult quick = infer(model, scene.descriptors, scene.graph, options);
-      options.max_iterations = 200;
-      options.tolerance = 1e-6f;
-      const InferenceResult tight = infer(model, scene.descriptors, scene.graph, options);
-      const double a_quick = accuracy(quick), a_tight = accuracy(tight);
-      std::printf("method %d max %d: node-only %.4f, default %.4f (%d it%s), tight %.4f (%d it)\n",
-                  int(method), int(max_product), plain, a_quick, quick.iterations,
-                  quick.converged ? ", converged" : "", a_tight, tight.iterations);
-      EXPECT_GT(a_quick, plain + 0.01);
-      EXPECT_GE(a_quick, a_tight - 1e-3);
-      if (method == InferenceMethod::kLoopyBp) {
-        EXPECT_TRUE(quick.converged);
-      }
+  const auto [scene, model] = noisy_scene(120, 90, 6);
+  const double plain = accuracy(infer_node_only(model, scene), scene);
+  for (const auto& [method, max_product] : kMethods) {
+    InferenceOptions options;
+    options.method = method;
+    options.max_product = max_product;
+    const InferenceResult quick = infer(model, scene.descriptors, scene.graph, options);
+    options.max_iterations = 200;
+    options.tolerance = 1e-6f;
+    const InferenceResult tight = infer(model, scene.descriptors, scene.graph, options);
+    const double a_quick = accuracy(quick, scene), a_tight = accuracy(tight, scene);
+    std::printf("method %d max %d: node-only %.4f, default %.4f (%d it%s), tight %.4f (%d it)\n",
+                int(method), int(max_product), plain, a_quick, quick.iterations,
+                quick.converged ? ", converged" : "", a_tight, tight.iterations);
+    EXPECT_GT(a_quick, plain + 0.01);
+    EXPECT_GE(a_quick, a_tight - 1e-3);
+    if (method == InferenceMethod::kLoopyBp) {
+      EXPECT_TRUE(quick.converged);
     }
   }
 }

@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
-#include <fstream>
 #include <functional>
 
 #include "primlabel/core/taxonomy.hpp"
@@ -14,6 +13,8 @@
 
 namespace primlabel {
 namespace {
+
+using test::write_bytes;
 
 LabelModel sample_crf() {
   LabelModel m;
@@ -54,10 +55,6 @@ LabelModel sample_svm() {
   m.svm_class_ids = m.weights.class_ids;
   m.weights.feature_scale = 0.02f;
   return m;
-}
-
-void write_bytes(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
 }
 
 TEST(LabelModel, CrfRoundTrip) {
