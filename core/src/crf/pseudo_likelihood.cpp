@@ -2,9 +2,9 @@
 //
 // p(y_i = k | y_N(i)) ∝ exp(w_k . x_i + sum_{j in N(i), y_j = k} v_k . e_ij): only neighbours
 // labelled k contribute to class k, so per node the edge features are summed per neighbour label
-// (A_i(k) = sum_{j: y_j = k} e_ij) and each class costs one dot product. Without edges every
-// block of nodes is two matrix products (scores, then the gradient), the fast path of node-only
-// and piecewise training.
+// (A_i(k) = sum_{j: y_j = k} e_ij) and each class costs one dot product. Without edges a block
+// of nodes is two matrix products (scores, then the gradient) in the identity basis, or 2d short
+// axpy's per node in the tent basis: the fast path of node-only and piecewise training.
 
 #include <algorithm>
 #include <cmath>
@@ -50,11 +50,51 @@ class PseudoLikelihood final : public Objective {
     return -(yi_score - top - std::log(z));
   }
 
+  // Node-only over one block in the tent basis: each bin touches two rows of w_t (node_row x K),
+  // so scores and gradient are 2d short axpy's per node instead of a dense product over
+  // d * knots values. Fills grad_t (node_row x K); returns the block's loss.
+  double tent_block(const NodeBlock& block, const RowMatrixXd& w_t, RowMatrixXd& residual,
+                    RowMatrixXd& grad_t) const {
+    const PreparedScene& scene = scenes_[block.scene];
+    const int k_count = shape_.classes;
+    const int row = shape_.node_row();
+    const int d = shape_.edge_dim;
+    residual.resize(block.count, k_count);
+    grad_t.setZero(row, k_count);
+    double* bias_grad = grad_t.data() + std::size_t(row - 1) * k_count;
+    double loss = 0.0;
+    for (long long r = 0; r < block.count; ++r) {
+      const long long i = block.first + r;
+      const int yi = scene.labels[i];
+      double* scores = residual.row(r).data();
+      const TentPair* pairs = &scene.tents[std::size_t(i) * d];
+      std::copy_n(w_t.row(row - 1).data(), k_count, scores);
+      if (yi >= 0)
+        for (int f = 0; f < d; ++f) {
+          const double* lo = w_t.data() + std::size_t(pairs[f].column) * k_count;
+          const double a = pairs[f].lower, c = pairs[f].upper;
+          for (int k = 0; k < k_count; ++k) scores[k] += a * lo[k] + c * lo[k + k_count];
+        }
+      loss += softmax_residual(residual.row(r), yi);
+      if (yi < 0) continue;
+      for (int f = 0; f < d; ++f) {
+        double* g = grad_t.data() + std::size_t(pairs[f].column) * k_count;
+        const double a = pairs[f].lower, c = pairs[f].upper;
+        for (int k = 0; k < k_count; ++k) {
+          g[k] += a * scores[k];
+          g[k + k_count] += c * scores[k];
+        }
+      }
+      for (int k = 0; k < k_count; ++k) bias_grad[k] += scores[k];
+    }
+    return loss;
+  }
+
   void evaluate_blocks_node_only(const Eigen::VectorXd& x) {
     const int k_count = shape_.classes;
     const int row = shape_.node_row();
     const Eigen::Map<const RowMatrixXd> w(x.data(), k_count, row);
-    const RowMatrixXd w_t = w.transpose();  // node_row x K: a tent's K weights are contiguous
+    const RowMatrixXd w_t = w.transpose();  // a tent's K weights contiguous (tent_block)
     const long long block_count = static_cast<long long>(blocks_.size());
 #pragma omp parallel num_threads(threads_)
     {
@@ -73,36 +113,7 @@ class PseudoLikelihood final : public Objective {
             loss += softmax_residual(residual.row(r), scene.labels[block.first + r]);
           grad_w.noalias() = residual.transpose() * features;
         } else {
-          // Tent basis: each bin touches two rows of w_t, so scores and gradient are 2d short
-          // axpy's per node instead of a dense product over d * knots values.
-          const int d = shape_.edge_dim;
-          residual.resize(block.count, k_count);
-          grad_t.setZero(row, k_count);
-          double* bias_grad = grad_t.data() + std::size_t(row - 1) * k_count;
-          for (long long r = 0; r < block.count; ++r) {
-            const long long i = block.first + r;
-            const int yi = scene.labels[i];
-            double* scores = residual.row(r).data();
-            const TentPair* pairs = &scene.tents[std::size_t(i) * d];
-            std::copy_n(w_t.row(row - 1).data(), k_count, scores);
-            if (yi >= 0)
-              for (int f = 0; f < d; ++f) {
-                const double* lo = w_t.data() + std::size_t(pairs[f].column) * k_count;
-                const double a = pairs[f].lower, c = pairs[f].upper;
-                for (int k = 0; k < k_count; ++k) scores[k] += a * lo[k] + c * lo[k + k_count];
-              }
-            loss += softmax_residual(residual.row(r), yi);
-            if (yi < 0) continue;
-            for (int f = 0; f < d; ++f) {
-              double* g = grad_t.data() + std::size_t(pairs[f].column) * k_count;
-              const double a = pairs[f].lower, c = pairs[f].upper;
-              for (int k = 0; k < k_count; ++k) {
-                g[k] += a * scores[k];
-                g[k + k_count] += c * scores[k];
-              }
-            }
-            for (int k = 0; k < k_count; ++k) bias_grad[k] += scores[k];
-          }
+          loss = tent_block(block, w_t, residual, grad_t);
           grad_w = grad_t.transpose();
         }
         partial_loss_(b) = loss;
