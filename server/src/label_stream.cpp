@@ -63,14 +63,18 @@ grpc::Status start_request(const ServiceEnvironment& env, const v1::ScanHeader& 
   return grpc::Status::OK;
 }
 
+// A draining server, or a caller without a valid token, is turned away before anything is read.
+grpc::Status may_start(const ServiceEnvironment& env, grpc::ServerContext& context) {
+  if (env.draining->load()) return shutting_down();
+  return env.auth->check(context, false);
+}
+
 }  // namespace
 
 grpc::Status serve_label_stream(const ServiceEnvironment& env, grpc::ServerContext& context,
                                 RawStream& stream) {
   RequestRecord record("Label", *env.metrics);
-  if (env.draining->load()) return record.finish(shutting_down());
-  if (grpc::Status status = env.auth->check(context, false); !status.ok())
-    return record.finish(status);
+  if (grpc::Status status = may_start(env, context); !status.ok()) return record.finish(status);
 
   // State 1: the header.
   grpc::ByteBuffer buffer;
@@ -145,9 +149,7 @@ grpc::Status serve_label_stream(const ServiceEnvironment& env, grpc::ServerConte
 grpc::Status serve_label_cloud(const ServiceEnvironment& env, grpc::ServerContext& context,
                                RawStream& stream) {
   RequestRecord record("LabelCloud", *env.metrics);
-  if (env.draining->load()) return record.finish(shutting_down());
-  if (grpc::Status status = env.auth->check(context, false); !status.ok())
-    return record.finish(status);
+  if (grpc::Status status = may_start(env, context); !status.ok()) return record.finish(status);
   grpc::ByteBuffer buffer;
   if (!stream.Read(&buffer)) return record.finish(invalid("no LabelCloudRequest was sent"));
   const Clock::time_point receive_start = Clock::now();
