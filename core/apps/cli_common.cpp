@@ -37,14 +37,11 @@ std::vector<float> node_knots(const std::string& basis, const std::vector<float>
     return {};
   }
   if (knots.empty()) return crf::default_node_knots();
-  if (knots.size() < 2 || knots.size() > std::size_t(crf::kMaxNodeKnots))
-    throw std::invalid_argument("--node-knots: give 2 to " + std::to_string(crf::kMaxNodeKnots) +
-                                " knots");
-  for (std::size_t a = 1; a < knots.size(); ++a)
-    if (!(knots[a] > knots[a - 1]))
-      throw std::invalid_argument("--node-knots: knots must increase (" +
-                                  std::to_string(knots[a - 1]) + " then " +
-                                  std::to_string(knots[a]) + ")");
+  try {
+    crf::validate_node_knots(knots);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("--node-knots: ") + e.what());
+  }
   return knots;
 }
 

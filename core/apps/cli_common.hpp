@@ -21,7 +21,7 @@ Vec3f parse_vec3(const std::string& text);
 
 // The CRF node feature basis of --node-basis (tent | linear) and --node-knots: the knots given,
 // crf::default_node_knots() for tent without them, nothing for linear. Throws
-// std::invalid_argument for knots with linear or knots that are not increasing.
+// std::invalid_argument for knots with linear or knots crf::validate_node_knots refuses.
 std::vector<float> node_knots(const std::string& basis, const std::vector<float>& knots);
 inline constexpr const char* kNodeKnotsHelp =
     "tent basis knots, scaled units (bin % / 100), comma separated and increasing "

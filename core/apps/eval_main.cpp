@@ -35,7 +35,7 @@ struct Arguments {
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
   bool table1 = false, no_pfh = false, no_svm = false;
   std::string node_basis = "tent";
-  std::vector<float> node_knots;
+  std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
   int table1_train = 8, table1_test = 4, pfh_max_neighbors = 40, threads = 0, fig4_scenes = 3;
 };
 
@@ -158,7 +158,7 @@ int table1(const Arguments& args) {
   options.with_pfh = !args.no_pfh;
   options.with_svm = !args.no_svm;
   options.pfh_max_neighbors = args.pfh_max_neighbors;
-  options.node_knots = cli::node_knots(args.node_basis, args.node_knots);
+  options.node_knots = args.node_knots;
   options.threads = args.threads;
   if (!args.quiet)
     options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
@@ -294,7 +294,7 @@ int main(int argc, char** argv) {
     return cli::kExitUsage;
   }
   try {
-    (void)cli::node_knots(args.node_basis, args.node_knots);
+    args.node_knots = cli::node_knots(args.node_basis, args.node_knots);  // resolved once
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "primlabel-eval: usage error: %s\n", e.what());
     return cli::kExitUsage;

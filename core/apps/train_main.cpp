@@ -26,7 +26,7 @@ struct Arguments {
   std::string fpfh_variant = "paper", node_basis = "tent";
   double label_radius = synth::kDefaultLabelRadius, l2 = 1e-6, svm_c = 10.0, svm_gamma = 0.0;
   std::size_t svm_max_points = 20000;
-  std::vector<float> node_knots;
+  std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
   float feature_radius = 0.025f, normal_radius = 0.01f;
   std::vector<std::string> train_files, val_files;
   std::string classes, output, curve_csv, curve_png, name;
@@ -110,7 +110,7 @@ int run(const Arguments& args) {
                                                 : crf::TrainingObjective::kPiecewise;
   options.l2 = args.l2;
   options.iterations = args.iterations;
-  options.node_knots = cli::node_knots(args.node_basis, args.node_knots);
+  options.node_knots = args.node_knots;
   options.threads = args.threads;
   std::vector<crf::TrainingIteration> curve;
   if (options.kind != ModelKind::kSvm && (!args.curve_csv.empty() || !args.curve_png.empty()))
@@ -223,6 +223,12 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
     std::fprintf(stderr, "primlabel-train: usage error: %s (see --help)\n", e.what());
+    return cli::kExitUsage;
+  }
+  try {  // before any scene is described
+    args.node_knots = cli::node_knots(args.node_basis, args.node_knots);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "primlabel-train: usage error: %s\n", e.what());
     return cli::kExitUsage;
   }
   if (args.kind == "svm" && (!args.curve_csv.empty() || !args.curve_png.empty())) {

@@ -134,7 +134,12 @@ TEST_F(PipelineCli, BadUsageExitsTwo) {
         test::binary("primlabel-train") + " --kind nonsense -o m.plm",
         test::binary("primlabel-train") + " --synth-train 1",
         test::binary("primlabel-train") + " --kind svm --curve c.csv -o m.plm",
-        test::binary("primlabel-train") + " --train a.pcd --synth-train 2 -o m.plm"}) {
+        test::binary("primlabel-train") + " --train a.pcd --synth-train 2 -o m.plm",
+        // Bad node knots are refused before any scene is described (one line, no progress).
+        eval() + " --table1 --node-knots 0,0.5,0.2",
+        eval() + " --table1 --node-basis linear --node-knots 0,1",
+        test::binary("primlabel-train") + " --node-knots 0 -o m.plm",
+        test::binary("primlabel-train") + " --node-knots 0,0.2,0.2 -o m.plm"}) {
     const Result r = run(command);
     EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
     EXPECT_EQ(lines(r.output), 1) << command << "\n" << r.output;

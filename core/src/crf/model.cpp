@@ -26,6 +26,17 @@ CrfModel CrfModel::zeros(std::vector<std::uint32_t> class_ids, int descriptor_di
   return m;
 }
 
+void validate_node_knots(const std::vector<float>& knots) {
+  if (knots.empty()) return;
+  if (knots.size() < 2 || knots.size() > std::size_t(kMaxNodeKnots))
+    throw std::invalid_argument("node knots: " + std::to_string(knots.size()) + " (2.." +
+                                std::to_string(kMaxNodeKnots) + " or none)");
+  for (std::size_t a = 0; a < knots.size(); ++a)
+    if (!std::isfinite(knots[a]) || (a > 0 && !(knots[a] > knots[a - 1])))
+      throw std::invalid_argument("node knots are not finite and increasing (knot " +
+                                  std::to_string(a) + ": " + std::to_string(knots[a]) + ")");
+}
+
 void CrfModel::validate() const {
   if (class_ids.empty()) throw std::invalid_argument("CRF model: no classes");
   if (descriptor_dim <= 0) throw std::invalid_argument("CRF model: descriptor_dim <= 0");
@@ -33,14 +44,10 @@ void CrfModel::validate() const {
   std::sort(sorted.begin(), sorted.end());
   if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end())
     throw std::invalid_argument("CRF model: repeated class id");
-  if (!node_knots.empty()) {
-    if (node_knots.size() < 2 || node_knots.size() > std::size_t(kMaxNodeKnots))
-      throw std::invalid_argument("CRF model: " + std::to_string(node_knots.size()) +
-                                  " node knots (2.." + std::to_string(kMaxNodeKnots) + " or none)");
-    for (std::size_t a = 0; a < node_knots.size(); ++a)
-      if (!std::isfinite(node_knots[a]) || (a > 0 && !(node_knots[a] > node_knots[a - 1])))
-        throw std::invalid_argument("CRF model: node knots are not finite and increasing (knot " +
-                                    std::to_string(a) + ")");
+  try {
+    validate_node_knots(node_knots);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("CRF model: ") + e.what());
   }
   const auto check = [&](const Eigen::MatrixXf& w, const char* what, int cols) {
     if (w.rows() != num_classes() || w.cols() != cols)

@@ -34,6 +34,10 @@ namespace primlabel::crf {
 
 inline constexpr int kMaxNodeKnots = 64;
 
+// Throws std::invalid_argument unless `knots` is empty (the identity basis) or 2..kMaxNodeKnots
+// finite, strictly increasing values; the message starts "node knots".
+void validate_node_knots(const std::vector<float>& knots);
+
 // The default tent knots, in scaled units (u = s * bin value; FPFH bins are percentages): dense
 // where most bin values lie, so the learnt per-bin curves bend where the classes differ. On the
 // default LMS400 sets (Table I) 6 knots label 98.41%, these 10 98.54%, 16 98.58%.
