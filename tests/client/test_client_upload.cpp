@@ -1,14 +1,17 @@
-// The scan uploader: spool durability (crash leftovers, restart), the spool-full policy, stdin
-// framing, exactly-once outputs, retries, and the tool's exit codes, against the fake server.
+// The scan uploader: spool durability (crash leftovers, restart, corrupt entries), the spool-full
+// policy, full disks (a small tmpfs when running as root), stdin framing, exactly-once outputs,
+// retries, and the tool's exit codes, against the fake server.
 
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "fake_labeler.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "process.hpp"
+#include "small_filesystem.hpp"
 #include "test_util.hpp"
 #include "upload/framing.hpp"
 #include "upload/spool.hpp"
@@ -20,8 +23,10 @@ namespace {
 namespace fs = std::filesystem;
 using client::upload::Spool;
 using client::upload::SpoolFull;
+using client::upload::SpoolWriteFailed;
 using client::upload::Uploader;
 using test::FakeServer;
+using test::SmallFilesystem;
 using test::write_bytes;
 
 // The bytes of a small PCD scan whose fake labels are (i + seed) % 4.
@@ -57,6 +62,21 @@ client::upload::UploaderOptions uploader_options(const test::TempDir& dir) {
   options.output_dir = dir.file("out");
   options.backoff = {std::chrono::milliseconds(10), 2.0, std::chrono::milliseconds(50), 0.2};
   return options;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Flips one bit in the middle of a file, as a failing disk would.
+void flip_a_bit(const fs::path& path) {
+  std::string bytes = read_text(path);
+  ASSERT_FALSE(bytes.empty());
+  bytes[bytes.size() / 2] ^= 0x10;
+  write_bytes(path.string(), bytes);
 }
 
 // Waits (30 s at most) until every queued scan is uploaded or failed; true when it is.
@@ -138,6 +158,69 @@ TEST(UploadSpool, FailedScansMoveAsideWithTheirReason) {
   std::getline(reason, line);
   EXPECT_EQ(line, "INVALID_ARGUMENT: zero points");
   EXPECT_EQ(Spool(dir.file("spool"), {}).size(), 0u);
+}
+
+TEST(UploadSpool, AScanThatWouldEatTheFreeSpaceMarginIsRefusedBeforeAnyWrite) {
+  test::TempDir dir;
+  client::upload::SpoolLimits limits;
+  limits.min_free_bytes = std::numeric_limits<std::uint64_t>::max();  // no disk has that much
+  Spool spool(dir.file("spool"), limits);
+  try {
+    spool.accept("a", "abc", ".pcd");
+    FAIL() << "accepted without the free-space margin";
+  } catch (const SpoolFull& e) {
+    EXPECT_NE(std::string(e.what()).find("not enough free space"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(dir.file("spool")), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(spool.size(), 0u);
+  EXPECT_EQ(files_in(dir.file("spool/scans")), 0u);
+  EXPECT_EQ(files_in(dir.file("spool/tmp")), 0u);
+}
+
+TEST(UploadSpool, AVanishedSpoolDirectoryRefusesTheScanNamingTheFile) {
+  test::TempDir dir;
+  Spool spool(dir.file("spool"), {});
+  spool.accept("a", "first", ".pcd");
+  fs::remove_all(dir.file("spool/scans"));  // the rename into scans/ fails
+  try {
+    spool.accept("b", "second", ".pcd");
+    FAIL() << "accepted into a vanished directory";
+  } catch (const SpoolWriteFailed& e) {
+    EXPECT_NE(std::string(e.what()).find(dir.file("spool/scans")), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("No such file or directory"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(files_in(dir.file("spool/tmp")), 0u);  // no partial entry
+  EXPECT_FALSE(spool.contains("b"));
+  fs::remove_all(dir.file("spool/tmp"));  // now the free-space check itself cannot look
+  EXPECT_THROW(spool.accept("c", "third", ".pcd"), SpoolWriteFailed);
+  EXPECT_EQ(spool.size(), 1u);
+}
+
+TEST(UploadSpool, ACorruptEntryGoesToFailedWithItsReasonAtTheNextStart) {
+  test::TempDir dir;
+  const std::string good = scan_bytes(50), bad = scan_bytes(51);
+  const std::string good_id = client::upload::scan_id(good), bad_id = client::upload::scan_id(bad);
+  client::upload::SpooledScan stored;
+  {
+    Spool spool(dir.file("spool"), {});
+    spool.accept(bad_id, bad, ".pcd", &stored);
+    spool.accept(good_id, good, ".pcd");
+  }
+  flip_a_bit(stored.path);
+  Spool reopened(dir.file("spool"), {});
+  ASSERT_EQ(reopened.size(), 1u);
+  EXPECT_TRUE(reopened.contains(good_id));
+  EXPECT_EQ(reopened.bytes(), good.size());  // the corrupt entry is out of the byte budget
+  ASSERT_EQ(reopened.corrupt_entries().size(), 1u);
+  EXPECT_EQ(reopened.corrupt_entries()[0].id, bad_id);
+  EXPECT_TRUE(reopened.corrupt_entries()[0].moved);
+  EXPECT_FALSE(fs::exists(stored.path));
+  EXPECT_TRUE(fs::exists(dir.file("spool/failed/" + bad_id + ".pcd")));
+  const std::string reason = read_text(dir.file("spool/failed/" + bad_id + ".error"));
+  EXPECT_NE(reason.find("corrupt spool entry"), std::string::npos) << reason;
+  EXPECT_NE(reason.find("not to its id " + bad_id), std::string::npos) << reason;
+  EXPECT_EQ(Spool(dir.file("spool"), {}).corrupt_entries().size(), 0u);  // dealt with once
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -246,6 +329,119 @@ TEST(Uploader, ARefusedScanMovesToFailedAndTheRestGoOn) {
   EXPECT_TRUE(fs::exists(dir.file("spool/failed/" + empty_id + ".pcd")));
 }
 
+TEST(Uploader, ACorruptSpoolEntryIsNeverUploaded) {
+  FakeServer server;
+  test::TempDir dir;
+  const auto options = uploader_options(dir);
+  client::upload::SpooledScan stored;
+  {
+    Spool spool(options.spool_dir, {});
+    spool.accept(client::upload::scan_id(scan_bytes(52)), scan_bytes(52), ".pcd", &stored);
+    spool.accept(client::upload::scan_id(scan_bytes(53)), scan_bytes(53), ".pcd");
+  }
+  flip_a_bit(stored.path);
+  client::Client client(fast_client(server.address()));
+  Uploader uploader(client, options);
+  EXPECT_EQ(uploader.queued(), 1u);
+  uploader.start();
+  ASSERT_TRUE(wait_idle(uploader));
+  EXPECT_EQ(server.service.label_calls, 1);
+  EXPECT_EQ(server.service.scan_ids, std::vector{client::upload::scan_id(scan_bytes(53))});
+  EXPECT_EQ(uploader.counters().corrupt, 1u);
+  EXPECT_EQ(files_in(options.output_dir), 1u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Full disks: a 1 MiB tmpfs (root only; skipped otherwise)
+
+// Scans of 12,000 points: about 144 kB, so seven fill 1 MiB.
+std::string big_scan(int seed) { return scan_bytes(seed, 12'000); }
+
+TEST(UploadFullDisk, AWriteOutOfSpaceLeavesNoTempFileAndNamesTheReason) {
+  test::TempDir dir;
+  SmallFilesystem disk(dir.file("disk"), "size=1m");
+  if (!disk.mounted()) GTEST_SKIP() << disk.why();
+  fs::create_directories(disk.path("tmp"));
+  ASSERT_GT(disk.fill("filler"), 0u);
+  try {
+    client::upload::write_file_durably(disk.path("scan.pcd"), big_scan(60), disk.path("tmp"));
+    FAIL() << "wrote a scan to a full filesystem";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(files_in(disk.path("tmp")), 0u);
+  EXPECT_FALSE(fs::exists(disk.path("scan.pcd")));
+}
+
+TEST(UploadFullDisk, ASpoolOutOfInodesRefusesTheScanAndKeepsWhatItHas) {
+  test::TempDir dir;
+  SmallFilesystem disk(dir.file("disk"), "size=1m,nr_inodes=32");
+  if (!disk.mounted()) GTEST_SKIP() << disk.why();
+  client::upload::SpoolLimits limits;
+  limits.min_free_bytes = 0;
+  Spool spool(disk.path("spool"), limits);
+  spool.accept("a", "first", ".pcd");
+  ASSERT_GT(disk.fill_inodes("filler"), 0u);  // blocks are left, so only the write can see it
+  try {
+    spool.accept("b", "second", ".pcd");
+    FAIL() << "accepted without an inode";
+  } catch (const SpoolWriteFailed& e) {
+    EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(disk.path("spool/tmp").string()), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(files_in(disk.path("spool/tmp")), 0u);
+  EXPECT_EQ(files_in(disk.path("spool/scans")), 1u);
+  fs::remove_all(disk.path("filler"));
+  EXPECT_EQ(spool.accept("b", "second", ".pcd"), Spool::Accepted::kNew);
+  EXPECT_EQ(Spool(disk.path("spool"), limits).size(), 2u);
+}
+
+TEST(UploadFullDisk, ASpoolThatFillsMidRunDrainsAfterSpaceReturns) {
+  FakeServer server;
+  test::TempDir dir;
+  SmallFilesystem disk(dir.file("disk"), "size=1m");
+  if (!disk.mounted()) GTEST_SKIP() << disk.why();
+  auto options = uploader_options(dir);
+  options.spool_dir = disk.path("spool");
+  options.output_dir = disk.path("out");    // the same disk: an output needs space too
+  options.limits.min_free_bytes = 200'000;  // what the margin is for: room for an output
+  client::Client client(fast_client(server.address()));
+  Uploader uploader(client, options);
+  std::vector<std::string> accepted;
+  std::string reason;
+  int seed = 100;
+  for (; seed < 120; ++seed) {
+    std::string id;
+    const auto result = uploader.submit(big_scan(seed), ".pcd", &id, &reason);
+    if (result != Uploader::Submitted::kAccepted) {
+      EXPECT_TRUE(result == Uploader::Submitted::kSpoolFull ||
+                  result == Uploader::Submitted::kWriteFailed);
+      break;
+    }
+    accepted.push_back(id);
+  }
+  ASSERT_GE(accepted.size(), 2u);
+  ASSERT_LT(seed, 120) << "a 1 MiB spool took 20 scans of 144 kB";
+  EXPECT_FALSE(reason.empty());
+  EXPECT_EQ(files_in(disk.path("spool/tmp")), 0u);
+  disk.fill("filler");  // not a block left for the outputs
+
+  uploader.start();
+  EXPECT_TRUE(
+      test::eventually([&] { return uploader.counters().retries >= 2; }, std::chrono::seconds(20)));
+  EXPECT_EQ(uploader.queued(), accepted.size());  // nothing accepted is lost
+  EXPECT_EQ(files_in(disk.path("spool/scans")), accepted.size());
+
+  fs::remove(disk.path("filler"));  // space returns
+  ASSERT_TRUE(wait_idle(uploader));
+  EXPECT_EQ(uploader.counters().uploaded, accepted.size());
+  for (const std::string& id : accepted) EXPECT_TRUE(fs::exists(uploader.output_path(id))) << id;
+  EXPECT_EQ(files_in(disk.path("spool/scans")), 0u);
+  EXPECT_EQ(uploader.submit(big_scan(seed), ".pcd"), Uploader::Submitted::kAccepted);
+  uploader.stop();
+}
+
 // ---------------------------------------------------------------------------------------------
 // The tool
 
@@ -269,6 +465,68 @@ TEST(UploadCli, SpoolFullRejectsWithExitFiveAndKeepsWhatItAccepted) {
   EXPECT_NE(r.output.find("spool full"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("left in spool 2"), std::string::npos) << r.output;
   EXPECT_EQ(files_in(dir.file("spool/scans")), 2u);
+}
+
+TEST(UploadCli, AFullSpoolDiskRejectsWithExitFiveAndARestartDrainsBeforeTakingMore) {
+  test::TempDir dir;
+  SmallFilesystem disk(dir.file("disk"), "size=1m");
+  if (!disk.mounted()) GTEST_SKIP() << disk.why();
+  std::string files;
+  for (int i = 0; i < 8; ++i) {
+    write_bytes(dir.file("s" + std::to_string(i) + ".pcd"), big_scan(70 + i));
+    files += " " + dir.file("s" + std::to_string(i) + ".pcd");
+  }
+  const std::string spool_out =
+      " --spool " + disk.path("spool").string() + " -o " + dir.file("out") + files;
+  std::string dead;
+  { dead = FakeServer().address(); }
+  // The default margin (16 MB) refuses everything on a 1 MiB disk, one line per scan.
+  auto r = test::run_command(upload_tool() + " -q --retries 1 --timeout 0.5 --server " + dead +
+                             spool_out);
+  EXPECT_EQ(r.exit_code, 5) << r.output;
+  EXPECT_NE(r.output.find("primlabel-upload: " + dir.file("s0.pcd") +
+                          ": not enough free space on the spool's filesystem"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(files_in(disk.path("spool/scans")), 0u);
+
+  r = test::run_command(upload_tool() + " -q --retries 1 --timeout 0.5 --spool-min-free-mb 0 " +
+                        "--server " + dead + spool_out);
+  EXPECT_EQ(r.exit_code, 5) << r.output;
+  const std::size_t spooled = files_in(disk.path("spool/scans"));
+  EXPECT_GE(spooled, 4u) << r.output;
+  EXPECT_LT(spooled, 8u) << r.output;
+  EXPECT_EQ(files_in(disk.path("spool/tmp")), 0u);
+  disk.fill("filler");  // and the disk fills up completely before the restart
+
+  // The restart uploads what is spooled first, which frees room for the rest.
+  FakeServer server;
+  r = test::run_command(upload_tool() + " -q --spool-min-free-mb 0 --server " + server.address() +
+                        spool_out);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(files_in(dir.file("out")), 8u) << r.output;
+  EXPECT_EQ(server.service.label_calls, 8);
+  EXPECT_EQ(files_in(disk.path("spool/scans")), 0u);
+}
+
+TEST(UploadCli, ACorruptSpoolEntryIsReportedAndExitsFour) {
+  FakeServer server;
+  test::TempDir dir;
+  client::upload::SpooledScan stored;
+  const std::string id = client::upload::scan_id(scan_bytes(54));
+  {
+    Spool spool(dir.file("spool"), {});
+    spool.accept(id, scan_bytes(54), ".pcd", &stored);
+  }
+  flip_a_bit(stored.path);
+  const auto r = test::run_command(upload_tool() + " -q --server " + server.address() +
+                                   " --spool " + dir.file("spool") + " -o " + dir.file("out"));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find(stored.path.string() + ": corrupt spool entry"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("corrupt 1"), std::string::npos) << r.output;
+  EXPECT_EQ(server.service.label_calls, 0);
+  EXPECT_EQ(files_in(dir.file("out")), 0u);
 }
 
 TEST(UploadCli, TimeoutWithTheServerAwayExitsThreeThenALaterRunDrainsTheSpool) {

@@ -1,7 +1,9 @@
 #include "spool.hpp"
 
 #include <fcntl.h>
+#include <openssl/evp.h>
 #include <openssl/sha.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 
 namespace primlabel::client::upload {
 
@@ -30,11 +33,7 @@ bool is_scan_file(const fs::path& path) {
   return ext == ".pcd" || ext == ".ply";
 }
 
-}  // namespace
-
-std::string scan_id(std::string_view bytes) {
-  unsigned char digest[SHA256_DIGEST_LENGTH];
-  SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), digest);
+std::string id_from_digest(const unsigned char* digest) {
   static const char* const kHex = "0123456789abcdef";
   std::string id;
   for (int i = 0; i < 16; ++i) {
@@ -42,6 +41,43 @@ std::string scan_id(std::string_view bytes) {
     id.push_back(kHex[digest[i] & 15]);
   }
   return id;
+}
+
+// The scan id of a file's content, read in blocks so a large entry costs no memory. Throws
+// std::runtime_error naming the file when it cannot be read.
+std::string scan_id_of_file(const fs::path& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail_errno("cannot open", path);
+  struct Closer {
+    int fd;
+    EVP_MD_CTX* context;
+    ~Closer() {
+      ::close(fd);
+      EVP_MD_CTX_free(context);
+    }
+  } closer{fd, EVP_MD_CTX_new()};
+  if (!closer.context || EVP_DigestInit_ex(closer.context, EVP_sha256(), nullptr) != 1)
+    throw std::runtime_error(path.string() + ": cannot start SHA-256");
+  std::vector<unsigned char> block(1 << 20);
+  for (;;) {
+    const ssize_t n = ::read(fd, block.data(), block.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) fail_errno("read failed", path);
+    if (n == 0) break;
+    EVP_DigestUpdate(closer.context, block.data(), static_cast<std::size_t>(n));
+  }
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  EVP_DigestFinal_ex(closer.context, digest, &length);
+  return id_from_digest(digest);
+}
+
+}  // namespace
+
+std::string scan_id(std::string_view bytes) {
+  unsigned char digest[SHA256_DIGEST_LENGTH];
+  SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), digest);
+  return id_from_digest(digest);
 }
 
 void fsync_path(const fs::path& path) {
@@ -71,11 +107,14 @@ void write_file_durably(const fs::path& target, std::string_view bytes, const fs
     }
     written += static_cast<std::size_t>(n);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const int saved = errno;
+  const bool synced = ::fsync(fd) == 0;
+  const int sync_error = errno;
+  const bool closed = ::close(fd) == 0;  // always, even when fsync failed
+  if (!synced || !closed) {
+    const int saved = synced ? errno : sync_error;
     ::unlink(temp.c_str());
     errno = saved;
-    fail_errno("fsync failed", temp);
+    fail_errno(synced ? "close failed" : "fsync failed", temp);
   }
   if (::rename(temp.c_str(), target.c_str()) != 0) {
     const int saved = errno;
@@ -111,12 +150,32 @@ Spool::Spool(fs::path dir, SpoolLimits limits) : dir_(std::move(dir)), limits_(l
     } catch (const std::exception&) {
       continue;
     }
-    found.push_back({sequence, {stem.substr(underscore + 1), entry.path(), entry.file_size()}});
+    const std::string id = stem.substr(underscore + 1);
+    next_sequence_ = std::max(next_sequence_, sequence + 1);  // corrupt entries included
+    // A bit flipped on disk would otherwise be labeled under the original scan's id.
+    std::string reason;
+    try {
+      const std::string actual = scan_id_of_file(entry.path());
+      if (actual != id)
+        reason = "corrupt spool entry: its content hashes to " + actual + ", not to its id " + id;
+    } catch (const std::exception& e) {
+      reason = std::string("unreadable spool entry: ") + e.what();
+    }
+    if (!reason.empty()) {
+      CorruptEntry corrupt{id, entry.path(), reason};
+      try {
+        move_to_failed(id, entry.path(), reason);
+      } catch (const std::exception&) {
+        corrupt.moved = false;  // left where it is, checked again at the next start
+      }
+      corrupt_.push_back(std::move(corrupt));
+      continue;
+    }
+    found.push_back({sequence, {id, entry.path(), entry.file_size()}});
   }
   std::sort(found.begin(), found.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
   for (auto& [sequence, scan] : found) {
-    next_sequence_ = std::max(next_sequence_, sequence + 1);
     bytes_ += scan.bytes;
     scans_.push_back(std::move(scan));
   }
@@ -138,16 +197,44 @@ Spool::Accepted Spool::accept(const std::string& id, std::string_view bytes, con
     throw SpoolFull("spool full (" + std::to_string(scans_.size()) + " scans, " +
                     std::to_string(bytes_) + " of " + std::to_string(limits_.max_bytes) +
                     " bytes): scan of " + std::to_string(bytes.size()) + " bytes not accepted");
+  check_free_space(bytes.size());
   char sequence[24];
   std::snprintf(sequence, sizeof sequence, "%016llu_",
                 static_cast<unsigned long long>(next_sequence_));
   const fs::path target = dir_ / kScans / (sequence + id + ext);
-  write_file_durably(target, bytes, dir_ / kTemp);
+  try {
+    write_file_durably(target, bytes, dir_ / kTemp);
+  } catch (const std::exception& e) {
+    // The temp file is gone; a renamed file whose directory fsync failed must go too, or the
+    // next start would resume a scan nobody was told was accepted.
+    std::error_code ec;
+    fs::remove(target, ec);
+    throw SpoolWriteFailed(std::string("cannot spool the scan: ") + e.what());
+  }
   ++next_sequence_;
   scans_.push_back({id, target, bytes.size()});
   if (stored) *stored = scans_.back();
   bytes_ += bytes.size();
   return Accepted::kNew;
+}
+
+void Spool::check_free_space(std::uint64_t scan_bytes) const {
+  const fs::path temp = dir_ / kTemp;
+  struct statvfs info {};
+  if (::statvfs(temp.c_str(), &info) != 0)
+    throw SpoolWriteFailed("cannot spool the scan: " + temp.string() +
+                           ": cannot check free space: " + std::strerror(errno));
+  const std::uint64_t free_bytes = std::uint64_t{info.f_bavail} * info.f_frsize;
+  // Saturating: a huge margin must refuse, not wrap around.
+  constexpr std::uint64_t kMax = std::numeric_limits<std::uint64_t>::max();
+  const std::uint64_t needed =
+      scan_bytes > kMax - limits_.min_free_bytes ? kMax : scan_bytes + limits_.min_free_bytes;
+  if (free_bytes < needed)
+    throw SpoolFull("not enough free space on the spool's filesystem (" + dir_.string() + ": " +
+                    std::to_string(free_bytes) + " bytes free; a scan of " +
+                    std::to_string(scan_bytes) + " bytes needs " + std::to_string(needed) +
+                    " with the margin of " + std::to_string(limits_.min_free_bytes) +
+                    "): not accepted");
 }
 
 std::vector<SpooledScan> Spool::pending() const {
@@ -172,15 +259,19 @@ void Spool::complete(const std::string& id) {
   scans_.erase(it);
 }
 
+void Spool::move_to_failed(const std::string& id, const fs::path& path, const std::string& reason) {
+  const fs::path target = dir_ / kFailed / (id + path.extension().string());
+  write_file_durably(dir_ / kFailed / (id + ".error"), reason + "\n", dir_ / kTemp);
+  if (::rename(path.c_str(), target.c_str()) != 0) fail_errno("cannot move", path);
+  fsync_path(dir_ / kFailed);
+  fsync_path(dir_ / kScans);
+}
+
 void Spool::fail(const std::string& id, const std::string& reason) {
   std::lock_guard lock(mutex_);
   const auto it = find(id);
   if (it == scans_.end()) return;
-  const fs::path target = dir_ / kFailed / (id + it->path.extension().string());
-  write_file_durably(dir_ / kFailed / (id + ".error"), reason + "\n", dir_ / kTemp);
-  if (::rename(it->path.c_str(), target.c_str()) != 0) fail_errno("cannot move", it->path);
-  fsync_path(dir_ / kFailed);
-  fsync_path(dir_ / kScans);
+  move_to_failed(id, it->path, reason);
   bytes_ -= it->bytes;
   scans_.erase(it);
 }

@@ -5,8 +5,13 @@
 // power loss at any moment leaves either no trace of an unacknowledged scan (a leftover temp
 // file, removed at the next start) or the whole scan.
 //
-// The spool is bounded (bytes and scans). When a new scan does not fit, accept() refuses it with
-// SpoolFull; accepted scans are never dropped to make room.
+// The spool is bounded (bytes and scans, and a free-space margin on its filesystem). When a new
+// scan does not fit, accept() refuses it with SpoolFull; when its write fails (ENOSPC, EIO, a
+// vanished directory) with SpoolWriteFailed, leaving no trace of it. Accepted scans are never
+// dropped to make room.
+//
+// At start every entry is checked against its id (the content hash): a corrupt one goes to
+// failed/ with its reason, exactly like a scan the server refused, and is never uploaded.
 
 #include <cstdint>
 #include <filesystem>
@@ -22,14 +27,36 @@ namespace primlabel::client::upload {
 // scan gives the same id wherever and however often it is submitted.
 std::string scan_id(std::string_view bytes);
 
-class SpoolFull : public std::runtime_error {
+// The spool cannot take a scan; it is not accepted and nothing of it is left in the spool.
+class SpoolRefusal : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+// Over the spool's limits, or too little free space on its filesystem.
+class SpoolFull : public SpoolRefusal {
+ public:
+  using SpoolRefusal::SpoolRefusal;
+};
+// Writing the scan failed (the message names the file and the system's reason).
+class SpoolWriteFailed : public SpoolRefusal {
+ public:
+  using SpoolRefusal::SpoolRefusal;
 };
 
 struct SpoolLimits {
   std::uint64_t max_bytes = 1ull << 30;
   std::uint64_t max_scans = 10'000;
+  // Free space the spool's filesystem must keep after a new scan (statvfs, before writing), so
+  // a full disk is refused up front rather than by a failing write.
+  std::uint64_t min_free_bytes = 16'000'000;
+};
+
+// A spool entry whose content no longer matches its id, found (and moved to failed/) at start.
+struct CorruptEntry {
+  std::string id;
+  std::filesystem::path path;  // where it was in scans/
+  std::string reason;
+  bool moved = true;  // false: the move to failed/ itself failed; it is still ignored
 };
 
 struct SpooledScan {
@@ -40,14 +67,15 @@ struct SpooledScan {
 
 class Spool {
  public:
-  // Opens (creating) the spool at `dir`: removes temp files of writes a crash interrupted and
-  // indexes the scans already accepted. Throws std::runtime_error naming the directory.
+  // Opens (creating) the spool at `dir`: removes temp files of writes a crash interrupted,
+  // verifies the scans already accepted against their ids and indexes the sound ones. Throws
+  // std::runtime_error naming the directory.
   Spool(std::filesystem::path dir, SpoolLimits limits);
 
   enum class Accepted { kNew, kAlreadyQueued };
 
   // Stores the scan durably under `id` with extension `ext` (".pcd" or ".ply") and tells where
-  // (`stored`). Throws SpoolFull when it does not fit, std::runtime_error when the write fails.
+  // (`stored`). Throws SpoolFull when it does not fit, SpoolWriteFailed when the write fails.
   Accepted accept(const std::string& id, std::string_view bytes, const std::string& ext,
                   SpooledScan* stored = nullptr);
 
@@ -66,9 +94,14 @@ class Spool {
   const SpoolLimits& limits() const { return limits_; }
   const std::filesystem::path& dir() const { return dir_; }
   std::size_t removed_temp_files() const { return removed_temp_files_; }
+  const std::vector<CorruptEntry>& corrupt_entries() const { return corrupt_; }
 
  private:
   std::vector<SpooledScan>::const_iterator find(const std::string& id) const;
+  void check_free_space(std::uint64_t scan_bytes) const;
+  // Moves a scan file to failed/ beside a ".error" file holding `reason`.
+  void move_to_failed(const std::string& id, const std::filesystem::path& path,
+                      const std::string& reason);
 
   std::filesystem::path dir_;
   SpoolLimits limits_;
@@ -77,12 +110,14 @@ class Spool {
   std::uint64_t bytes_ = 0;
   std::uint64_t next_sequence_ = 0;
   std::size_t removed_temp_files_ = 0;
+  std::vector<CorruptEntry> corrupt_;
 };
 
 // Durable-write helpers the uploader shares with its output writer.
 void fsync_path(const std::filesystem::path& path);  // a file or a directory
 // Writes `bytes` to `target` via a temp file in `temp_dir` (same filesystem), fsync and rename,
-// then fsyncs target's directory.
+// then fsyncs target's directory. On failure the temp file is gone; `target` may exist only when
+// the final directory fsync failed. Throws std::runtime_error naming the file and the reason.
 void write_file_durably(const std::filesystem::path& target, std::string_view bytes,
                         const std::filesystem::path& temp_dir);
 

@@ -28,15 +28,18 @@ constexpr int kExitUsage = 1;
 constexpr int kExitInput = 2;
 constexpr int kExitTimedOut = 3;
 constexpr int kExitRefused = 4;
-constexpr int kExitSpoolFull = 5;
+constexpr int kExitNotAccepted = 5;  // full spool, full disk or a failed spool write
 
 constexpr const char* kFooter =
     "Each accepted scan is acknowledged on stdout as '<state> <id> <source>' (state: accepted, "
-    "queued = already in the spool, labeled = output exists, rejected = spool full) and labeled "
-    "into OUT/<id>.pcd, id = content hash. Exit codes (the highest that applies): 0 every scan "
-    "labeled (or --watch stopped by a signal), 1 usage, 2 an input could not be read, 3 "
-    "--timeout passed with scans still spooled, 4 the server refused scans for good (kept in "
-    "SPOOL/failed), 5 the spool was full and scans were not accepted.";
+    "queued = already in the spool, labeled = output exists, rejected = the spool could not take "
+    "it) and labeled into OUT/<id>.pcd, id = content hash. Scans already spooled are uploaded "
+    "before new input is read. Exit codes (the highest that applies): 0 every scan labeled (or "
+    "--watch stopped by a signal), 1 usage, 2 an input could not be read, 3 --timeout passed "
+    "with scans still spooled, 4 scans were moved to SPOOL/failed (refused by the server for "
+    "good, or corrupt in the spool), 5 scans were not accepted: the spool was full, its disk "
+    "short of --spool-min-free-mb, or the write failed (one line on stderr names the file and "
+    "the reason).";
 
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
@@ -65,21 +68,21 @@ struct Intake {
 
   void raise(int code) { exit_code = std::max(exit_code, code); }
 
-  // Submits one scan and acknowledges it on stdout; false when the spool was full.
+  // Submits one scan and acknowledges it on stdout; false when the spool could not take it.
   bool submit(std::string_view bytes, const std::string& ext, const std::string& source) {
     std::string id, reason;
     const auto result = uploader.submit(bytes, ext, &id, &reason);
-    static const char* const kState[] = {"accepted", "queued", "labeled", "rejected"};
+    static const char* const kState[] = {"accepted", "queued", "labeled", "rejected", "rejected"};
     std::printf("%s %s %s\n", kState[static_cast<int>(result)], id.c_str(), source.c_str());
     std::fflush(stdout);
-    if (result == Uploader::Submitted::kSpoolFull) {
+    if (result == Uploader::Submitted::kSpoolFull || result == Uploader::Submitted::kWriteFailed) {
       std::fprintf(stderr, "primlabel-upload: %s: %s\n", source.c_str(), reason.c_str());
       return false;
     }
     return true;
   }
 
-  // A file input; false when the spool was full (the file is left alone).
+  // A file input; false when the spool could not take it (the file is left alone).
   bool submit_file(const fs::path& path) {
     std::string bytes;
     try {
@@ -107,7 +110,7 @@ struct Intake {
   void from_files(const std::vector<std::string>& files) {
     for (const auto& f : files) {
       if (g_stop) return;
-      if (!submit_file(f)) raise(kExitSpoolFull);
+      if (!submit_file(f)) raise(kExitNotAccepted);
     }
   }
 
@@ -128,7 +131,7 @@ struct Intake {
       }
       if (!scan) return;
       if (!submit(*scan, scan_extension(*scan), "stdin#" + std::to_string(n)))
-        raise(kExitSpoolFull);
+        raise(kExitNotAccepted);
     }
   }
 
@@ -159,14 +162,16 @@ std::string summary_line(const UploadCounters& c, std::size_t left) {
   std::snprintf(
       line, sizeof line,
       "summary: accepted %llu new, %llu already spooled, %llu already labeled; uploaded "
-      "%llu (%llu points), failed %llu, rejected %llu (spool full), retries %llu, left in "
-      "spool %zu",
+      "%llu (%llu points), failed %llu, corrupt %llu, rejected %llu (spool full), %llu (spool "
+      "write failed), retries %llu, left in spool %zu",
       static_cast<unsigned long long>(c.accepted),
       static_cast<unsigned long long>(c.already_queued),
       static_cast<unsigned long long>(c.already_labeled),
       static_cast<unsigned long long>(c.uploaded), static_cast<unsigned long long>(c.points),
-      static_cast<unsigned long long>(c.failed), static_cast<unsigned long long>(c.rejected_full),
-      static_cast<unsigned long long>(c.retries), left);
+      static_cast<unsigned long long>(c.failed), static_cast<unsigned long long>(c.corrupt),
+      static_cast<unsigned long long>(c.rejected_full),
+      static_cast<unsigned long long>(c.rejected_write), static_cast<unsigned long long>(c.retries),
+      left);
   return line;
 }
 
@@ -183,7 +188,7 @@ int main(int argc, char** argv) {
   std::string spool, out, watch_dir;
   std::vector<std::string> files, frame_files;
   bool from_stdin = false, quiet = false, remove_source = false;
-  double spool_mb = 1024, status_s = 10, timeout_s = 0, backoff_max_s = 30;
+  double spool_mb = 1024, spool_min_free_mb = 16, status_s = 10, timeout_s = 0, backoff_max_s = 30;
   std::uint64_t max_scans = 10'000;
   app.add_option("FILE", files, "Scan files (.pcd / .ply) to upload");
   app.add_option("--spool", spool, "Spool directory (created)");
@@ -195,6 +200,10 @@ int main(int argc, char** argv) {
   app.add_flag("--remove-source", remove_source, "Delete input files once spooled");
   app.add_option("--spool-max-mb", spool_mb, "Spool size limit (MB)")->capture_default_str();
   app.add_option("--spool-max-scans", max_scans, "Spool scan count limit")->capture_default_str();
+  app.add_option("--spool-min-free-mb", spool_min_free_mb,
+                 "Free space (MB) the spool's filesystem must keep after a new scan")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--workers", options.workers, "Uploads in parallel")->capture_default_str();
   app.add_option("--status-interval", status_s, "Seconds between status lines (0 = none)")
       ->capture_default_str();
@@ -240,6 +249,7 @@ int main(int argc, char** argv) {
   options.output_dir = out;
   options.limits.max_bytes = static_cast<std::uint64_t>(spool_mb * 1e6);
   options.limits.max_scans = max_scans;
+  options.limits.min_free_bytes = static_cast<std::uint64_t>(spool_min_free_mb * 1e6);
   options.backoff.max = std::chrono::milliseconds(static_cast<long long>(backoff_max_s * 1000));
   std::unique_ptr<Client> client;
   std::unique_ptr<Uploader> uploader;
@@ -250,10 +260,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "primlabel-upload: %s\n", e.what());
     return kExitInput;
   }
-  if (!quiet && uploader->queued() > 0)
-    std::fprintf(stderr, "primlabel-upload: resuming %zu scans from the spool\n",
-                 uploader->queued());
+  for (const CorruptEntry& entry : uploader->corrupt_entries())
+    std::fprintf(stderr, "primlabel-upload: %s: %s; %s\n", entry.path.c_str(), entry.reason.c_str(),
+                 entry.moved ? ("moved to " + (fs::path(spool) / "failed").string()).c_str()
+                             : "not uploaded (moving it to failed/ failed too)");
+  const std::size_t resuming = uploader->queued();
+  if (!quiet && resuming > 0)
+    std::fprintf(stderr, "primlabel-upload: resuming %zu scans from the spool\n", resuming);
   uploader->start();
+  auto deadline = [&]() -> std::optional<std::chrono::steady_clock::time_point> {
+    if (timeout_s <= 0) return std::nullopt;
+    return std::chrono::steady_clock::now() +
+           std::chrono::milliseconds(static_cast<long long>(timeout_s * 1000));
+  };
 
   // The operator's status line, on its own thread so a blocked intake does not silence it.
   std::atomic<bool> status_done{false};
@@ -270,31 +289,33 @@ int main(int argc, char** argv) {
   });
 
   Intake intake{*uploader, remove_source};
-  if (!watch_dir.empty()) {
-    try {
+  // What is already spooled goes first: new input could fill the disk and strand it.
+  if (resuming > 0 && !uploader->wait_idle(g_stop, deadline()) && !g_stop)
+    std::fprintf(stderr,
+                 "primlabel-upload: --timeout passed with %zu scans still spooled from the last "
+                 "run; taking new input anyway\n",
+                 uploader->queued());
+  try {
+    if (!g_stop) {
       intake.from_files(files);
-      intake.watch(watch_dir);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "primlabel-upload: %s\n", e.what());
-      intake.raise(kExitInput);
+      if (!watch_dir.empty()) {
+        intake.watch(watch_dir);
+      } else if (from_stdin) {
+        intake.from_stdin(options.limits.max_bytes);
+      }
     }
-  } else {
-    intake.from_files(files);
-    if (from_stdin) intake.from_stdin(options.limits.max_bytes);
+  } catch (const std::exception& e) {  // e.g. the watched directory vanished
+    std::fprintf(stderr, "primlabel-upload: %s\n", e.what());
+    intake.raise(kExitInput);
   }
   // Files and stdin: wait for the uploads (a watch ends only by signal, so it does not wait).
-  if (watch_dir.empty()) {
-    std::optional<std::chrono::steady_clock::time_point> until;
-    if (timeout_s > 0)
-      until = std::chrono::steady_clock::now() +
-              std::chrono::milliseconds(static_cast<long long>(timeout_s * 1000));
-    if (!uploader->wait_idle(g_stop, until) && !g_stop) intake.raise(kExitTimedOut);
-  }
+  if (watch_dir.empty() && !uploader->wait_idle(g_stop, deadline()) && !g_stop)
+    intake.raise(kExitTimedOut);
   uploader->stop();
   status_done = true;
   status.join();
   const UploadCounters counters = uploader->counters();
-  if (counters.failed > 0) intake.raise(kExitRefused);
+  if (counters.failed > 0 || counters.corrupt > 0) intake.raise(kExitRefused);
   std::fprintf(stderr, "primlabel-upload: %s\n",
                summary_line(counters, uploader->queued()).c_str());
   return intake.exit_code;

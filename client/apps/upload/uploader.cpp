@@ -37,6 +37,7 @@ Uploader::Uploader(Client& client, UploaderOptions options)
       options_(std::move(options)),
       spool_(options_.spool_dir, options_.limits),
       backoff_(options_.backoff) {
+  counters_.corrupt = spool_.corrupt_entries().size();
   std::error_code ec;
   fs::create_directories(options_.output_dir, ec);
   if (ec)
@@ -67,7 +68,8 @@ Uploader::Submitted Uploader::submit(std::string_view bytes, const std::string& 
                                      std::string* id_out, std::string* reason) {
   const std::string id = scan_id(bytes);
   if (id_out) *id_out = id;
-  if (fs::exists(output_path(id))) {
+  std::error_code ec;  // an unreadable output directory means "not labeled yet"
+  if (fs::exists(output_path(id), ec)) {
     std::lock_guard lock(mutex_);
     ++counters_.already_labeled;
     return Submitted::kAlreadyLabeled;
@@ -81,6 +83,11 @@ Uploader::Submitted Uploader::submit(std::string_view bytes, const std::string& 
     std::lock_guard lock(mutex_);
     ++counters_.rejected_full;
     return Submitted::kSpoolFull;
+  } catch (const std::exception& e) {  // SpoolWriteFailed, or anything else the write threw
+    if (reason) *reason = e.what();
+    std::lock_guard lock(mutex_);
+    ++counters_.rejected_write;
+    return Submitted::kWriteFailed;
   }
   std::lock_guard lock(mutex_);
   if (accepted == Spool::Accepted::kAlreadyQueued) {
@@ -233,7 +240,7 @@ std::string Uploader::status_line() const {
                 queue_.size() + in_flight_, in_flight_,
                 static_cast<unsigned long long>(counters_.uploaded),
                 static_cast<unsigned long long>(counters_.failed),
-                static_cast<unsigned long long>(counters_.rejected_full),
+                static_cast<unsigned long long>(counters_.rejected_full + counters_.rejected_write),
                 static_cast<unsigned long long>(counters_.retries), spool_.bytes() / 1e6,
                 spool_.limits().max_bytes / 1e6, server_down_ ? "down" : "up");
   return line;

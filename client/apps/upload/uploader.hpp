@@ -35,23 +35,25 @@ struct UploadCounters {
   std::uint64_t accepted = 0;         // new scans taken into the spool
   std::uint64_t already_queued = 0;   // submitted again while in the spool
   std::uint64_t already_labeled = 0;  // submitted (or found in the spool) with output present
-  std::uint64_t rejected_full = 0;    // refused: the spool was full
+  std::uint64_t rejected_full = 0;    // refused: the spool (or its filesystem) was full
+  std::uint64_t rejected_write = 0;   // refused: writing it into the spool failed
   std::uint64_t uploaded = 0;         // labeled and written
   std::uint64_t failed = 0;           // refused by the server for good (kept in spool/failed)
+  std::uint64_t corrupt = 0;          // spool entries that did not match their id at start
   std::uint64_t retries = 0;          // uploads that will be tried again
   std::uint64_t points = 0;           // points labeled
 };
 
 class Uploader {
  public:
-  // Opens the spool (recovering from a crash) and queues what it holds. Throws
-  // std::runtime_error when the spool or output directory cannot be used.
+  // Opens the spool (recovering from a crash, setting corrupt entries aside) and queues what it
+  // holds. Throws std::runtime_error when the spool or output directory cannot be used.
   Uploader(Client& client, UploaderOptions options);
   ~Uploader();  // stop()
 
-  enum class Submitted { kAccepted, kAlreadyQueued, kAlreadyLabeled, kSpoolFull };
-  // Takes one scan (its file bytes). Thread-safe. Throws std::runtime_error when the spool write
-  // fails; the scan is then not accepted.
+  enum class Submitted { kAccepted, kAlreadyQueued, kAlreadyLabeled, kSpoolFull, kWriteFailed };
+  // Takes one scan (its file bytes). Thread-safe. A scan the spool cannot take (full, or its
+  // write failed) is not accepted and `reason` says why; nothing of it stays in the spool.
   Submitted submit(std::string_view bytes, const std::string& ext, std::string* id = nullptr,
                    std::string* reason = nullptr);
 
@@ -65,6 +67,8 @@ class Uploader {
   UploadCounters counters() const;
   std::size_t queued() const;  // in the spool, not yet uploaded (includes those in flight)
   bool server_down() const { return server_down_; }
+  // Entries found corrupt at start (already moved to spool/failed), for the operator's log.
+  const std::vector<CorruptEntry>& corrupt_entries() const { return spool_.corrupt_entries(); }
   // "queued 3, in flight 1, uploaded 10, failed 0, rejected 0, retries 2, spool 1.2/1024.0 MB,
   // server up"
   std::string status_line() const;

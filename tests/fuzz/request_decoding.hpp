@@ -1,0 +1,30 @@
+#pragma once
+// The server's request decoding without the transport, as server/src/label_stream.cpp does it:
+// check_header, then a ScanAssembler over every chunk, then finish(), stopping at the first
+// refusal. This is the only file that knows what the assembler returns: when scan_assembler.*
+// moves from grpc::Status to ServiceError, only refused() changes.
+
+#include <vector>
+
+#include "primlabel/v1/labeling.pb.h"
+#include "scan_assembler.hpp"
+
+namespace primlabel::fuzz {
+
+inline bool refused(const grpc::Status& status) { return !status.ok(); }
+
+// The server's defaults (server_config.hpp: --max-points, --max-request-bytes).
+inline server::ScanLimits server_default_limits() { return {10'000'000, 512ull << 20}; }
+
+// Decodes one scan: `header`, then `chunks` in order. True when the server would label it.
+inline bool decode_scan(const v1::ScanHeader& header,
+                        const std::vector<const v1::PointChunk*>& chunks,
+                        const server::ScanLimits& limits) {
+  if (refused(server::check_header(header, limits))) return false;
+  server::ScanAssembler assembler(header, limits);
+  for (const v1::PointChunk* chunk : chunks)
+    if (refused(assembler.add(*chunk))) return false;
+  return !refused(assembler.finish());
+}
+
+}  // namespace primlabel::fuzz
