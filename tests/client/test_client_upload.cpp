@@ -42,6 +42,9 @@ std::string scan_bytes(int seed, std::size_t n = 200) {
   return bytes.str();
 }
 
+// Spool entries are named by their content hash, which the spool checks when it reopens.
+std::string id_of(std::string_view bytes) { return client::upload::scan_id(bytes); }
+
 std::size_t files_in(const fs::path& dir) {
   if (!fs::exists(dir)) return 0;
   return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir), {}));
@@ -96,20 +99,21 @@ TEST(UploadSpool, ScanIdIsAStableContentHash) {
 
 TEST(UploadSpool, AcceptedScansSurviveAReopenInAcceptanceOrder) {
   test::TempDir dir;
+  const std::string first = "second-but-first", second = "x";
   {
     Spool spool(dir.file("spool"), {});
-    EXPECT_EQ(spool.accept("bbb", "second-but-first", ".pcd"), Spool::Accepted::kNew);
-    EXPECT_EQ(spool.accept("aaa", "x", ".ply"), Spool::Accepted::kNew);
-    EXPECT_EQ(spool.accept("aaa", "x", ".ply"), Spool::Accepted::kAlreadyQueued);
+    EXPECT_EQ(spool.accept(id_of(first), first, ".pcd"), Spool::Accepted::kNew);
+    EXPECT_EQ(spool.accept(id_of(second), second, ".ply"), Spool::Accepted::kNew);
+    EXPECT_EQ(spool.accept(id_of(second), second, ".ply"), Spool::Accepted::kAlreadyQueued);
     EXPECT_EQ(spool.bytes(), 17u);
   }
   Spool reopened(dir.file("spool"), {});
   const auto pending = reopened.pending();
   ASSERT_EQ(pending.size(), 2u);
   EXPECT_EQ(reopened.bytes(), 17u);
-  EXPECT_TRUE(reopened.contains("aaa"));
+  EXPECT_TRUE(reopened.contains(id_of(second)));
   EXPECT_EQ(pending[1].path.extension(), ".ply");
-  reopened.complete("bbb");
+  reopened.complete(id_of(first));
   EXPECT_FALSE(fs::exists(pending[0].path));
   EXPECT_EQ(Spool(dir.file("spool"), {}).size(), 1u);
 }
@@ -129,19 +133,20 @@ TEST(UploadSpool, ACrashMidWriteLeavesOnlyATempFileThatTheNextStartRemoves) {
 TEST(UploadSpool, WhenFullNewScansAreRefusedAndAcceptedOnesKept) {
   test::TempDir dir;
   Spool spool(dir.file("spool"), {/*max_bytes=*/100, /*max_scans=*/2});
-  spool.accept("a", std::string(60, 'a'), ".pcd");
+  const std::string a(60, 'a'), b(41, 'b'), c(40, 'c'), d = "d";
+  spool.accept(id_of(a), a, ".pcd");
   try {
-    spool.accept("b", std::string(41, 'b'), ".pcd");
+    spool.accept(id_of(b), b, ".pcd");
     FAIL() << "accepted over the byte limit";
   } catch (const SpoolFull& e) {
     EXPECT_NE(std::string(e.what()).find("spool full"), std::string::npos);
   }
-  spool.accept("c", std::string(40, 'c'), ".pcd");         // exactly fits
-  EXPECT_THROW(spool.accept("d", "", ".pcd"), SpoolFull);  // over the scan count
+  spool.accept(id_of(c), c, ".pcd");                             // exactly fits
+  EXPECT_THROW(spool.accept(id_of(""), "", ".pcd"), SpoolFull);  // over the scan count
   EXPECT_EQ(spool.size(), 2u);
   EXPECT_EQ(spool.bytes(), 100u);
-  spool.complete("a");
-  spool.accept("d", "d", ".pcd");
+  spool.complete(id_of(a));
+  spool.accept(id_of(d), d, ".pcd");
   EXPECT_EQ(Spool(dir.file("spool"), {}).bytes(), 41u);  // what was accepted is on disk
 }
 
@@ -354,8 +359,16 @@ TEST(Uploader, ACorruptSpoolEntryIsNeverUploaded) {
 // ---------------------------------------------------------------------------------------------
 // Full disks: a 1 MiB tmpfs (root only; skipped otherwise)
 
-// Scans of 12,000 points: about 144 kB, so seven fill 1 MiB.
-std::string big_scan(int seed) { return scan_bytes(seed, 12'000); }
+// Distinct scans of 12,000 points: about 144 kB, so seven fill 1 MiB.
+std::string big_scan(int seed) {
+  test::TempDir dir;
+  PointCloud cloud;
+  cloud.resize_unorganized(12'000);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    cloud.xyz[i] = Vec3f(float(i % 4), 0.01f * i, 1 + 0.001f * seed);
+  write_pcd(dir.file("s.pcd"), cloud, PcdEncoding::kBinary);
+  return read_text(dir.file("s.pcd"));
+}
 
 TEST(UploadFullDisk, AWriteOutOfSpaceLeavesNoTempFileAndNamesTheReason) {
   test::TempDir dir;
@@ -380,10 +393,10 @@ TEST(UploadFullDisk, ASpoolOutOfInodesRefusesTheScanAndKeepsWhatItHas) {
   client::upload::SpoolLimits limits;
   limits.min_free_bytes = 0;
   Spool spool(disk.path("spool"), limits);
-  spool.accept("a", "first", ".pcd");
+  spool.accept(id_of("first"), "first", ".pcd");
   ASSERT_GT(disk.fill_inodes("filler"), 0u);  // blocks are left, so only the write can see it
   try {
-    spool.accept("b", "second", ".pcd");
+    spool.accept(id_of("second"), "second", ".pcd");
     FAIL() << "accepted without an inode";
   } catch (const SpoolWriteFailed& e) {
     EXPECT_NE(std::string(e.what()).find("No space left on device"), std::string::npos) << e.what();
@@ -393,7 +406,7 @@ TEST(UploadFullDisk, ASpoolOutOfInodesRefusesTheScanAndKeepsWhatItHas) {
   EXPECT_EQ(files_in(disk.path("spool/tmp")), 0u);
   EXPECT_EQ(files_in(disk.path("spool/scans")), 1u);
   fs::remove_all(disk.path("filler"));
-  EXPECT_EQ(spool.accept("b", "second", ".pcd"), Spool::Accepted::kNew);
+  EXPECT_EQ(spool.accept(id_of("second"), "second", ".pcd"), Spool::Accepted::kNew);
   EXPECT_EQ(Spool(disk.path("spool"), limits).size(), 2u);
 }
 
