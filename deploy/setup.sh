@@ -30,8 +30,9 @@ PACKAGES=(
   libgtest-dev
 )
 # Only the tests need these: the deployment checks (YAML, nginx -t, promtool, the local
-# three-replica proof) and TLS certificates made on the fly.
-TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl)
+# three-replica proof), TLS certificates made on the fly, and clang with libFuzzer for the fuzz
+# targets (tests/fuzz).
+TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl clang-14 libclang-rt-14-dev)
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev)
 [[ "${1:-}" == test ]] && PACKAGES+=("${TEST_PACKAGES[@]}")
 
