@@ -121,11 +121,13 @@ LabelServer::~LabelServer() { shutdown(std::chrono::milliseconds(0)); }
 int LabelServer::metrics_port() const { return exposer_ ? exposer_->port() : 0; }
 
 void LabelServer::models_changed() {
+  // One at a time, reading the registry under the lock: whichever call comes last publishes the
+  // latest state (the constructor's call can race with an early admin RPC's observer call).
+  std::lock_guard lock(health_mutex_);
   const std::vector<ServedModel> models = registry_.list();
   std::vector<std::pair<std::string, std::string>> served;
   for (const ServedModel& model : models) served.emplace_back(model.name, model.served->version);
   metrics_.set_models(served, registry_.loaded_versions());
-  std::lock_guard lock(health_mutex_);
   if (draining_.load() || !server_) return;  // health was shut down for good
   const bool serving = !models.empty();
   grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService();

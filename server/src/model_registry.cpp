@@ -148,12 +148,13 @@ std::map<ModelRegistry::Key, ModelRegistry::Found> ModelRegistry::discover(
     if (hidden(model_entry.path())) continue;
     const auto model_dir = inside(model_entry.path());
     if (!model_dir || !fs::is_directory(*model_dir, error)) continue;
-    for (const fs::directory_entry& version_entry : entries_of(*model_dir)) {
+    // Listed by the repository's own names, so refusals and paths read as the operator wrote them.
+    for (const fs::directory_entry& version_entry : entries_of(model_entry.path())) {
       if (hidden(version_entry.path())) continue;
       const auto version_dir = inside(version_entry.path());
       if (!version_dir || !fs::is_directory(*version_dir, error)) continue;
       std::vector<fs::path> files;
-      for (const fs::directory_entry& file : entries_of(*version_dir))
+      for (const fs::directory_entry& file : entries_of(version_entry.path()))
         if (file.path().extension() == ".plm" && !hidden(file.path())) files.push_back(file.path());
       std::sort(files.begin(), files.end());
       for (const fs::path& file : files) {  // several files: the first by name (documented)

@@ -258,8 +258,9 @@ TEST_F(ServerBinary, ADefaultModelOrPinNamingNothingLoadedFailsStartup) {
       {{"--default-model", "nosuch"},
        "--default-model 'nosuch' is not a loaded model; loaded: "
        "tabletop (1)"},
-      {{"--pin", "tabletop=9"}, "--pin tabletop=9: model 'tabletop' has no version '9'"},
-      {{"--pin", "other=1"}, "--pin other=1: model 'other' is not loaded"}};
+      {{"--pin", "tabletop=9"},
+       "--pin tabletop=9: model 'tabletop' has no version '9'; loaded: tabletop (1)"},
+      {{"--pin", "other=1"}, "--pin other=1: model 'other' is not loaded; loaded: tabletop (1)"}};
   for (const Case& c : cases) {
     std::vector<std::string> args = base_args();
     args.insert(args.end(), c.flags.begin(), c.flags.end());
