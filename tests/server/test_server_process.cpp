@@ -271,6 +271,21 @@ TEST_F(ServerBinary, ADefaultModelOrPinNamingNothingLoadedFailsStartup) {
   }
 }
 
+TEST_F(ServerBinary, InsecureAdminIsWarnedAtStartup) {
+  std::vector<std::string> args = base_args();
+  {
+    ServerProcess server(args);
+    ASSERT_TRUE(server.wait_listening()) << server.log();
+    EXPECT_TRUE(server.logged(" admin=off ")) << server.log();
+    EXPECT_FALSE(server.logged("event=insecure_admin")) << server.log();
+  }
+  args.push_back("--insecure-admin");
+  ServerProcess server(args);
+  ASSERT_TRUE(server.wait_listening()) << server.log();
+  EXPECT_TRUE(server.logged("level=warn event=insecure_admin")) << server.log();
+  EXPECT_TRUE(server.logged(" admin=insecure ")) << server.log();
+}
+
 TEST_F(ServerBinary, ASecondServerOnAPortInUseExitsNamingTheAddress) {
   ServerProcess first(base_args());
   ASSERT_TRUE(first.wait_listening()) << first.log();
