@@ -16,12 +16,12 @@ grpc::Status AdminService::LoadModel(grpc::ServerContext* context,
   try {
     const auto entry = env_.registry->load(request->model(), request->version());
     record.version = entry->version;
+    record.model_resolved = true;
     env_.metrics->reloads(1, 0);
   } catch (const RegistryError& error) {
     if (error.kind() == RegistryError::Kind::kLoadFailed) env_.metrics->reloads(0, 1);
     return record.finish(registry_status(error));
   }
-  env_.models_changed();
   for (const ServedModel& model : env_.registry->list())
     if (model.name == request->model()) fill_model_info(model, *response->mutable_model());
   return record.finish(grpc::Status::OK);
@@ -40,7 +40,6 @@ grpc::Status AdminService::UnloadModel(grpc::ServerContext* context,
   } catch (const RegistryError& error) {
     return record.finish(registry_status(error));
   }
-  env_.models_changed();
   return record.finish(grpc::Status::OK);
 }
 
@@ -51,7 +50,8 @@ grpc::Status AdminService::ReloadModels(grpc::ServerContext* context,
   if (grpc::Status status = env_.auth->check(*context, true); !status.ok())
     return record.finish(status);
   try {
-    const ReloadReport report = env_.registry->rescan();
+    // Unloads last until this explicit reload, which brings their versions back.
+    const ReloadReport report = env_.registry->reload();
     env_.metrics->reloads(report.loaded, report.failed);
     response->set_loaded(report.loaded);
     response->set_failed(report.failed);
@@ -59,7 +59,6 @@ grpc::Status AdminService::ReloadModels(grpc::ServerContext* context,
   } catch (const RegistryError& error) {
     return record.finish(registry_status(error));
   }
-  env_.models_changed();
   for (const ServedModel& model : env_.registry->list())
     fill_model_info(model, *response->add_models());
   return record.finish(grpc::Status::OK);

@@ -1,6 +1,8 @@
 #pragma once
 // primlabel.v1.ModelAdmin: load, unload and rescan models; needs the bearer token when one is
-// configured.
+// configured, and is refused without one unless --insecure-admin allows it. An unload lasts
+// until the next LoadModel of that model or ReloadModels (the periodic scan does not undo it).
+// Health and metrics follow the registry through its observer, not through this service.
 
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "service_environment.hpp"

@@ -28,10 +28,17 @@ std::string read_pem(const std::string& path) {
 
 }  // namespace
 
-TokenAuth::TokenAuth(std::string token, bool required_for_all)
-    : token_(std::move(token)), required_for_all_(required_for_all) {}
+TokenAuth::TokenAuth(std::string token, bool required_for_all, bool insecure_admin)
+    : token_(std::move(token)),
+      required_for_all_(required_for_all),
+      insecure_admin_(insecure_admin) {}
 
 grpc::Status TokenAuth::check(const grpc::ServerContext& context, bool admin) const {
+  if (admin && token_.empty() && !insecure_admin_)
+    return {grpc::StatusCode::PERMISSION_DENIED,
+            "admin RPCs are disabled: this server has no token; start it with --token-file "
+            "(or PRIMLABEL_TOKEN) to require one, or with --insecure-admin to allow them "
+            "without one"};
   if (token_.empty() || (!admin && !required_for_all_)) return grpc::Status::OK;
   const auto& metadata = context.client_metadata();
   auto found = metadata.find("authorization");

@@ -13,18 +13,22 @@ namespace primlabel::server {
 
 class TokenAuth {
  public:
-  // An empty token means no checks at all.
-  TokenAuth(std::string token, bool required_for_all);
+  // An empty token means no checks on non-admin RPCs; admin RPCs are then refused unless
+  // `insecure_admin` allows them (anyone who reaches the port could unload every model).
+  TokenAuth(std::string token, bool required_for_all, bool insecure_admin = false);
 
-  // OK, or UNAUTHENTICATED saying what is missing. `admin` RPCs need the token whenever one is
-  // configured; the others only with required_for_all.
+  // OK, or UNAUTHENTICATED saying what is missing, or PERMISSION_DENIED naming the flags that
+  // enable admin RPCs. `admin` RPCs need the token whenever one is configured; the others only
+  // with required_for_all.
   grpc::Status check(const grpc::ServerContext& context, bool admin) const;
 
   bool enabled() const { return !token_.empty(); }
+  bool admin_open() const { return token_.empty() && insecure_admin_; }
 
  private:
   std::string token_;
   bool required_for_all_;
+  bool insecure_admin_;
 };
 
 struct TlsFiles {

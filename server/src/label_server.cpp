@@ -19,6 +19,7 @@ ModelRegistry::Options registry_options(const ServerConfig& config) {
   options.root = config.models_dir;
   options.default_model = config.default_model;
   options.pins = config.pins;
+  options.missing_scans_before_unload = config.unload_after_missing_polls;
   return options;
 }
 
@@ -34,7 +35,7 @@ std::string with_port(const std::string& address, int port) {
 LabelServer::LabelServer(ServerConfig config)
     : config_(std::move(config)),
       registry_(registry_options(config_)),
-      auth_(config_.token, config_.token_for_all) {
+      auth_(config_.token, config_.token_for_all, config_.insecure_admin) {
   admission_ = std::make_unique<Admission>(
       effective_workers(config_), config_.queue,
       [this](int admitted, int queued) { metrics_.set_admission(admitted, queued); });
@@ -45,7 +46,9 @@ LabelServer::LabelServer(ServerConfig config)
   env_.auth = &auth_;
   env_.draining = &draining_;
   env_.threads_per_job = effective_threads_per_job(config_);
-  env_.models_changed = [this] { models_changed(); };
+  // Every change of the registry, whoever made it (poller, admin RPC), reaches health and the
+  // model gauges.
+  registry_.set_observer([this] { models_changed(); });
 
   try {
     const ReloadReport report = registry_.rescan();
@@ -53,6 +56,15 @@ LabelServer::LabelServer(ServerConfig config)
   } catch (const RegistryError& error) {
     throw std::runtime_error(error.what());
   }
+  // A default or pin naming nothing loaded is a typo that would otherwise only show as failed
+  // requests (or a silently different version) in production.
+  if (std::string problem = registry_.configuration_problem(); !problem.empty())
+    throw ConfigError{std::move(problem), 2};
+  if (auth_.admin_open())
+    log_warn("insecure_admin")
+        .kv("message",
+            "admin RPCs (load, unload, reload models) are open to anyone who reaches the port: "
+            "--insecure-admin without a token");
 
   labeler_ = std::make_unique<LabelerService>(env_);
   admin_ = std::make_unique<AdminService>(env_);
@@ -64,10 +76,19 @@ LabelServer::LabelServer(ServerConfig config)
       server_credentials({config_.tls_cert, config_.tls_key, config_.tls_client_ca}), &port_);
   builder.SetMaxReceiveMessageSize(config_.max_message_bytes);
   builder.SetMaxSendMessageSize(config_.max_message_bytes);
+  // gRPC sets SO_REUSEPORT by default: a second server on a port in use would start and
+  // silently take a share of its connections. The port is ours alone, or start-up fails.
+  builder.AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
   builder.RegisterService(labeler_.get());
   builder.RegisterService(admin_.get());
-  server_ = builder.BuildAndStart();
-  if (!server_ || port_ == 0) throw std::runtime_error("cannot listen on " + config_.listen);
+  {
+    std::unique_ptr<grpc::Server> built = builder.BuildAndStart();
+    std::lock_guard lock(health_mutex_);  // the observer may run on an admin call already
+    server_ = std::move(built);
+  }
+  if (!server_ || port_ == 0)
+    throw std::runtime_error("cannot listen on " + config_.listen +
+                             " (in use by another process, or not an address of this host)");
 
   if (!config_.metrics_listen.empty()) {
     exposer_ = std::make_unique<metrics::Exposer>(config_.metrics_listen);
@@ -84,6 +105,9 @@ LabelServer::LabelServer(ServerConfig config)
       .kv("tls", !config_.tls_cert.empty())
       .kv("mtls", !config_.tls_client_ca.empty())
       .kv("token", auth_.enabled())
+      .kv("admin", auth_.enabled()      ? "token"
+                   : auth_.admin_open() ? "insecure"
+                                        : "off")
       .kv("workers", admission_->workers())
       .kv("queue", config_.queue)
       .kv("threads_per_job", env_.threads_per_job)
@@ -97,11 +121,13 @@ LabelServer::~LabelServer() { shutdown(std::chrono::milliseconds(0)); }
 int LabelServer::metrics_port() const { return exposer_ ? exposer_->port() : 0; }
 
 void LabelServer::models_changed() {
+  // One at a time, reading the registry under the lock: whichever call comes last publishes the
+  // latest state (the constructor's call can race with an early admin RPC's observer call).
+  std::lock_guard lock(health_mutex_);
   const std::vector<ServedModel> models = registry_.list();
   std::vector<std::pair<std::string, std::string>> served;
   for (const ServedModel& model : models) served.emplace_back(model.name, model.served->version);
   metrics_.set_models(served, registry_.loaded_versions());
-  std::lock_guard lock(health_mutex_);
   if (draining_.load() || !server_) return;  // health was shut down for good
   const bool serving = !models.empty();
   grpc::HealthCheckServiceInterface* health = server_->GetHealthCheckService();
@@ -120,9 +146,8 @@ void LabelServer::poll_models(std::stop_token stop) {
       if (stop.stop_requested()) return;
     }
     try {
-      const ReloadReport report = registry_.rescan();
+      const ReloadReport report = registry_.rescan();  // changes reach models_changed()
       metrics_.reloads(report.loaded, report.failed);
-      if (report.loaded || report.removed) models_changed();
     } catch (const std::exception& e) {
       log_error("model_poll_failed").kv("error", e.what());
     }

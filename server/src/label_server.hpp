@@ -26,8 +26,9 @@ inline constexpr const char* kLabelerServiceName = "primlabel.v1.Labeler";
 class LabelServer {
  public:
   // Loads the models (failures are logged and counted; an empty repository is allowed) and
-  // binds both ports. Throws std::runtime_error when the repository is not a directory or an
-  // address cannot be bound.
+  // binds both ports, the gRPC one exclusively (no SO_REUSEPORT). Throws ConfigError (exit code
+  // 2) when --default-model or a --pin names no loaded model or version, std::runtime_error
+  // when the repository is not a directory or an address cannot be bound.
   explicit LabelServer(ServerConfig config);
   ~LabelServer();  // shutdown(0) if still running
   LabelServer(const LabelServer&) = delete;

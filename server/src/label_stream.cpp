@@ -58,6 +58,7 @@ grpc::Status start_request(const ServiceEnvironment& env, const v1::ScanHeader& 
   if (grpc::Status status = plan_labeling(header, env, plan); !status.ok()) return status;
   record.model = plan.entry->name;
   record.version = plan.entry->version;
+  record.model_resolved = true;
   ticket = env.admission->try_admit();
   if (!ticket) return server_busy(*env.admission);
   return grpc::Status::OK;

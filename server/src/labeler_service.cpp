@@ -72,6 +72,7 @@ grpc::Status LabelerService::GetModelMetadata(grpc::ServerContext* context,
     const auto entry = env_.registry->resolve(request->model(), request->version());
     record.model = entry->name;
     record.version = entry->version;
+    record.model_resolved = true;
     *response = entry->metadata;
   } catch (const RegistryError& error) {
     return record.finish(registry_status(error));

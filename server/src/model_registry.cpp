@@ -4,10 +4,13 @@
 #include <cctype>
 #include <chrono>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "logging.hpp"
 #include "primlabel/v1/model.pb.h"
+#include "repository_path.hpp"
+#include "user_text.hpp"
 
 namespace primlabel::server {
 
@@ -28,7 +31,21 @@ void check_name(const std::string& what, const std::string& name) {
   if (name.empty() || name == "." || name == ".." || name.size() > 200 ||
       name.find_first_of("/\\") != std::string::npos || name.find('\0') != std::string::npos)
     throw RegistryError(RegistryError::Kind::kInvalidArgument,
-                        "invalid " + what + " name '" + name + "'");
+                        "invalid " + what + " name '" + user_text(name) + "'");
+}
+
+// " version 'v'" when a version is named.
+std::string version_part(const std::string& version) {
+  return version.empty() ? "" : " version '" + user_text(version) + "'";
+}
+
+// The entries of a directory; an unreadable one has none (it counts as missing).
+std::vector<fs::directory_entry> entries_of(const fs::path& dir) {
+  std::vector<fs::directory_entry> entries;
+  std::error_code error;
+  for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error))
+    entries.push_back(*it);
+  return entries;
 }
 
 bool hidden(const fs::path& path) {
@@ -98,38 +115,87 @@ bool version_less(const std::string& a, const std::string& b) {
   return a.size() - i < b.size() - j;
 }
 
-ModelRegistry::ModelRegistry(Options options) : options_(std::move(options)) {}
+ModelRegistry::ModelRegistry(Options options) : options_(std::move(options)) {
+  options_.missing_scans_before_unload = std::max(1u, options_.missing_scans_before_unload);
+  default_ = options_.default_model;
+}
 
-std::map<ModelRegistry::Key, ModelRegistry::Found> ModelRegistry::discover() const {
+std::map<ModelRegistry::Key, ModelRegistry::Found> ModelRegistry::discover(
+    std::vector<Refused>& refused) const {
   std::error_code error;
-  if (!fs::is_directory(options_.root, error))
+  const fs::path root = fs::canonical(options_.root, error);
+  if (error || !fs::is_directory(root, error))
     throw RegistryError(RegistryError::Kind::kNotFound,
                         "model repository '" + options_.root.string() + "' is not a directory");
+  std::vector<fs::directory_entry> model_dirs;
+  for (fs::directory_iterator it(root, error), end; !error && it != end; it.increment(error))
+    model_dirs.push_back(*it);
+  if (error)  // an unlisted repository must not look like one whose models all went away
+    throw RegistryError(
+        RegistryError::Kind::kNotFound,
+        "cannot list the model repository '" + options_.root.string() + "': " + error.message());
+  // The resolved path when it stays inside the repository; refusals are collected.
+  auto inside = [&](const fs::path& path) -> std::optional<fs::path> {
+    std::error_code resolve_error;
+    fs::path resolved = fs::canonical(path, resolve_error);
+    if (resolve_error) return std::nullopt;  // a dangling link, or removed meanwhile: not there
+    if (is_within(root, resolved)) return resolved;
+    refused.push_back({path.lexically_relative(root).string(), resolved});
+    return std::nullopt;
+  };
   std::map<Key, Found> found;
-  for (const fs::directory_entry& model_dir : fs::directory_iterator(options_.root, error)) {
-    if (!model_dir.is_directory(error) || hidden(model_dir.path())) continue;
-    for (const fs::directory_entry& version_dir : fs::directory_iterator(model_dir.path(), error)) {
-      if (!version_dir.is_directory(error) || hidden(version_dir.path())) continue;
+  for (const fs::directory_entry& model_entry : model_dirs) {
+    if (hidden(model_entry.path())) continue;
+    const auto model_dir = inside(model_entry.path());
+    if (!model_dir || !fs::is_directory(*model_dir, error)) continue;
+    // Listed by the repository's own names, so refusals and paths read as the operator wrote them.
+    for (const fs::directory_entry& version_entry : entries_of(model_entry.path())) {
+      if (hidden(version_entry.path())) continue;
+      const auto version_dir = inside(version_entry.path());
+      if (!version_dir || !fs::is_directory(*version_dir, error)) continue;
       std::vector<fs::path> files;
-      for (const fs::directory_entry& file : fs::directory_iterator(version_dir.path(), error))
-        if (file.is_regular_file(error) && file.path().extension() == ".plm" &&
-            !hidden(file.path()))
-          files.push_back(file.path());
-      if (files.empty()) continue;  // being written, or not a model version
+      for (const fs::directory_entry& file : entries_of(version_entry.path()))
+        if (file.path().extension() == ".plm" && !hidden(file.path())) files.push_back(file.path());
       std::sort(files.begin(), files.end());
-      Found entry;
-      entry.file = files.front();  // several files: the first by name (documented)
-      entry.signature.size = fs::file_size(entry.file, error);
-      entry.signature.mtime = fs::last_write_time(entry.file, error);
-      found[{model_dir.path().filename().string(), version_dir.path().filename().string()}] = entry;
+      for (const fs::path& file : files) {  // several files: the first by name (documented)
+        const auto resolved = inside(file);
+        if (!resolved || !fs::is_regular_file(*resolved, error)) continue;
+        Found entry;
+        entry.file = *resolved;
+        entry.relative = (fs::path(model_entry.path().filename()) /
+                          version_entry.path().filename() / file.filename())
+                             .string();
+        entry.signature.size = fs::file_size(entry.file, error);
+        entry.signature.mtime = fs::last_write_time(entry.file, error);
+        found[{model_entry.path().filename().string(), version_entry.path().filename().string()}] =
+            entry;
+        break;
+      }
+      // No model file: being written, or not a model version.
     }
   }
   return found;
 }
 
+void ModelRegistry::note_refused(const std::vector<Refused>& refused, ReloadReport& report) {
+  std::set<std::string> now;
+  for (const Refused& path : refused) {
+    now.insert(path.relative);
+    ++report.refused;
+    report.errors.push_back(path.relative + ": resolves to " + path.target.string() +
+                            ", outside the model repository");
+    if (refused_.count(path.relative)) continue;  // logged when first refused
+    log_warn("model_path_refused")
+        .kv("path", user_text(path.relative))
+        .kv("resolves_to", user_text(path.target.string()))
+        .kv("reason", "outside the model repository");
+  }
+  refused_ = std::move(now);
+}
+
 std::shared_ptr<const ModelEntry> ModelRegistry::read_entry(const Key& key,
                                                             const Found& found) const {
-  const std::string relative = fs::relative(found.file, options_.root).string();
+  const std::string& relative = found.relative;
   const std::string bytes = read_file(found.file);
   auto entry = std::make_shared<ModelEntry>();
   entry->name = key.first;
@@ -141,17 +207,31 @@ std::shared_ptr<const ModelEntry> ModelRegistry::read_entry(const Key& key,
   entry->signature = found.signature;
   if (entry->model->name != key.first || entry->model->version != key.second)
     log_warn("model_name_mismatch")
-        .kv("path", relative)
-        .kv("file_model", entry->model->name)
-        .kv("file_version", entry->model->version)
-        .kv("served_as", key.first + "/" + key.second);
+        .kv("path", user_text(relative))
+        .kv("file_model", user_text(entry->model->name))
+        .kv("file_version", user_text(entry->model->version))
+        .kv("served_as", user_text(key.first + "/" + key.second));
   return entry;
 }
 
 ReloadReport ModelRegistry::rescan() {
   std::lock_guard reload_lock(reload_mutex_);
-  const std::map<Key, Found> found = discover();
+  return scan_locked();
+}
+
+ReloadReport ModelRegistry::reload() {
+  std::lock_guard reload_lock(reload_mutex_);
+  unloaded_.clear();
+  failed_.clear();
+  return scan_locked();
+}
+
+ReloadReport ModelRegistry::scan_locked() {
+  std::vector<Refused> refused;
+  const std::map<Key, Found> found = discover(refused);
   ReloadReport report;
+  note_refused(refused, report);
+  bool changed = false;
   for (const auto& [key, file] : found) {
     if (unloaded_.count(key) || unloaded_.count({key.first, ""})) continue;
     {
@@ -172,35 +252,61 @@ ReloadReport ModelRegistry::rescan() {
         models_[key.first][key.second] = entry;
       }
       failed_.erase(key);
+      changed = true;
       ++report.loaded;
       log_info("model_loaded")
-          .kv("model", key.first)
-          .kv("version", key.second)
-          .kv("path", entry->path);
+          .kv("model", user_text(key.first))
+          .kv("version", user_text(key.second))
+          .kv("path", user_text(entry->path));
     } catch (const std::exception& e) {
       failed_[key] = file.signature;
       ++report.failed;
       report.errors.push_back(e.what());
       log_error("model_load_failed")
-          .kv("model", key.first)
-          .kv("version", key.second)
-          .kv("error", e.what());
+          .kv("model", user_text(key.first))
+          .kv("version", user_text(key.second))
+          .kv("error", user_text(e.what(), 1000));
     }
   }
-  // Versions whose directory went away stop being served.
-  std::lock_guard lock(mutex_);
-  for (auto model = models_.begin(); model != models_.end();) {
-    for (auto version = model->second.begin(); version != model->second.end();) {
-      if (found.count({model->first, version->first})) {
-        ++version;
-        continue;
+  // Versions missing from disk keep serving until they have been missing long enough.
+  {
+    std::lock_guard lock(mutex_);
+    std::map<Key, unsigned> still_missing;
+    for (auto model = models_.begin(); model != models_.end();) {
+      for (auto version = model->second.begin(); version != model->second.end();) {
+        const Key key{model->first, version->first};
+        if (found.count(key)) {
+          ++version;
+          continue;
+        }
+        const unsigned scans = missing_.count(key) ? missing_.at(key) + 1 : 1;
+        if (scans < options_.missing_scans_before_unload) {
+          still_missing[key] = scans;
+          ++report.missing;
+          log_warn("model_missing")
+              .kv("model", user_text(key.first))
+              .kv("version", user_text(key.second))
+              .kv("missing_scans", scans)
+              .kv("unload_after", options_.missing_scans_before_unload);
+          ++version;
+          continue;
+        }
+        log_info("model_removed")
+            .kv("model", user_text(key.first))
+            .kv("version", user_text(key.second))
+            .kv("missing_scans", scans);
+        version = model->second.erase(version);
+        changed = true;
+        ++report.removed;
       }
-      log_info("model_removed").kv("model", model->first).kv("version", version->first);
-      version = model->second.erase(version);
-      ++report.removed;
+      model = model->second.empty() ? models_.erase(model) : std::next(model);
     }
-    model = model->second.empty() ? models_.erase(model) : std::next(model);
+    missing_ = std::move(still_missing);
+    const std::string old_default = default_;
+    settle_default_locked();
+    changed = changed || default_ != old_default;
   }
+  if (changed) notify();
   return report;
 }
 
@@ -209,7 +315,8 @@ std::shared_ptr<const ModelEntry> ModelRegistry::load(const std::string& model,
   check_name("model", model);
   if (!version.empty()) check_name("version", version);
   std::lock_guard reload_lock(reload_mutex_);
-  const std::map<Key, Found> found = discover();
+  std::vector<Refused> refused;
+  const std::map<Key, Found> found = discover(refused);
   const Found* file = nullptr;
   std::string chosen = version;
   for (const auto& [key, entry] : found) {
@@ -221,9 +328,8 @@ std::shared_ptr<const ModelEntry> ModelRegistry::load(const std::string& model,
   }
   if (!file)
     throw RegistryError(RegistryError::Kind::kNotFound,
-                        "no model file for model '" + model + "'" +
-                            (version.empty() ? "" : " version '" + version + "'") + " under " +
-                            options_.root.string());
+                        "no model file for model '" + user_text(model) + "'" +
+                            version_part(version) + " under " + options_.root.string());
   const Key key{model, chosen};
   std::shared_ptr<const ModelEntry> entry;
   try {
@@ -235,11 +341,17 @@ std::shared_ptr<const ModelEntry> ModelRegistry::load(const std::string& model,
   {
     std::lock_guard lock(mutex_);
     models_[model][chosen] = entry;
+    missing_.erase(key);
+    settle_default_locked();
   }
   failed_.erase(key);
   unloaded_.erase(key);
   unloaded_.erase({model, ""});
-  log_info("model_loaded").kv("model", model).kv("version", chosen).kv("path", entry->path);
+  log_info("model_loaded")
+      .kv("model", user_text(model))
+      .kv("version", user_text(chosen))
+      .kv("path", user_text(entry->path));
+  notify();
   return entry;
 }
 
@@ -247,26 +359,36 @@ unsigned ModelRegistry::unload(const std::string& model, const std::string& vers
   check_name("model", model);
   if (!version.empty()) check_name("version", version);
   std::lock_guard reload_lock(reload_mutex_);
-  std::lock_guard lock(mutex_);
-  auto found = models_.find(model);
   unsigned removed = 0;
-  if (found != models_.end()) {
-    if (version.empty()) {
-      removed = unsigned(found->second.size());
-      models_.erase(found);
-    } else {
-      removed = unsigned(found->second.erase(version));
-      if (found->second.empty()) models_.erase(found);
+  {
+    std::lock_guard lock(mutex_);
+    auto found = models_.find(model);
+    if (found != models_.end()) {
+      if (version.empty()) {
+        removed = unsigned(found->second.size());
+        models_.erase(found);
+      } else {
+        removed = unsigned(found->second.erase(version));
+        if (found->second.empty()) models_.erase(found);
+      }
     }
+    if (removed == 0)
+      throw RegistryError(
+          RegistryError::Kind::kNotFound,
+          "model '" + user_text(model) + "'" + version_part(version) + " is not loaded");
+    settle_default_locked();
   }
-  if (removed == 0)
-    throw RegistryError(RegistryError::Kind::kNotFound,
-                        "model '" + model + "'" +
-                            (version.empty() ? "" : " version '" + version + "'") +
-                            " is not loaded");
   unloaded_.insert({model, version});
-  log_info("model_unloaded").kv("model", model).kv("version", version).kv("versions", removed);
+  log_info("model_unloaded")
+      .kv("model", user_text(model))
+      .kv("version", user_text(version))
+      .kv("versions", removed);
+  notify();
   return removed;
+}
+
+void ModelRegistry::notify() const {
+  if (observer_) observer_();
 }
 
 std::shared_ptr<const ModelEntry> ModelRegistry::served_locked(const std::string& model,
@@ -279,10 +401,12 @@ std::shared_ptr<const ModelEntry> ModelRegistry::served_locked(const std::string
   return versions.rbegin()->second;  // the latest
 }
 
-std::string ModelRegistry::default_model_locked() const {
-  if (!options_.default_model.empty()) return options_.default_model;
-  if (models_.size() == 1) return models_.begin()->first;
-  return {};
+void ModelRegistry::settle_default_locked() {
+  if (!options_.default_model.empty()) return;  // named by the operator: never moves
+  // The only model becomes the default and stays it when others appear, so requests naming no
+  // model keep working. When it is gone and several remain, there is no safe guess: requests
+  // naming no model are refused, naming the default, until it returns or only one is left.
+  if (models_.size() == 1) default_ = models_.begin()->first;
 }
 
 std::string ModelRegistry::describe_loaded_locked() const {
@@ -290,49 +414,53 @@ std::string ModelRegistry::describe_loaded_locked() const {
   std::string text = "loaded: ";
   bool first_model = true;
   for (const auto& [name, versions] : models_) {
-    text += (first_model ? "" : ", ") + name + " (";
+    if (!first_model) text += ", ";
     first_model = false;
+    text += user_text(name);
+    text += " (";
     bool first_version = true;
     for (const auto& [version, entry] : versions) {
-      text += (first_version ? "" : " ") + version;
+      if (!first_version) text += ' ';
       first_version = false;
+      text += user_text(version);
     }
-    text += ")";
+    text += ')';
   }
-  return text;
+  return user_text(text, 2000);  // a repository of thousands of models stays one readable line
 }
 
 std::shared_ptr<const ModelEntry> ModelRegistry::resolve(const std::string& model,
                                                          const std::string& version) const {
   std::lock_guard lock(mutex_);
-  const std::string name = model.empty() ? default_model_locked() : model;
-  if (name.empty())
+  if (model.empty() && default_.empty())
     throw RegistryError(RegistryError::Kind::kNotFound,
-                        "the request names no model and the server has no default model; " +
+                        "the request names no model and the server has no default model "
+                        "(--default-model); " +
                             describe_loaded_locked());
+  const std::string& name = model.empty() ? default_ : model;
   auto found = models_.find(name);
   if (found == models_.end())
     throw RegistryError(RegistryError::Kind::kNotFound,
-                        "model '" + name + "' is not loaded; " + describe_loaded_locked());
+                        std::string(model.empty() ? "the default model '" : "model '") +
+                            user_text(name) + "' is not loaded; " + describe_loaded_locked());
   if (version.empty()) return served_locked(name, found->second);
   auto exact = found->second.find(version);
   if (exact == found->second.end())
-    throw RegistryError(
-        RegistryError::Kind::kNotFound,
-        "model '" + name + "' has no version '" + version + "'; " + describe_loaded_locked());
+    throw RegistryError(RegistryError::Kind::kNotFound,
+                        "model '" + user_text(name) + "' has no version '" + user_text(version) +
+                            "'; " + describe_loaded_locked());
   return exact->second;
 }
 
 std::vector<ServedModel> ModelRegistry::list() const {
   std::lock_guard lock(mutex_);
-  const std::string default_name = default_model_locked();
   std::vector<ServedModel> out;
   for (const auto& [name, versions] : models_) {
     ServedModel served;
     served.name = name;
     served.served = served_locked(name, versions);
     for (const auto& [version, entry] : versions) served.versions.push_back(version);
-    served.is_default = name == default_name;
+    served.is_default = name == default_;
     out.push_back(std::move(served));
   }
   return out;
@@ -347,7 +475,25 @@ std::size_t ModelRegistry::loaded_versions() const {
 
 std::string ModelRegistry::default_model() const {
   std::lock_guard lock(mutex_);
-  return default_model_locked();
+  return default_;
+}
+
+std::string ModelRegistry::configuration_problem() const {
+  std::lock_guard lock(mutex_);
+  const std::string& wanted = options_.default_model;
+  if (!wanted.empty() && !models_.count(wanted))
+    return "--default-model '" + user_text(wanted) + "' is not a loaded model; " +
+           describe_loaded_locked();
+  for (const auto& [model, version] : options_.pins) {
+    const std::string flag = "--pin " + user_text(model) + "=" + user_text(version) + ": ";
+    auto found = models_.find(model);
+    if (found == models_.end())
+      return flag + "model '" + user_text(model) + "' is not loaded; " + describe_loaded_locked();
+    if (!found->second.count(version))
+      return flag + "model '" + user_text(model) + "' has no version '" + user_text(version) +
+             "'; " + describe_loaded_locked();
+  }
+  return {};
 }
 
 }  // namespace primlabel::server

@@ -7,9 +7,18 @@
 // checks a file completely before the new entry replaces the old one, so a request that took an
 // entry (a shared_ptr) keeps using it unchanged, and a file that fails to load leaves the old
 // version serving. Thread-safe.
+//
+// Last known good: a loaded version whose directory is missing stays served until it has been
+// missing at `missing_scans_before_unload` consecutive scans (a directory moved away and back,
+// or a repository being synced, must not take the model down), or until unload().
+// Paths are resolved: a model directory, version directory or model file that resolves outside
+// the repository (a symlink to elsewhere) is refused and logged, never read.
+// The default model is sticky: Options::default_model if given; else the only model, which
+// stays the default when other models appear.
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -53,7 +62,9 @@ class RegistryError : public std::runtime_error {
 struct ReloadReport {
   unsigned loaded = 0;              // versions newly loaded or replaced
   unsigned failed = 0;              // versions that failed to load (old ones keep serving)
-  unsigned removed = 0;             // versions whose directory disappeared
+  unsigned removed = 0;             // versions whose directory disappeared (for long enough)
+  unsigned missing = 0;             // versions missing from disk but still served (last known good)
+  unsigned refused = 0;             // paths that resolve outside the repository
   std::vector<std::string> errors;  // "path: reason"
 };
 
@@ -75,16 +86,28 @@ class ModelRegistry {
  public:
   struct Options {
     std::filesystem::path root;
-    std::string default_model;                // empty: the only model, if there is one
-    std::map<std::string, std::string> pins;  // model -> version served by default
+    std::string default_model;                 // empty: the only model, if there is one
+    std::map<std::string, std::string> pins;   // model -> version served by default
+    unsigned missing_scans_before_unload = 3;  // consecutive scans; 1 = at once
   };
   explicit ModelRegistry(Options options);
 
-  // Loads new and changed versions and drops versions whose directory went away. A version that
-  // failed to load is not retried until its file changes. Versions unloaded by unload() are
-  // skipped until load() brings them back. Throws RegistryError(kNotFound) when the root is not
-  // a readable directory.
+  // Called after every change of what is served (a version loaded, replaced or removed, the
+  // default moved), with no registry lock but the one that orders changes held: the callback may
+  // read the registry (list(), resolve(), ...) but must not change it. Set it before the
+  // registry is shared between threads.
+  void set_observer(std::function<void()> observer) { observer_ = std::move(observer); }
+
+  // The periodic scan: loads new and changed versions and drops versions whose directory has
+  // been missing at missing_scans_before_unload consecutive scans. A version that failed to load
+  // is not retried until its file changes. Versions unloaded by unload() are skipped until
+  // load() or reload() brings them back. Throws RegistryError(kNotFound) when the root is not a
+  // readable directory.
   ReloadReport rescan();
+
+  // An explicit reload (ReloadModels): lifts every unload() and retries files that failed to
+  // load, then scans as rescan() does.
+  ReloadReport reload();
 
   // Loads (or reloads) one version from the repository; an empty version means the latest on
   // disk. Throws RegistryError.
@@ -101,30 +124,47 @@ class ModelRegistry {
 
   std::vector<ServedModel> list() const;
   std::size_t loaded_versions() const;
-  std::string default_model() const;
+  std::string default_model() const;  // empty: none
   const std::filesystem::path& root() const { return options_.root; }
+
+  // What is wrong with Options::default_model and pins given what is loaded now (a model or
+  // version that is not loaded), as one line naming the flag; empty when nothing is.
+  std::string configuration_problem() const;
 
  private:
   struct Found {
-    std::filesystem::path file;
+    std::filesystem::path file;  // canonical: the file that is read
+    std::string relative;        // <model>/<version>/<file>, as the repository names it
     FileSignature signature;
+  };
+  struct Refused {
+    std::string relative;  // as the repository names it
+    std::filesystem::path target;
   };
   using Key = std::pair<std::string, std::string>;  // model, version
   using Versions = std::map<std::string, std::shared_ptr<const ModelEntry>, VersionLess>;
 
-  std::map<Key, Found> discover() const;  // what is on disk now
+  // What is on disk now; paths leading outside the repository go to `refused`.
+  std::map<Key, Found> discover(std::vector<Refused>& refused) const;
+  ReloadReport scan_locked();  // with reload_mutex_ held
+  void note_refused(const std::vector<Refused>& refused, ReloadReport& report);
   std::shared_ptr<const ModelEntry> read_entry(const Key& key, const Found& found) const;
   std::shared_ptr<const ModelEntry> served_locked(const std::string& model,
                                                   const Versions& versions) const;
-  std::string default_model_locked() const;
+  void settle_default_locked();
   std::string describe_loaded_locked() const;
+  void notify() const;
 
   Options options_;
+  std::function<void()> observer_;
   std::mutex reload_mutex_;   // one rescan / load / unload at a time
-  mutable std::mutex mutex_;  // guards models_ (held only to look up or swap)
+  mutable std::mutex mutex_;  // guards models_ and default_ (held only to look up or swap)
   std::map<std::string, Versions> models_;
+  std::string default_;                  // the sticky default model; empty: none
   std::map<Key, FileSignature> failed_;  // files that failed to load, until they change
   std::set<Key> unloaded_;               // (model, "") = every version of the model
+  std::map<Key, unsigned> missing_;      // loaded versions missing from disk: consecutive scans
+  std::set<std::string> refused_;        // refused at the last scan (logged once)
 };
 
 }  // namespace primlabel::server

@@ -6,6 +6,7 @@
 
 #include "logging.hpp"
 #include "status_names.hpp"
+#include "user_text.hpp"
 
 namespace primlabel::server {
 
@@ -33,8 +34,9 @@ grpc::Status RequestRecord::finish(const grpc::Status& status) {
   finished_ = true;
   const double seconds = elapsed_seconds();
   const std::string code = status_code_name(status.error_code());
-  metrics_.request_finished(method_, model, code, seconds);
-  if (status.ok() && points > 0) metrics_.points_labeled(model, double(points));
+  const std::string metric_model = model_resolved ? user_text(model) : std::string();
+  metrics_.request_finished(method_, metric_model, code, seconds);
+  if (status.ok() && points > 0) metrics_.points_labeled(metric_model, double(points));
   if (dropped_non_finite > 0) metrics_.points_dropped("non_finite", double(dropped_non_finite));
   const std::pair<const char*, double> named_stages[] = {
       {"receive", stages.receive},   {"prefilter", stages.prefilter}, {"normals", stages.normals},
@@ -42,9 +44,9 @@ grpc::Status RequestRecord::finish(const grpc::Status& status) {
   LogLine line(status.ok() ? LogLevel::kInfo : LogLevel::kWarn, "request");
   line.kv("method", method_)
       .kv("request_id", id_)
-      .kv("scan_id", scan_id)
-      .kv("model", model)
-      .kv("version", version)
+      .kv("scan_id", user_text(scan_id))
+      .kv("model", user_text(model))
+      .kv("version", user_text(version))
       .kv("points", points)
       .kv("dropped_non_finite", dropped_non_finite)
       .kv("duration_ms", seconds * 1e3)
@@ -54,7 +56,7 @@ grpc::Status RequestRecord::finish(const grpc::Status& status) {
     metrics_.stage(name, value);
     line.kv(std::string(name) + "_ms", value * 1e3);
   }
-  if (!status.ok()) line.kv("message", status.error_message());
+  if (!status.ok()) line.kv("message", user_text(status.error_message(), 2000));
   return status;
 }
 

@@ -26,7 +26,12 @@ class RequestRecord {
   const std::string& id() const { return id_; }
   double elapsed_seconds() const;
 
+  // As the client sent them until the model is resolved; capped (user_text) where they are
+  // logged or counted.
   std::string scan_id, model, version;
+  // Set once `model` names a loaded model: only then is it a metric label, so clients that send
+  // made-up names cannot grow the metrics without bound (they count as model="").
+  bool model_resolved = false;
   std::uint64_t points = 0, dropped_non_finite = 0;
   StageTimes stages;
 

@@ -1,6 +1,7 @@
 #include "scan_assembler.hpp"
 
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "primlabel/wire/packing.hpp"
@@ -20,6 +21,14 @@ std::string describe_point(const Vec3f& p) {
 }
 
 bool finite_non_negative(float value) { return std::isfinite(value) && value >= 0.0f; }
+
+// Shorter than this (or non-finite), a client's normal gives no direction: used as given, a
+// zero normal makes every pair angle degenerate and the whole scan look like one plane.
+constexpr float kMinNormalLength = 1e-3f;
+
+bool usable_normal(const Vec3f& n) {
+  return is_finite(n) && n.squaredNorm() >= kMinNormalLength * kMinNormalLength;
+}
 
 }  // namespace
 
@@ -99,12 +108,23 @@ grpc::Status ScanAssembler::add(const v1::PointChunk& chunk) {
     wire::unpack_le<float>(chunk.normals(), cloud_.normals[first].data());
   }
   for (std::uint64_t i = first; i < first + n; ++i) {
-    if (is_finite(cloud_.xyz[i])) continue;
-    if (reject_non_finite_)
+    const bool finite_xyz = is_finite(cloud_.xyz[i]);
+    if (!finite_xyz && reject_non_finite_)
       return invalid("point " + std::to_string(i) + " (" + where +
                      ") has a non-finite coordinate " + describe_point(cloud_.xyz[i]) +
                      " and options.non_finite is NON_FINITE_REJECT");
-    ++non_finite_;
+    bool dropped = !finite_xyz;
+    if (normals_ && !usable_normal(cloud_.normals[i])) {
+      if (reject_non_finite_)
+        return invalid("point " + std::to_string(i) + " (" + where + ") has the normal " +
+                       describe_point(cloud_.normals[i]) +
+                       ", zero-length or non-finite, and options.non_finite is "
+                       "NON_FINITE_REJECT");
+      // As a PCL normal of NaNs means: this point has no normal (no descriptor, label 0).
+      cloud_.normals[i] = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+      dropped = true;
+    }
+    non_finite_ += dropped;
   }
   cloud_.width = static_cast<std::uint32_t>(cloud_.size());
   cloud_.height = 1;

@@ -1,8 +1,9 @@
 #pragma once
 // Builds the cloud of one scan from its PointChunks, checking each as it arrives: byte lengths
 // that fit the point layout, the point and byte limits, the announced point count, and
-// non-finite coordinates (counted, or refused when the request says so). Every refusal names
-// the chunk and, for a coordinate, the point.
+// non-finite coordinates and client normals that are zero-length (shorter than 1e-3) or
+// non-finite (counted, the point then has no normal and gets label 0; or refused when the
+// request says NON_FINITE_REJECT). Every refusal names the chunk and, for a point, the point.
 
 #include <grpcpp/support/status.h>
 
@@ -29,6 +30,7 @@ class ScanAssembler {
 
   PointCloud& cloud() { return cloud_; }
   std::uint64_t points() const { return cloud_.size(); }
+  // Points with a non-finite coordinate or an unusable normal (each counted once).
   std::uint64_t non_finite() const { return non_finite_; }
 
  private:

@@ -119,6 +119,12 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
       ->envname("PRIMLABEL_RELOAD_SECONDS")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--unload-after-missing-polls", config.unload_after_missing_polls,
+                 "a loaded version whose directory is missing keeps serving until it has been "
+                 "missing at this many scans in a row (1: at once)")
+      ->envname("PRIMLABEL_UNLOAD_AFTER_MISSING_POLLS")
+      ->check(CLI::Range(1u, 1000000u))
+      ->capture_default_str();
   app.add_option("--workers", config.workers,
                  "concurrent labeling jobs (0: half the cores, at least 1)")
       ->envname("PRIMLABEL_WORKERS")
@@ -173,6 +179,10 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
   app.add_flag("--token-for-all", config.token_for_all,
                "require the token on every RPC, not only on admin ones")
       ->envname("PRIMLABEL_TOKEN_FOR_ALL");
+  app.add_flag("--insecure-admin", config.insecure_admin,
+               "allow admin RPCs (load, unload, reload models) without a token; without a token "
+               "and without this flag they are refused")
+      ->envname("PRIMLABEL_INSECURE_ADMIN");
   app.add_option("--log-level", config.log_level, "debug, info, warn or error")
       ->envname("PRIMLABEL_LOG_LEVEL")
       ->check(CLI::IsMember({"debug", "info", "warn", "error"}))

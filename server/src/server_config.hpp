@@ -18,6 +18,7 @@ struct ServerConfig {
   std::string default_model;                      // served when a request names none
   std::map<std::string, std::string> pins;        // model -> version served by default
   double reload_seconds = 30.0;                   // poll the models directory; 0 = never
+  unsigned unload_after_missing_polls = 3;        // scans a version may be missing before it goes
 
   int workers = 0;          // concurrent labeling jobs; 0 = half the cores, at least 1
   int queue = 4;            // admitted requests beyond the workers; more get RESOURCE_EXHAUSTED
@@ -30,9 +31,10 @@ struct ServerConfig {
 
   std::string tls_cert;  // PEM; with tls_key enables TLS
   std::string tls_key;
-  std::string tls_client_ca;   // PEM; requires and verifies client certificates (mutual TLS)
-  std::string token;           // bearer token for admin RPCs (from --token-file or env)
-  bool token_for_all = false;  // also require the token on labeling and model queries
+  std::string tls_client_ca;    // PEM; requires and verifies client certificates (mutual TLS)
+  std::string token;            // bearer token for admin RPCs (from --token-file or env)
+  bool token_for_all = false;   // also require the token on labeling and model queries
+  bool insecure_admin = false;  // allow admin RPCs without a token (warned at start-up)
 
   std::string log_level = "info";
 };

@@ -1,5 +1,6 @@
 // primlabel-server: serves the labeling API until SIGTERM or SIGINT, then drains and exits 0.
-// Exit codes: 0 clean shutdown, 1 could not start, 2 bad usage.
+// Exit codes: 0 clean shutdown, 1 could not start (e.g. the address is in use), 2 bad usage
+// (including a --default-model or --pin that names no loaded model).
 
 #include <signal.h>
 
@@ -33,6 +34,9 @@ int main(int argc, char** argv) {
   std::unique_ptr<LabelServer> server;
   try {
     server = std::make_unique<LabelServer>(config);
+  } catch (const ConfigError& error) {  // settings that contradict the repository: as bad usage
+    std::fprintf(stderr, "%s\n", error.message.c_str());
+    return error.exit_code;
   } catch (const std::exception& e) {
     log_error("startup_failed").kv("error", e.what());
     return 1;

@@ -3,7 +3,6 @@
 // whether the server is draining. Owned by LabelServer, which outlives every handler.
 
 #include <atomic>
-#include <functional>
 
 #include "admission.hpp"
 #include "auth.hpp"
@@ -21,8 +20,6 @@ struct ServiceEnvironment {
   const TokenAuth* auth = nullptr;
   const std::atomic<bool>* draining = nullptr;
   int threads_per_job = 1;
-  // After the admin service changed the registry: health and model gauges follow.
-  std::function<void()> models_changed;
 };
 
 }  // namespace primlabel::server

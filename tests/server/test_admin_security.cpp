@@ -26,7 +26,8 @@ grpc::Status call_with_token(Call call, const Request& request, Response& respon
 }
 
 TEST(AdminService, LoadUnloadAndReloadFollowHealthAndMetrics) {
-  TestServer server({random_label_model("m", "1")});
+  TestServer server({random_label_model("m", "1")},
+                    [](server::ServerConfig& c) { c.insecure_admin = true; });
   auto& admin = *server.admin;
   v1::UnloadModelRequest unload;
   unload.set_model("m");

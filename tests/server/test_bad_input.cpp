@@ -18,7 +18,11 @@ class BadInput : public ::testing::Test {
  protected:
   BadInput()
       : model_(random_label_model("m", "1")),
-        server_({model_}, [](server::ServerConfig& c) { c.max_points = 50000; }),
+        server_({model_},
+                [](server::ServerConfig& c) {
+                  c.max_points = 50000;
+                  c.insecure_admin = true;  // the reload race below needs ReloadModels
+                }),
         cloud_(table_with_box_cloud(0.01f)) {}
 
   // The server still labels a good scan correctly.
@@ -261,7 +265,8 @@ TEST_F(BadInput, ReloadDuringLabelingNeverShowsAHalfLoadedModel) {
       write_model(server_.repo.path(), i % 2 ? model_ : other);
       grpc::ClientContext context;
       v1::ReloadModelsResponse response;
-      server_.admin->ReloadModels(&context, {}, &response);
+      const grpc::Status status = server_.admin->ReloadModels(&context, {}, &response);
+      EXPECT_TRUE(status.ok()) << status.error_message();
     }
   });
   int matched = 0;

@@ -56,7 +56,10 @@ TEST(ModelRegistry, ServesTheLatestUnlessPinnedAndKnowsTheDefault) {
 
   write_model(repo.path(), random_label_model("other", "1"));
   registry.rescan();
-  EXPECT_THROW(registry.resolve("", ""), RegistryError);  // two models, no default named
+  EXPECT_EQ(registry.resolve("", "")->name, "m");  // the only model stays the default
+  auto fresh = registry_over(repo.path());
+  fresh.rescan();
+  EXPECT_THROW(fresh.resolve("", ""), RegistryError);  // two models from the start, none named
   auto with_default = registry_over(repo.path(), "other");
   with_default.rescan();
   EXPECT_EQ(with_default.resolve("", "")->name, "other");
@@ -101,6 +104,10 @@ TEST(ModelRegistry, RemovedDirectoriesStopServingAndOthersAreIgnored) {
   registry.rescan();
   EXPECT_EQ(registry.loaded_versions(), 2u);
   fs::remove_all(repo.path() / "m" / "2");
+  for (int scan = 1; scan < 3; ++scan) {  // last known good: served until missing at 3 scans
+    EXPECT_EQ(registry.rescan().removed, 0u);
+    EXPECT_EQ(registry.resolve("m", "")->version, "2");
+  }
   EXPECT_EQ(registry.rescan().removed, 1u);
   EXPECT_EQ(registry.resolve("m", "")->version, "1");
 }

@@ -1,7 +1,8 @@
 // The real primlabel-server binary on 127.0.0.1 with ephemeral ports (read back from its
 // "event=listening" log line): labeling through the generated stubs, /metrics, graceful
 // shutdown on SIGTERM (in-flight requests finish, exit 0), the drain deadline, configuration
-// precedence (flags > environment > file) and start-up errors.
+// precedence (flags > environment > file) and start-up errors (bad flags, a --default-model or
+// --pin naming nothing loaded, a port already in use).
 
 #include <fcntl.h>
 #include <signal.h>
@@ -246,6 +247,57 @@ TEST_F(ServerBinary, StartupErrorsExitNonZeroWithAReason) {
     EXPECT_EQ(server.exit_code(30000), 2);
     EXPECT_TRUE(server.logged("MODEL=VERSION")) << server.log();
   }
+}
+
+TEST_F(ServerBinary, ADefaultModelOrPinNamingNothingLoadedFailsStartup) {
+  struct Case {
+    std::vector<std::string> flags;
+    std::string says;
+  };
+  const std::vector<Case> cases{
+      {{"--default-model", "nosuch"},
+       "--default-model 'nosuch' is not a loaded model; loaded: "
+       "tabletop (1)"},
+      {{"--pin", "tabletop=9"},
+       "--pin tabletop=9: model 'tabletop' has no version '9'; loaded: tabletop (1)"},
+      {{"--pin", "other=1"}, "--pin other=1: model 'other' is not loaded; loaded: tabletop (1)"}};
+  for (const Case& c : cases) {
+    std::vector<std::string> args = base_args();
+    args.insert(args.end(), c.flags.begin(), c.flags.end());
+    ServerProcess server(args);
+    EXPECT_EQ(server.exit_code(30000), 2) << server.log();
+    EXPECT_TRUE(server.logged(c.says + "\n")) << server.log();  // one line
+    EXPECT_FALSE(server.logged("event=listening")) << server.log();
+  }
+}
+
+TEST_F(ServerBinary, InsecureAdminIsWarnedAtStartup) {
+  std::vector<std::string> args = base_args();
+  {
+    ServerProcess server(args);
+    ASSERT_TRUE(server.wait_listening()) << server.log();
+    EXPECT_TRUE(server.logged(" admin=off ")) << server.log();
+    EXPECT_FALSE(server.logged("event=insecure_admin")) << server.log();
+  }
+  args.push_back("--insecure-admin");
+  ServerProcess server(args);
+  ASSERT_TRUE(server.wait_listening()) << server.log();
+  EXPECT_TRUE(server.logged("level=warn event=insecure_admin")) << server.log();
+  EXPECT_TRUE(server.logged(" admin=insecure ")) << server.log();
+}
+
+TEST_F(ServerBinary, ASecondServerOnAPortInUseExitsNamingTheAddress) {
+  ServerProcess first(base_args());
+  ASSERT_TRUE(first.wait_listening()) << first.log();
+  const std::string address = "127.0.0.1:" + std::to_string(first.port);
+  ServerProcess second(
+      {"--models", repo_.path().string(), "--listen", address, "--metrics-listen", ""});
+  EXPECT_EQ(second.exit_code(30000), 1) << second.log();
+  EXPECT_TRUE(second.logged("cannot listen on " + address)) << second.log();
+  EXPECT_FALSE(second.logged("event=listening")) << second.log();
+  EXPECT_EQ(health_status(channel_to(first.port), ""), "SERVING");
+  first.signal(SIGTERM);
+  EXPECT_EQ(first.exit_code(30000), 0) << first.log();
 }
 
 }  // namespace
