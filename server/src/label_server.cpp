@@ -69,10 +69,9 @@ LabelServer::LabelServer(ServerConfig config)
   server_ = builder.BuildAndStart();
   if (!server_ || port_ == 0) throw std::runtime_error("cannot listen on " + config_.listen);
 
-  if (!config_.metrics_listen.empty()) {
-    exposer_ = std::make_unique<metrics::Exposer>(config_.metrics_listen);
-    exposer_->RegisterCollectable(metrics_.registry());
-  }
+  if (!config_.metrics_listen.empty())
+    metrics_endpoint_ =
+        std::make_unique<MetricsEndpoint>(config_.metrics_listen, metrics_.collectables());
   models_changed();
   if (config_.reload_seconds > 0)
     poller_ = std::jthread([this](std::stop_token stop) { poll_models(stop); });
@@ -94,7 +93,7 @@ LabelServer::LabelServer(ServerConfig config)
 
 LabelServer::~LabelServer() { shutdown(std::chrono::milliseconds(0)); }
 
-int LabelServer::metrics_port() const { return exposer_ ? exposer_->port() : 0; }
+int LabelServer::metrics_port() const { return metrics_endpoint_ ? metrics_endpoint_->port() : 0; }
 
 void LabelServer::models_changed() {
   const std::vector<ServedModel> models = registry_.list();
@@ -154,7 +153,7 @@ void LabelServer::shutdown(std::chrono::milliseconds drain) {
     server_->Shutdown(std::min(deadline, std::chrono::system_clock::now() + kShutdownGrace));
     server_->Wait();
   }
-  exposer_.reset();
+  metrics_endpoint_.reset();
   log_info("stopped");
 }
 

@@ -1,25 +1,32 @@
-// Parsing the text exposition format: round trip of Serialize() and errors on malformed input.
+// Parsing the text exposition format: what prometheus-cpp's serializer writes, and errors on
+// malformed input.
 
 #include <gtest/gtest.h>
+#include <prometheus/counter.h>
+#include <prometheus/gauge.h>
+#include <prometheus/histogram.h>
+#include <prometheus/registry.h>
+#include <prometheus/text_serializer.h>
 
 #include <cmath>
 #include <stdexcept>
 
-#include "primlabel/metrics/metrics.hpp"
+#include "primlabel/scrape/exposition_parser.hpp"
 
-namespace primlabel::metrics {
+namespace primlabel::scrape {
 namespace {
 
-TEST(ExpositionParser, RoundTripsSerialize) {
-  Registry registry;
-  auto& requests = BuildCounter().Name("req_total").Help("h").Register(registry);
+TEST(ExpositionParser, ReadsWhatPrometheusCppWrites) {
+  prometheus::Registry registry;
+  auto& requests = prometheus::BuildCounter().Name("req_total").Help("h").Register(registry);
   requests.Add({{"model", "tabletop"}, {"odd", "a\\b\"c\nd"}}).Increment(41);
-  BuildGauge().Name("depth").Register(registry).Add({}).Set(-0.125);
-  auto& histogram = BuildHistogram().Name("lat").Register(registry).Add({{"stage", "crf"}}, {0.1});
+  prometheus::BuildGauge().Name("depth").Register(registry).Add({}).Set(-0.125);
+  auto& histogram =
+      prometheus::BuildHistogram().Name("lat").Register(registry).Add({{"stage", "crf"}}, {0.1});
   histogram.Observe(0.05);
   histogram.Observe(3);
 
-  const auto samples = parse_exposition(registry.Serialize());
+  const auto samples = parse_exposition(prometheus::TextSerializer().Serialize(registry.Collect()));
   ASSERT_EQ(samples.size(), 6u);
   EXPECT_EQ(samples[0].name, "req_total");
   EXPECT_EQ(samples[0].labels, (Labels{{"model", "tabletop"}, {"odd", "a\\b\"c\nd"}}));
@@ -88,4 +95,4 @@ TEST(ExpositionParser, RejectsMalformedInputNamingTheLine) {
 }
 
 }  // namespace
-}  // namespace primlabel::metrics
+}  // namespace primlabel::scrape

@@ -1,4 +1,4 @@
-#include "primlabel/metrics/exposition_parser.hpp"
+#include "primlabel/scrape/exposition_parser.hpp"
 
 #include <cctype>
 #include <charconv>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace primlabel::metrics {
+namespace primlabel::scrape {
 namespace {
 
 class LineError : public std::invalid_argument {
@@ -16,6 +16,17 @@ class LineError : public std::invalid_argument {
 };
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+// [a-zA-Z_:][a-zA-Z0-9_:]*
+bool is_valid_metric_name(std::string_view name) {
+  if (name.empty()) return false;
+  for (std::size_t i = 0; i < name.size(); ++i) {
+    const char c = name[i];
+    const bool letter = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' || c == ':';
+    if (!letter && !(i > 0 && c >= '0' && c <= '9')) return false;
+  }
+  return true;
+}
 
 // Cursor over one line of the exposition.
 class LineReader {
@@ -193,4 +204,4 @@ double sum_samples(const std::vector<Sample>& samples, std::string_view name, co
   return sum;
 }
 
-}  // namespace primlabel::metrics
+}  // namespace primlabel::scrape
