@@ -121,8 +121,8 @@ TEST(ProcessMetrics, ReadFromProcSelf) {
 TEST(ProcessMetrics, WithoutProcOnlyTheLimitsAreLeft) {
   const auto families =
       server::ProcessCollector("/nonexistent/proc", "/nonexistent/stat").Collect();
-  ASSERT_EQ(families.size(), 1u);
-  EXPECT_EQ(families[0].name, "process_max_fds");
+  ASSERT_LE(families.size(), 1u);  // none when RLIMIT_NOFILE is unlimited
+  for (const auto& family : families) EXPECT_EQ(family.name, "process_max_fds");
 }
 
 TEST(ProcSelf, ParsesStatLinesWhoseCommandNameHasBlanksAndParentheses) {

@@ -88,7 +88,11 @@ class LineReader {
 double parse_value(std::string_view text, const LineReader& reader) {
   if (text == "+Inf" || text == "Inf") return INFINITY;
   if (text == "-Inf") return -INFINITY;
-  if (text == "NaN") return NAN;
+  // prometheus-cpp writes NaN as "Nan"; Prometheus reads NaN in any case.
+  if (text.size() == 3 && std::tolower(static_cast<unsigned char>(text[0])) == 'n' &&
+      std::tolower(static_cast<unsigned char>(text[1])) == 'a' &&
+      std::tolower(static_cast<unsigned char>(text[2])) == 'n')
+    return NAN;
   if (text.starts_with('+')) text.remove_prefix(1);  // from_chars takes no '+'
   double value = 0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
