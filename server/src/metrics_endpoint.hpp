@@ -1,10 +1,12 @@
 #pragma once
 // The /metrics HTTP endpoint: prometheus-cpp's Exposer (civetweb) serving collectables.
 
+#include <netinet/in.h>
 #include <prometheus/collectable.h>
 #include <prometheus/exposer.h>
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,12 +19,17 @@ class MetricsEndpoint {
   // is malformed (std::invalid_argument from civetweb_listening_port) or cannot be bound.
   MetricsEndpoint(const std::string& address,
                   const std::vector<std::weak_ptr<prometheus::Collectable>>& collectables);
+  // Stops within milliseconds (civetweb alone takes up to 2 s, see the .cpp).
+  ~MetricsEndpoint();
+  MetricsEndpoint(const MetricsEndpoint&) = delete;
+  MetricsEndpoint& operator=(const MetricsEndpoint&) = delete;
 
   int port() const { return port_; }
 
  private:
   std::unique_ptr<prometheus::Exposer> exposer_;
   int port_ = 0;
+  std::optional<sockaddr_in> listening_;  // where to connect to wake civetweb's accept loop
 };
 
 // civetweb's `listening_ports` value for a --metrics-listen address. civetweb reads that option
