@@ -22,9 +22,9 @@
 
 #include "label_server.hpp"
 #include "logging.hpp"
-#include "primlabel/metrics/metrics.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
+#include "primlabel/scrape/exposition_parser.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "primlabel/wire/packing.hpp"
 #include "random_label_model.hpp"
@@ -152,8 +152,8 @@ Latency compare(const char* name, const LabelModel& model, const PointCloud& clo
 }
 
 double inflight(server::LabelServer& server) {
-  const std::string text = server.metrics().registry()->Serialize();
-  return metrics::sum_samples(metrics::parse_exposition(text), "primlabel_inflight_requests");
+  const std::string text = server.metrics().serialize();
+  return scrape::sum_samples(scrape::parse_exposition(text), "primlabel_inflight_requests");
 }
 
 // Streams the cloud, cancels `after_ms` after the upload ended, and measures cancel -> request

@@ -26,6 +26,7 @@ PACKAGES=(
   libeigen3-dev libnanoflann-dev liblzf-dev libcli11-dev libpng-dev zlib1g-dev
   libprotobuf-dev protobuf-compiler liblbfgspp-dev libsvm-dev
   libgrpc++-dev protobuf-compiler-grpc
+  prometheus-cpp-dev libcurl4-openssl-dev
   libssl-dev
   libgtest-dev
 )

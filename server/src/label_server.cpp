@@ -90,10 +90,9 @@ LabelServer::LabelServer(ServerConfig config)
     throw std::runtime_error("cannot listen on " + config_.listen +
                              " (in use by another process, or not an address of this host)");
 
-  if (!config_.metrics_listen.empty()) {
-    exposer_ = std::make_unique<metrics::Exposer>(config_.metrics_listen);
-    exposer_->RegisterCollectable(metrics_.registry());
-  }
+  if (!config_.metrics_listen.empty())
+    metrics_endpoint_ =
+        std::make_unique<MetricsEndpoint>(config_.metrics_listen, metrics_.collectables());
   models_changed();
   if (config_.reload_seconds > 0)
     poller_ = std::jthread([this](std::stop_token stop) { poll_models(stop); });
@@ -118,7 +117,7 @@ LabelServer::LabelServer(ServerConfig config)
 
 LabelServer::~LabelServer() { shutdown(std::chrono::milliseconds(0)); }
 
-int LabelServer::metrics_port() const { return exposer_ ? exposer_->port() : 0; }
+int LabelServer::metrics_port() const { return metrics_endpoint_ ? metrics_endpoint_->port() : 0; }
 
 void LabelServer::models_changed() {
   // One at a time, reading the registry under the lock: whichever call comes last publishes the
@@ -179,7 +178,7 @@ void LabelServer::shutdown(std::chrono::milliseconds drain) {
     server_->Shutdown(std::min(deadline, std::chrono::system_clock::now() + kShutdownGrace));
     server_->Wait();
   }
-  exposer_.reset();
+  metrics_endpoint_.reset();
   log_info("stopped");
 }
 

@@ -15,7 +15,7 @@
 
 #include "admin_service.hpp"
 #include "labeler_service.hpp"
-#include "primlabel/metrics/exposer.hpp"
+#include "metrics_endpoint.hpp"
 #include "server_config.hpp"
 #include "service_environment.hpp"
 
@@ -59,7 +59,7 @@ class LabelServer {
   std::unique_ptr<LabelerService> labeler_;
   std::unique_ptr<AdminService> admin_;
   std::unique_ptr<grpc::Server> server_;
-  std::unique_ptr<metrics::Exposer> exposer_;
+  std::unique_ptr<MetricsEndpoint> metrics_endpoint_;
   int port_ = 0;
   std::mutex health_mutex_;
   std::mutex shutdown_mutex_;

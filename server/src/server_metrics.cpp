@@ -1,17 +1,22 @@
 #include "server_metrics.hpp"
 
+#include <prometheus/text_serializer.h>
+
+#include "build_version.hpp"
+#include "process_collector.hpp"
+
 namespace primlabel::server {
 
 namespace {
 
-using metrics::BuildCounter;
-using metrics::BuildGauge;
-using metrics::BuildHistogram;
+using prometheus::BuildCounter;
+using prometheus::BuildGauge;
+using prometheus::BuildHistogram;
 
 // 1 ms .. ~2 min, roughly x2.5 per bucket: a table scene takes tens of ms, a 5M-point scan tens
 // of seconds.
-const metrics::Histogram::BucketBoundaries& seconds_buckets() {
-  static const metrics::Histogram::BucketBoundaries buckets{
+const prometheus::Histogram::BucketBoundaries& seconds_buckets() {
+  static const prometheus::Histogram::BucketBoundaries buckets{
       0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1, 2.5, 5, 10, 25, 60, 120};
   return buckets;
 }
@@ -19,7 +24,8 @@ const metrics::Histogram::BucketBoundaries& seconds_buckets() {
 }  // namespace
 
 ServerMetrics::ServerMetrics()
-    : registry_(std::make_shared<metrics::Registry>()),
+    : registry_(std::make_shared<prometheus::Registry>()),
+      process_(std::make_shared<ProcessCollector>()),
       requests_(BuildCounter()
                     .Name("primlabel_requests_total")
                     .Help("RPCs finished, by method, model and gRPC status")
@@ -72,16 +78,39 @@ ServerMetrics::ServerMetrics()
   for (const char* stage : {"receive", "prefilter", "normals", "features", "inference", "send"})
     stage_seconds_.Add({{"stage", stage}}, seconds_buckets());
   dropped_.Add({{"reason", "non_finite"}});
+  BuildGauge()
+      .Name("primlabel_build_info")
+      .Help("1, labeled with the version and the git description the server was built from")
+      .Register(*registry_)
+      .Add({{"version", std::string(kBuildVersion)}, {"git", std::string(kBuildGitDescribe)}})
+      .Set(1);
+}
+
+std::vector<std::weak_ptr<prometheus::Collectable>> ServerMetrics::collectables() const {
+  return {registry_, process_};
+}
+
+std::string ServerMetrics::serialize() const {
+  std::vector<prometheus::MetricFamily> families = registry_->Collect();
+  std::vector<prometheus::MetricFamily> process = process_->Collect();
+  families.insert(families.end(), process.begin(), process.end());
+  return prometheus::TextSerializer().Serialize(families);
+}
+
+std::string ServerMetrics::model_label(const std::string& model) const {
+  std::shared_lock lock(loaded_models_mutex_);
+  return loaded_models_.contains(model) ? model : kUnknownModelLabel;
 }
 
 void ServerMetrics::request_finished(const std::string& method, const std::string& model,
                                      const std::string& status, double seconds) {
-  requests_.Add({{"method", method}, {"model", model}, {"status", status}}).Increment();
+  requests_.Add({{"method", method}, {"model", model_label(model)}, {"status", status}})
+      .Increment();
   request_seconds_.Add({{"method", method}}, seconds_buckets()).Observe(seconds);
 }
 
 void ServerMetrics::points_labeled(const std::string& model, double points) {
-  points_.Add({{"model", model}}).Increment(points);
+  points_.Add({{"model", model_label(model)}}).Increment(points);
 }
 
 void ServerMetrics::points_dropped(const std::string& reason, double points) {
@@ -99,11 +128,17 @@ void ServerMetrics::set_admission(int admitted, int queued) {
 
 void ServerMetrics::set_models(const std::vector<std::pair<std::string, std::string>>& served,
                                std::size_t loaded_versions) {
+  std::set<std::string, std::less<>> names;
+  for (const auto& entry : served) names.insert(entry.first);
+  {
+    std::unique_lock lock(loaded_models_mutex_);
+    loaded_models_ = std::move(names);
+  }
   std::lock_guard lock(model_info_mutex_);
-  for (metrics::Gauge* series : model_info_series_) model_info_.Remove(series);
+  for (prometheus::Gauge* series : model_info_series_) model_info_.Remove(series);
   model_info_series_.clear();
   for (const auto& [model, version] : served) {
-    metrics::Gauge& series = model_info_.Add({{"model", model}, {"version", version}});
+    prometheus::Gauge& series = model_info_.Add({{"model", model}, {"version", version}});
     series.Set(1);
     model_info_series_.push_back(&series);
   }

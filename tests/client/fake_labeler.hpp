@@ -7,6 +7,8 @@
 
 #include <grpcpp/grpcpp.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <prometheus/counter.h>
+#include <prometheus/family.h>
 
 #include <atomic>
 #include <cmath>
@@ -16,8 +18,6 @@
 #include <vector>
 
 #include "primlabel/client/client.hpp"
-#include "primlabel/metrics/counter.hpp"
-#include "primlabel/metrics/family.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "wire.hpp"
 
@@ -42,7 +42,7 @@ class FakeLabeler final : public v1::Labeler::Service {
 
   // When set, every Label / LabelCloud call is counted here as the real server does:
   // primlabel_requests_total{method, model, status}.
-  metrics::Family<metrics::Counter>* requests_total = nullptr;
+  prometheus::Family<prometheus::Counter>* requests_total = nullptr;
 
   grpc::Status Label(
       grpc::ServerContext* context,

@@ -2,14 +2,15 @@
 // the fake server, and the tool's report formats and its counts beside the server's.
 
 #include <gtest/gtest.h>
+#include <prometheus/counter.h>
+#include <prometheus/exposer.h>
+#include <prometheus/registry.h>
 
 #include "fake_labeler.hpp"
 #include "loadgen/load_runner.hpp"
 #include "loadgen/report.hpp"
 #include "loadgen/server_counters.hpp"
 #include "primlabel/core/cloud_io.hpp"
-#include "primlabel/metrics/exposer.hpp"
-#include "primlabel/metrics/registry.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -69,6 +70,17 @@ TEST(LoadgenStats, ServerCountsSumModelsPerMethodAndStatus) {
   EXPECT_EQ(delta.total, 2);
   EXPECT_EQ(delta.by_status.size(), 1u);  // unchanged statuses drop out
   EXPECT_THROW(parse_server_counts("garbage{", "Label"), std::runtime_error);
+}
+
+TEST(LoadgenStats, MetricsUrlTakesUrlsAndHostPort) {
+  EXPECT_EQ(metrics_url_from("127.0.0.1:9464"), "http://127.0.0.1:9464/metrics");
+  EXPECT_EQ(metrics_url_from("labeler:9464"), "http://labeler:9464/metrics");
+  EXPECT_EQ(metrics_url_from("http://labeler:9464/metrics"), "http://labeler:9464/metrics");
+  EXPECT_EQ(metrics_url_from("https://labeler/prom/metrics"), "https://labeler/prom/metrics");
+  for (const char* bad : {"", "ftp://labeler/metrics", "file:///etc/passwd", "a b:1", "h:1\n"})
+    EXPECT_THROW(metrics_url_from(bad), std::invalid_argument) << bad;
+  // Nothing listens on port 1: a clear error, not a hang.
+  EXPECT_THROW(read_server_counts("127.0.0.1:1", "Label", 2000), std::runtime_error);
 }
 
 std::vector<PointCloud> small_clouds() {
@@ -160,18 +172,21 @@ TEST(LoadgenReport, CsvAndJsonCarryEveryStep) {
 
 // The tool against the fake server, which counts its calls on a real /metrics endpoint.
 TEST(LoadgenCli, SweepReportsMatchTheServersCounters) {
-  auto registry = std::make_shared<metrics::Registry>();
-  metrics::Exposer exposer("127.0.0.1:0");
+  auto registry = std::make_shared<prometheus::Registry>();
+  prometheus::Exposer exposer("127.0.0.1:0");
   exposer.RegisterCollectable(registry);
   FakeServer server;
-  server.service.requests_total =
-      &registry->Add<metrics::Counter>("primlabel_requests_total", "Requests", {});
+  server.service.requests_total = &prometheus::BuildCounter()
+                                       .Name("primlabel_requests_total")
+                                       .Help("Requests")
+                                       .Register(*registry);
   test::TempDir dir;
   write_cloud(dir.file("a.pcd"), test::random_box(500, 1.0f, 3));
   const auto r = test::run_command(
       "( " + test::binary("primlabel-loadgen") + " --server " + server.address() + " " +
       dir.file("a.pcd") + " --requests 7 --concurrency-range 1:3:2 --format csv --metrics-url " +
-      "127.0.0.1:" + std::to_string(exposer.port()) + " 2>/dev/null )");
+      "http://127.0.0.1:" + std::to_string(exposer.GetListeningPorts().at(0)) + "/metrics" +
+      " 2>/dev/null )");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(test::count_lines(r.output), 3) << r.output;  // header + 2 steps
   EXPECT_NE(r.output.find("closed,stream,1,0,"), std::string::npos) << r.output;

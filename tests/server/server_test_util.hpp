@@ -18,6 +18,8 @@
 #include "grpc/health/v1/health.grpc.pb.h"
 #include "label_server.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/scrape/exposition_parser.hpp"
+#include "primlabel/scrape/http_fetch.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "primlabel/wire/packing.hpp"
 #include "random_label_model.hpp"
@@ -65,6 +67,12 @@ inline server::ServerConfig test_config(const fs::path& models) {
   config.queue = 2;
   config.threads_per_job = 2;
   return config;
+}
+
+// The samples of http://127.0.0.1:<metrics_port>/metrics.
+inline std::vector<scrape::Sample> scrape_metrics(int metrics_port) {
+  return scrape::parse_exposition(
+      scrape::fetch_text("http://127.0.0.1:" + std::to_string(metrics_port) + "/metrics"));
 }
 
 inline std::shared_ptr<grpc::Channel> channel_to(int port) {

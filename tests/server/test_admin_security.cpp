@@ -7,7 +7,6 @@
 #include <sstream>
 #include <thread>
 
-#include "primlabel/metrics/metrics.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {
@@ -64,12 +63,10 @@ TEST(AdminService, LoadUnloadAndReloadFollowHealthAndMetrics) {
   // Loading "m" again lifted the model-wide unload, so the rescan brought version 1 back too.
   EXPECT_EQ(reloaded.models(0).loaded_versions_size(), 3);
 
-  const std::string text = metrics::http_get(
-      "127.0.0.1:" + std::to_string(server.server->metrics_port()), "/metrics", 5000);
-  const auto samples = metrics::parse_exposition(text);
-  EXPECT_EQ(metrics::sum_samples(samples, "primlabel_model_reload_failures_total"), 1.0);
-  EXPECT_EQ(metrics::sum_samples(samples, "primlabel_model_info", {{"version", "3"}}), 1.0);
-  EXPECT_EQ(metrics::sum_samples(samples, "primlabel_model_info", {{"version", "2"}}), 0.0);
+  const auto samples = scrape_metrics(server.server->metrics_port());
+  EXPECT_EQ(scrape::sum_samples(samples, "primlabel_model_reload_failures_total"), 1.0);
+  EXPECT_EQ(scrape::sum_samples(samples, "primlabel_model_info", {{"version", "3"}}), 1.0);
+  EXPECT_EQ(scrape::sum_samples(samples, "primlabel_model_info", {{"version", "2"}}), 0.0);
 
   v1::LoadModelRequest bad;
   bad.set_model("../../etc");

@@ -5,7 +5,6 @@
 
 #include <thread>
 
-#include "primlabel/metrics/metrics.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {
@@ -39,10 +38,8 @@ class BadInput : public ::testing::Test {
     EXPECT_NE(status.error_message().find(says), std::string::npos) << status.error_message();
   }
 
-  double metric(const std::string& name, const metrics::Labels& labels = {}) {
-    const std::string text = metrics::http_get(
-        "127.0.0.1:" + std::to_string(server_.server->metrics_port()), "/metrics", 5000);
-    return metrics::sum_samples(metrics::parse_exposition(text), name, labels);
+  double metric(const std::string& name, const scrape::Labels& labels = {}) {
+    return scrape::sum_samples(scrape_metrics(server_.server->metrics_port()), name, labels);
   }
 
   LabelModel model_;

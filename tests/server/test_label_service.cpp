@@ -4,7 +4,6 @@
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 
-#include "primlabel/metrics/metrics.hpp"
 #include "server_test_util.hpp"
 #include "small_svm_model.hpp"
 
@@ -241,10 +240,8 @@ TEST(LabelService, MetricsCountRequestsPointsAndStages) {
   ASSERT_TRUE(label_stream(*server.stub, scan_requests(cloud, header_for())).status.ok());
   EXPECT_EQ(label_cloud(*server.stub, cloud, header_for("nope")).status.error_code(),
             grpc::StatusCode::NOT_FOUND);
-  const std::string text = metrics::http_get(
-      "127.0.0.1:" + std::to_string(server.server->metrics_port()), "/metrics", 5000);
-  const auto samples = metrics::parse_exposition(text);
-  using metrics::sum_samples;
+  const auto samples = scrape_metrics(server.server->metrics_port());
+  using scrape::sum_samples;
   EXPECT_EQ(sum_samples(samples, "primlabel_requests_total",
                         {{"method", "Label"}, {"model", "m"}, {"status", "OK"}}),
             1.0);

@@ -13,7 +13,7 @@
 #include <sstream>
 #include <thread>
 
-#include "primlabel/metrics/metrics.hpp"
+#include "metrics_endpoint.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {
@@ -128,14 +128,12 @@ TEST_F(ServerBinary, LabelsServesMetricsAndStopsCleanlyOnSigterm) {
   ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
   EXPECT_EQ(answer.labels, reference_labels(model_, cloud));
 
-  const std::string text =
-      metrics::http_get("127.0.0.1:" + std::to_string(server.metrics_port), "/metrics", 5000);
-  const auto samples = metrics::parse_exposition(text);
-  EXPECT_EQ(metrics::sum_samples(samples, "primlabel_requests_total",
-                                 {{"method", "Label"}, {"status", "OK"}}),
+  const auto samples = scrape_metrics(server.metrics_port);
+  EXPECT_EQ(scrape::sum_samples(samples, "primlabel_requests_total",
+                                {{"method", "Label"}, {"status", "OK"}}),
             1.0);
-  EXPECT_EQ(metrics::sum_samples(samples, "primlabel_model_info",
-                                 {{"model", "tabletop"}, {"version", "1"}}),
+  EXPECT_EQ(scrape::sum_samples(samples, "primlabel_model_info",
+                                {{"model", "tabletop"}, {"version", "1"}}),
             1.0);
 
   server.signal(SIGTERM);
@@ -159,11 +157,9 @@ TEST_F(ServerBinary, SigtermLetsInFlightRequestsFinishAndRefusesNewOnes) {
   LabelAnswer in_flight;
   std::thread client([&] { in_flight = label_stream(*stub, scan_requests(big, header_for())); });
   // Wait until the server is labeling it.
-  const std::string metrics_address = "127.0.0.1:" + std::to_string(server.metrics_port);
   for (int i = 0; i < 400; ++i) {
-    const auto samples =
-        metrics::parse_exposition(metrics::http_get(metrics_address, "/metrics", 5000));
-    if (metrics::sum_samples(samples, "primlabel_inflight_requests") >= 1) break;
+    const auto samples = scrape_metrics(server.metrics_port);
+    if (scrape::sum_samples(samples, "primlabel_inflight_requests") >= 1) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   server.signal(SIGTERM);
@@ -190,9 +186,8 @@ TEST_F(ServerBinary, TheDrainDeadlineCancelsWhatIsLeft) {
   LabelAnswer in_flight;
   std::thread client([&] { in_flight = label_stream(*stub, scan_requests(big, header_for())); });
   for (int i = 0; i < 400 && !server.logged("event=request") && !server.logged("receive_ms"); ++i) {
-    const auto text =
-        metrics::http_get("127.0.0.1:" + std::to_string(server.metrics_port), "/metrics", 5000);
-    if (metrics::sum_samples(metrics::parse_exposition(text), "primlabel_inflight_requests") >= 1)
+    if (scrape::sum_samples(scrape_metrics(server.metrics_port), "primlabel_inflight_requests") >=
+        1)
       break;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
@@ -240,6 +235,18 @@ TEST_F(ServerBinary, StartupErrorsExitNonZeroWithAReason) {
         {"--models", "/nonexistent/models", "--listen", "127.0.0.1:0", "--metrics-listen", ""});
     EXPECT_EQ(server.exit_code(30000), 1);
     EXPECT_TRUE(server.logged("event=startup_failed")) << server.log();
+  }
+  {
+    // A /metrics address that is taken, or one this build cannot serve: a reason, no abort.
+    server::MetricsEndpoint taken("127.0.0.1:0", {});
+    const std::string busy = "127.0.0.1:" + std::to_string(taken.port());
+    for (const std::string& address : {busy, std::string("[::1]:9464"), std::string("x:99999")}) {
+      ServerProcess server({"--models", repo_.path().string(), "--listen", "127.0.0.1:0",
+                            "--metrics-listen", address});
+      EXPECT_EQ(server.exit_code(30000), 1) << address << ": " << server.log();
+      EXPECT_TRUE(server.logged("event=startup_failed")) << server.log();
+      EXPECT_TRUE(server.logged("cannot serve /metrics on '" + address + "'")) << server.log();
+    }
   }
   {
     ServerProcess server(

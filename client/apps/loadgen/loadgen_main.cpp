@@ -80,7 +80,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::IsMember({"text", "csv", "json"}));
   app.add_option("--metrics-url", metrics_url,
-                 "HOST:PORT of the server's /metrics: report its primlabel_requests_total delta");
+                 "the server's /metrics, http://HOST:PORT/metrics or HOST:PORT: report its "
+                 "primlabel_requests_total delta");
   try {
     app.parse(argc, argv);
     open_loop = rate->count() > 0;

@@ -1,13 +1,16 @@
 #include "server_counters.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
-#include "primlabel/metrics/exposition_parser.hpp"
-#include "primlabel/metrics/http_client.hpp"
+#include "primlabel/scrape/exposition_parser.hpp"
+#include "primlabel/scrape/http_fetch.hpp"
 
 namespace primlabel::client::loadgen {
 
 namespace {
+
+bool is_blank_or_control(char c) { return static_cast<unsigned char>(c) <= ' ' || c == 0x7f; }
 
 bool method_matches(const std::string& label, const std::string& method) {
   return label == method || (label.size() > method.size() + 1 && label.ends_with("/" + method));
@@ -25,9 +28,9 @@ ServerCounts ServerCounts::operator-(const ServerCounts& before) const {
 
 ServerCounts parse_server_counts(const std::string& exposition, const std::string& method) {
   ServerCounts counts;
-  std::vector<metrics::Sample> samples;
+  std::vector<scrape::Sample> samples;
   try {
-    samples = metrics::parse_exposition(exposition);
+    samples = scrape::parse_exposition(exposition);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(std::string("metrics: ") + e.what());
   }
@@ -42,9 +45,27 @@ ServerCounts parse_server_counts(const std::string& exposition, const std::strin
   return counts;
 }
 
-ServerCounts read_server_counts(const std::string& host_port, const std::string& method,
+std::string metrics_url_from(const std::string& flag) {
+  if (flag.empty()) throw std::invalid_argument("empty metrics URL");
+  if (std::any_of(flag.begin(), flag.end(), is_blank_or_control))
+    throw std::invalid_argument("blank or control character in the metrics URL");
+  const auto scheme_end = flag.find("://");
+  if (scheme_end == std::string::npos) return "http://" + flag + "/metrics";  // HOST:PORT
+  const std::string scheme = flag.substr(0, scheme_end);
+  if (scheme != "http" && scheme != "https")
+    throw std::invalid_argument("metrics URL scheme '" + scheme + "' is not http or https");
+  return flag;
+}
+
+ServerCounts read_server_counts(const std::string& where, const std::string& method,
                                 int timeout_ms) {
-  return parse_server_counts(metrics::http_get(host_port, "/metrics", timeout_ms), method);
+  std::string url;
+  try {
+    url = metrics_url_from(where);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(e.what());
+  }
+  return parse_server_counts(scrape::fetch_text(url, {.timeout_ms = timeout_ms}), method);
 }
 
 }  // namespace primlabel::client::loadgen

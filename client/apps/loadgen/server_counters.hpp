@@ -14,10 +14,15 @@ struct ServerCounts {
   ServerCounts operator-(const ServerCounts& before) const;
 };
 
+// The URL to scrape for a --metrics-url value: a URL ("http://host:port/metrics") as given,
+// "HOST:PORT" as http://HOST:PORT/metrics. Throws std::invalid_argument on an empty value, a
+// scheme other than http(s), or blanks and control characters.
+std::string metrics_url_from(const std::string& flag);
+
 // Sums primlabel_requests_total over models for `method` ("Label" or "LabelCloud"; a method label
-// written as the full "/primlabel.v1.Labeler/Label" matches too). Throws std::runtime_error when
-// the endpoint cannot be read or parsed.
-ServerCounts read_server_counts(const std::string& host_port, const std::string& method,
+// written as the full "/primlabel.v1.Labeler/Label" matches too), from metrics_url_from(`where`).
+// Throws std::runtime_error when the endpoint cannot be read or parsed.
+ServerCounts read_server_counts(const std::string& where, const std::string& method,
                                 int timeout_ms = 5000);
 
 // Same, from exposition text already fetched.

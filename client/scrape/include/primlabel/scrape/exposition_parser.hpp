@@ -1,14 +1,16 @@
 #pragma once
 // Reading the Prometheus text exposition format (tests, and the load generator reading a
-// server's counters).
+// server's counters). prometheus-cpp writes this format but has no reader.
 
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "primlabel/metrics/labels.hpp"
+namespace primlabel::scrape {
 
-namespace primlabel::metrics {
+// Label name -> value. A std::map, so a label set has one canonical (sorted) order.
+using Labels = std::map<std::string, std::string>;
 
 struct Sample {
   std::string name;  // as written, e.g. "x_bucket" for a histogram bucket
@@ -26,4 +28,4 @@ std::vector<Sample> parse_exposition(std::string_view text);
 double sum_samples(const std::vector<Sample>& samples, std::string_view name,
                    const Labels& match = {});
 
-}  // namespace primlabel::metrics
+}  // namespace primlabel::scrape

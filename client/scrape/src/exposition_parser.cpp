@@ -1,4 +1,4 @@
-#include "primlabel/metrics/exposition_parser.hpp"
+#include "primlabel/scrape/exposition_parser.hpp"
 
 #include <cctype>
 #include <charconv>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-namespace primlabel::metrics {
+namespace primlabel::scrape {
 namespace {
 
 class LineError : public std::invalid_argument {
@@ -16,6 +16,17 @@ class LineError : public std::invalid_argument {
 };
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+// [a-zA-Z_:][a-zA-Z0-9_:]*
+bool is_valid_metric_name(std::string_view name) {
+  if (name.empty()) return false;
+  for (std::size_t i = 0; i < name.size(); ++i) {
+    const char c = name[i];
+    const bool letter = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_' || c == ':';
+    if (!letter && !(i > 0 && c >= '0' && c <= '9')) return false;
+  }
+  return true;
+}
 
 // Cursor over one line of the exposition.
 class LineReader {
@@ -77,7 +88,11 @@ class LineReader {
 double parse_value(std::string_view text, const LineReader& reader) {
   if (text == "+Inf" || text == "Inf") return INFINITY;
   if (text == "-Inf") return -INFINITY;
-  if (text == "NaN") return NAN;
+  // prometheus-cpp writes NaN as "Nan"; Prometheus reads NaN in any case.
+  if (text.size() == 3 && std::tolower(static_cast<unsigned char>(text[0])) == 'n' &&
+      std::tolower(static_cast<unsigned char>(text[1])) == 'a' &&
+      std::tolower(static_cast<unsigned char>(text[2])) == 'n')
+    return NAN;
   if (text.starts_with('+')) text.remove_prefix(1);  // from_chars takes no '+'
   double value = 0;
   const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
@@ -193,4 +208,4 @@ double sum_samples(const std::vector<Sample>& samples, std::string_view name, co
   return sum;
 }
 
-}  // namespace primlabel::metrics
+}  // namespace primlabel::scrape

@@ -1,25 +1,32 @@
-// Parsing the text exposition format: round trip of Serialize() and errors on malformed input.
+// Parsing the text exposition format: what prometheus-cpp's serializer writes, and errors on
+// malformed input.
 
 #include <gtest/gtest.h>
+#include <prometheus/counter.h>
+#include <prometheus/gauge.h>
+#include <prometheus/histogram.h>
+#include <prometheus/registry.h>
+#include <prometheus/text_serializer.h>
 
 #include <cmath>
 #include <stdexcept>
 
-#include "primlabel/metrics/metrics.hpp"
+#include "primlabel/scrape/exposition_parser.hpp"
 
-namespace primlabel::metrics {
+namespace primlabel::scrape {
 namespace {
 
-TEST(ExpositionParser, RoundTripsSerialize) {
-  Registry registry;
-  auto& requests = BuildCounter().Name("req_total").Help("h").Register(registry);
+TEST(ExpositionParser, ReadsWhatPrometheusCppWrites) {
+  prometheus::Registry registry;
+  auto& requests = prometheus::BuildCounter().Name("req_total").Help("h").Register(registry);
   requests.Add({{"model", "tabletop"}, {"odd", "a\\b\"c\nd"}}).Increment(41);
-  BuildGauge().Name("depth").Register(registry).Add({}).Set(-0.125);
-  auto& histogram = BuildHistogram().Name("lat").Register(registry).Add({{"stage", "crf"}}, {0.1});
+  prometheus::BuildGauge().Name("depth").Register(registry).Add({}).Set(-0.125);
+  auto& histogram = prometheus::BuildHistogram().Name("lat").Register(registry).Add(
+      {{"stage", "crf"}}, prometheus::Histogram::BucketBoundaries{0.1});
   histogram.Observe(0.05);
   histogram.Observe(3);
 
-  const auto samples = parse_exposition(registry.Serialize());
+  const auto samples = parse_exposition(prometheus::TextSerializer().Serialize(registry.Collect()));
   ASSERT_EQ(samples.size(), 6u);
   EXPECT_EQ(samples[0].name, "req_total");
   EXPECT_EQ(samples[0].labels, (Labels{{"model", "tabletop"}, {"odd", "a\\b\"c\nd"}}));
@@ -27,14 +34,16 @@ TEST(ExpositionParser, RoundTripsSerialize) {
   EXPECT_EQ(samples[1].name, "depth");
   EXPECT_TRUE(samples[1].labels.empty());
   EXPECT_EQ(samples[1].value, -0.125);
-  EXPECT_EQ(samples[2].name, "lat_bucket");
-  EXPECT_EQ(samples[2].labels, (Labels{{"le", "0.1"}, {"stage", "crf"}}));
-  EXPECT_EQ(samples[2].value, 1);
-  EXPECT_EQ(samples[3].labels.at("le"), "+Inf");
-  EXPECT_EQ(samples[3].value, 2);
-  EXPECT_EQ(samples[4].name, "lat_sum");
-  EXPECT_EQ(samples[4].value, 3.05);
-  EXPECT_EQ(samples[5].name, "lat_count");
+  // prometheus-cpp writes a histogram's count and sum before its buckets.
+  EXPECT_EQ(samples[2].name, "lat_count");
+  EXPECT_EQ(samples[2].value, 2);
+  EXPECT_EQ(samples[3].name, "lat_sum");
+  EXPECT_EQ(samples[3].value, 3.05);
+  EXPECT_EQ(samples[4].name, "lat_bucket");
+  EXPECT_EQ(samples[4].labels, (Labels{{"le", "0.1"}, {"stage", "crf"}}));
+  EXPECT_EQ(samples[4].value, 1);
+  EXPECT_EQ(samples[5].labels.at("le"), "+Inf");
+  EXPECT_EQ(samples[5].value, 2);
   EXPECT_EQ(sum_samples(samples, "req_total", {{"model", "tabletop"}}), 41);
   EXPECT_EQ(sum_samples(samples, "req_total", {{"model", "other"}}), 0);
 }
@@ -49,14 +58,16 @@ TEST(ExpositionParser, AcceptsWhatPrometheusWrites) {
       "x{a=\"1\",} +Inf\n"
       "x{ a = \"2\" } -Inf\n"
       "y NaN\n"
+      "w Nan\n"     // prometheus-cpp's spelling (its exposer's empty summaries)
       "z 1.5e-3");  // no final newline
-  ASSERT_EQ(samples.size(), 5u);
+  ASSERT_EQ(samples.size(), 6u);
   EXPECT_EQ(samples[0].value, 1);
   EXPECT_EQ(samples[1].value, INFINITY);
   EXPECT_EQ(samples[2].labels.at("a"), "2");
   EXPECT_EQ(samples[2].value, -INFINITY);
   EXPECT_TRUE(std::isnan(samples[3].value));
-  EXPECT_EQ(samples[4].value, 1.5e-3);
+  EXPECT_TRUE(std::isnan(samples[4].value));
+  EXPECT_EQ(samples[5].value, 1.5e-3);
 }
 
 void expect_error_on_line(const std::string& text, int line) {
@@ -88,4 +99,4 @@ TEST(ExpositionParser, RejectsMalformedInputNamingTheLine) {
 }
 
 }  // namespace
-}  // namespace primlabel::metrics
+}  // namespace primlabel::scrape
