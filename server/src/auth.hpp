@@ -4,10 +4,12 @@
 
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server_context.h>
-#include <grpcpp/support/status.h>
 
 #include <memory>
+#include <optional>
 #include <string>
+
+#include "service_error.hpp"
 
 namespace primlabel::server {
 
@@ -16,9 +18,9 @@ class TokenAuth {
   // An empty token means no checks at all.
   TokenAuth(std::string token, bool required_for_all);
 
-  // OK, or UNAUTHENTICATED saying what is missing. `admin` RPCs need the token whenever one is
-  // configured; the others only with required_for_all.
-  grpc::Status check(const grpc::ServerContext& context, bool admin) const;
+  // Nothing, or UNAUTHENTICATED saying what is missing. `admin` RPCs need the token whenever
+  // one is configured; the others only with required_for_all. Any kind of server context.
+  std::optional<ServiceError> check(const grpc::ServerContextBase& context, bool admin) const;
 
   bool enabled() const { return !token_.empty(); }
 

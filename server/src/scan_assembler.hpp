@@ -1,15 +1,15 @@
 #pragma once
 // Builds the cloud of one scan from its PointChunks, checking each as it arrives: byte lengths
 // that fit the point layout, the point and byte limits, the announced point count, and
-// non-finite coordinates (counted, or refused when the request says so). Every refusal names
-// the chunk and, for a coordinate, the point.
-
-#include <grpcpp/support/status.h>
+// non-finite coordinates (counted, or refused when the request says so). Every refusal is an
+// INVALID_ARGUMENT naming the chunk and, for a coordinate, the point.
 
 #include <cstdint>
+#include <optional>
 
 #include "primlabel/core/point_cloud.hpp"
 #include "primlabel/v1/labeling.pb.h"
+#include "service_error.hpp"
 
 namespace primlabel::server {
 
@@ -23,9 +23,9 @@ class ScanAssembler {
   ScanAssembler(const v1::ScanHeader& header, const ScanLimits& limits);
 
   // Checks and appends one chunk (chunks are numbered from 1 in messages).
-  grpc::Status add(const v1::PointChunk& chunk);
+  std::optional<ServiceError> add(const v1::PointChunk& chunk);
   // After the last chunk: at least one point, and as many as the header announced.
-  grpc::Status finish() const;
+  std::optional<ServiceError> finish() const;
 
   PointCloud& cloud() { return cloud_; }
   std::uint64_t points() const { return cloud_.size(); }
@@ -44,6 +44,6 @@ class ScanAssembler {
 };
 
 // Checks a header before any point arrives: limits against expected_points and option values.
-grpc::Status check_header(const v1::ScanHeader& header, const ScanLimits& limits);
+std::optional<ServiceError> check_header(const v1::ScanHeader& header, const ScanLimits& limits);
 
 }  // namespace primlabel::server

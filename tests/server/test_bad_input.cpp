@@ -18,7 +18,11 @@ class BadInput : public ::testing::Test {
  protected:
   BadInput()
       : model_(random_label_model("m", "1")),
-        server_({model_}, [](server::ServerConfig& c) { c.max_points = 50000; }),
+        server_({model_},
+                [](server::ServerConfig& c) {
+                  c.max_points = 50000;
+                  c.max_receiving_streams = 3;
+                }),
         cloud_(table_with_box_cloud(0.01f)) {}
 
   // The server still labels a good scan correctly.
@@ -223,7 +227,7 @@ TEST_F(BadInput, DeadlineExceededWhileLabeling) {
 }
 
 TEST_F(BadInput, BusyServerAnswersResourceExhaustedAtHeaderTime) {
-  // Capacity is 1 worker + 2 queued: hold three streams open after their headers.
+  // The receiving budget is 3 streams: hold three streams open after their headers.
   std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
   std::vector<std::unique_ptr<grpc::ClientReaderWriter<v1::LabelRequest, v1::LabelResponse>>>
       streams;
