@@ -150,9 +150,15 @@ grpc::ServerUnaryReactor* start_label_cloud_reactor(const ServiceEnvironment& en
                                                     grpc::CallbackServerContext* context,
                                                     const grpc::ByteBuffer* request,
                                                     grpc::ByteBuffer* response) {
-  auto reactor = std::make_shared<LabelCloudReactor>(env, context, response);
-  reactor->begin(request);
-  return reactor.get();
+  try {
+    auto reactor = std::make_shared<LabelCloudReactor>(env, context, response);
+    reactor->begin(request);
+    return reactor.get();
+  } catch (...) {  // the reactor could not even be made (out of memory): say so
+    grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+    reactor->Finish(to_grpc_status(internal_error("starting the call", std::current_exception())));
+    return reactor;
+  }
 }
 
 }  // namespace primlabel::server

@@ -329,13 +329,25 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
   Clock::time_point timer_at_;
 };
 
+// For a call whose reactor could not even be made (out of memory): it only says so.
+class RefusedReactor final : public RawReactor {
+ public:
+  explicit RefusedReactor(const grpc::Status& status) { Finish(status); }
+  void OnDone() override { delete this; }
+};
+
 }  // namespace
 
 RawReactor* start_label_reactor(const ServiceEnvironment& env,
                                 grpc::CallbackServerContext* context) {
-  auto reactor = std::make_shared<LabelReactor>(env, context);
-  reactor->begin();
-  return reactor.get();
+  try {
+    auto reactor = std::make_shared<LabelReactor>(env, context);
+    reactor->begin();
+    return reactor.get();
+  } catch (...) {
+    return new RefusedReactor(
+        to_grpc_status(internal_error("starting the call", std::current_exception())));
+  }
 }
 
 }  // namespace primlabel::server

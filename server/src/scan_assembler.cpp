@@ -1,5 +1,6 @@
 #include "scan_assembler.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -16,6 +17,8 @@ std::string describe_point(const Vec3f& p) {
   text << "(" << p.x() << ", " << p.y() << ", " << p.z() << ")";
   return text.str();
 }
+
+constexpr std::uint64_t kMaxReservedPoints = 1u << 18;  // 3 MiB of xyz
 
 bool finite_non_negative(float value) { return std::isfinite(value) && value >= 0.0f; }
 
@@ -48,9 +51,12 @@ ScanAssembler::ScanAssembler(const v1::ScanHeader& header, const ScanLimits& lim
       limits_(limits) {
   cloud_.viewpoint.origin =
       Vec3f(header.viewpoint().x(), header.viewpoint().y(), header.viewpoint().z());
-  if (expected_points_ > 0) {
-    cloud_.xyz.reserve(expected_points_);
-    if (normals_) cloud_.normals.reserve(expected_points_);
+  // A header alone must not buy memory: announced points are reserved only up to a modest
+  // count, the rest grows as points really arrive.
+  const std::uint64_t reserved = std::min<std::uint64_t>(expected_points_, kMaxReservedPoints);
+  if (reserved > 0) {
+    cloud_.xyz.reserve(reserved);
+    if (normals_) cloud_.normals.reserve(reserved);
   }
 }
 
