@@ -1,7 +1,8 @@
 #include "admin_service.hpp"
 
+#include "grpc_status.hpp"
 #include "labeler_service.hpp"
-#include "registry_status.hpp"
+#include "registry_error.hpp"
 #include "request_record.hpp"
 
 namespace primlabel::server {
@@ -11,8 +12,8 @@ grpc::Status AdminService::LoadModel(grpc::ServerContext* context,
                                      v1::LoadModelResponse* response) {
   RequestRecord record("LoadModel", *env_.metrics);
   record.model = request->model();
-  if (grpc::Status status = env_.auth->check(*context, true); !status.ok())
-    return record.finish(status);
+  if (auto refused = env_.auth->check(*context, true))
+    return record.finish(to_grpc_status(*refused));
   try {
     const auto entry = env_.registry->load(request->model(), request->version());
     record.version = entry->version;
@@ -20,7 +21,7 @@ grpc::Status AdminService::LoadModel(grpc::ServerContext* context,
     env_.metrics->reloads(1, 0);
   } catch (const RegistryError& error) {
     if (error.kind() == RegistryError::Kind::kLoadFailed) env_.metrics->reloads(0, 1);
-    return record.finish(registry_status(error));
+    return record.finish(to_grpc_status(registry_error(error)));
   }
   for (const ServedModel& model : env_.registry->list())
     if (model.name == request->model()) fill_model_info(model, *response->mutable_model());
@@ -33,12 +34,12 @@ grpc::Status AdminService::UnloadModel(grpc::ServerContext* context,
   RequestRecord record("UnloadModel", *env_.metrics);
   record.model = request->model();
   record.version = request->version();
-  if (grpc::Status status = env_.auth->check(*context, true); !status.ok())
-    return record.finish(status);
+  if (auto refused = env_.auth->check(*context, true))
+    return record.finish(to_grpc_status(*refused));
   try {
     response->set_unloaded_versions(env_.registry->unload(request->model(), request->version()));
   } catch (const RegistryError& error) {
-    return record.finish(registry_status(error));
+    return record.finish(to_grpc_status(registry_error(error)));
   }
   return record.finish(grpc::Status::OK);
 }
@@ -47,8 +48,8 @@ grpc::Status AdminService::ReloadModels(grpc::ServerContext* context,
                                         const v1::ReloadModelsRequest*,
                                         v1::ReloadModelsResponse* response) {
   RequestRecord record("ReloadModels", *env_.metrics);
-  if (grpc::Status status = env_.auth->check(*context, true); !status.ok())
-    return record.finish(status);
+  if (auto refused = env_.auth->check(*context, true))
+    return record.finish(to_grpc_status(*refused));
   try {
     // Unloads last until this explicit reload, which brings their versions back.
     const ReloadReport report = env_.registry->reload();
@@ -57,7 +58,7 @@ grpc::Status AdminService::ReloadModels(grpc::ServerContext* context,
     response->set_failed(report.failed);
     for (const std::string& error : report.errors) response->add_errors(error);
   } catch (const RegistryError& error) {
-    return record.finish(registry_status(error));
+    return record.finish(to_grpc_status(registry_error(error)));
   }
   for (const ServedModel& model : env_.registry->list())
     fill_model_info(model, *response->add_models());

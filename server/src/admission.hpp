@@ -1,8 +1,8 @@
 #pragma once
 // Bounded concurrency: a fixed pool of worker threads runs labeling jobs, and at most
-// workers + queue requests are admitted at once (counted from the moment their header arrives,
-// so a refused request never buffers points). Admission beyond that fails at once, for the
-// caller to answer RESOURCE_EXHAUSTED.
+// workers + queue requests hold a compute slot at once (from their complete scan until their
+// result is computed; streams still receiving points count in their own budget, SlotBudget).
+// Admission beyond that fails at once, for the caller to answer RESOURCE_EXHAUSTED.
 
 #include <chrono>
 #include <condition_variable>

@@ -33,25 +33,26 @@ TokenAuth::TokenAuth(std::string token, bool required_for_all, bool insecure_adm
       required_for_all_(required_for_all),
       insecure_admin_(insecure_admin) {}
 
-grpc::Status TokenAuth::check(const grpc::ServerContext& context, bool admin) const {
+std::optional<ServiceError> TokenAuth::check(const grpc::ServerContextBase& context,
+                                             bool admin) const {
   if (admin && token_.empty() && !insecure_admin_)
-    return {grpc::StatusCode::PERMISSION_DENIED,
-            "admin RPCs are disabled: this server has no token; start it with --token-file "
-            "(or PRIMLABEL_TOKEN) to require one, or with --insecure-admin to allow them "
-            "without one"};
-  if (token_.empty() || (!admin && !required_for_all_)) return grpc::Status::OK;
+    return ServiceError{ErrorCode::kPermissionDenied,
+                        "admin RPCs are disabled: this server has no token; start it with "
+                        "--token-file (or PRIMLABEL_TOKEN) to require one, or with "
+                        "--insecure-admin to allow them without one"};
+  if (token_.empty() || (!admin && !required_for_all_)) return std::nullopt;
   const auto& metadata = context.client_metadata();
   auto found = metadata.find("authorization");
   if (found == metadata.end())
-    return {grpc::StatusCode::UNAUTHENTICATED,
-            std::string(admin ? "admin RPCs" : "this server") +
-                " require an 'authorization: Bearer <token>' header"};
+    return ServiceError{ErrorCode::kUnauthenticated,
+                        std::string(admin ? "admin RPCs" : "this server") +
+                            " require an 'authorization: Bearer <token>' header"};
   const std::string value(found->second.data(), found->second.size());
   const std::string prefix = "Bearer ";
   if (value.compare(0, prefix.size(), prefix) != 0 ||
       !constant_time_equal(value.substr(prefix.size()), token_))
-    return {grpc::StatusCode::UNAUTHENTICATED, "the bearer token is not valid"};
-  return grpc::Status::OK;
+    return ServiceError{ErrorCode::kUnauthenticated, "the bearer token is not valid"};
+  return std::nullopt;
 }
 
 std::shared_ptr<grpc::ServerCredentials> server_credentials(const TlsFiles& files) {

@@ -4,10 +4,12 @@
 
 #include <grpcpp/security/server_credentials.h>
 #include <grpcpp/server_context.h>
-#include <grpcpp/support/status.h>
 
 #include <memory>
+#include <optional>
 #include <string>
+
+#include "service_error.hpp"
 
 namespace primlabel::server {
 
@@ -17,10 +19,10 @@ class TokenAuth {
   // `insecure_admin` allows them (anyone who reaches the port could unload every model).
   TokenAuth(std::string token, bool required_for_all, bool insecure_admin = false);
 
-  // OK, or UNAUTHENTICATED saying what is missing, or PERMISSION_DENIED naming the flags that
-  // enable admin RPCs. `admin` RPCs need the token whenever one is configured; the others only
-  // with required_for_all.
-  grpc::Status check(const grpc::ServerContext& context, bool admin) const;
+  // Nothing, or UNAUTHENTICATED saying what is missing, or PERMISSION_DENIED naming the flags
+  // that enable admin RPCs. `admin` RPCs need the token whenever one is configured; the others
+  // only with required_for_all. Any kind of server context.
+  std::optional<ServiceError> check(const grpc::ServerContextBase& context, bool admin) const;
 
   bool enabled() const { return !token_.empty(); }
   bool admin_open() const { return token_.empty() && insecure_admin_; }

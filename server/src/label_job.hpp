@@ -1,17 +1,19 @@
 #pragma once
 // One labeling request between "points received" and "labels ready": which model and options
-// it gets (checked against what the model allows), and the run on a worker thread, stopped as
-// soon as the client cancels, its deadline passes or the drain deadline cancels it.
+// it gets (checked against what the model allows), and the labeling itself, which turns every
+// way it can fail (stopped, bad options, out of memory, any other exception) into a
+// ServiceError. No transport here.
 
-#include <grpcpp/server_context.h>
-#include <grpcpp/support/status.h>
-
+#include <cstdint>
 #include <memory>
+#include <optional>
+#include <stop_token>
 
+#include "admission.hpp"
+#include "model_registry.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/v1/labeling.pb.h"
-#include "request_record.hpp"
-#include "service_environment.hpp"
+#include "service_error.hpp"
 
 namespace primlabel::server {
 
@@ -21,18 +23,21 @@ struct LabelPlan {
 };
 
 // Resolves the model and checks the options (NOT_FOUND, INVALID_ARGUMENT, FAILED_PRECONDITION).
-grpc::Status plan_labeling(const v1::ScanHeader& header, const ServiceEnvironment& env,
-                           LabelPlan& plan);
+std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelRegistry& registry,
+                                          LabelPlan& plan);
 
-// Runs label_cloud on a worker, polling the call every few milliseconds; fills the record's
-// prefilter / normals / features / inference times. CANCELLED or DEADLINE_EXCEEDED when stopped.
-grpc::Status run_labeling(grpc::ServerContext& context, const ServiceEnvironment& env,
-                          const Admission::Ticket& ticket, const LabelPlan& plan, PointCloud& cloud,
-                          pipeline::LabelingResult& result, RequestRecord& record);
+// Bytes per point of the answer the plan asks for (labels, descriptors, probabilities), known
+// before labeling.
+std::uint64_t answer_bytes_per_point(const LabelPlan& plan);
 
-// RESOURCE_EXHAUSTED naming the limits, for a request refused at admission.
-grpc::Status server_busy(const Admission& admission);
+// Runs label_cloud; never throws. CANCELLED when `stop` was requested.
+std::optional<ServiceError> run_label_job(const LabelPlan& plan, PointCloud& cloud,
+                                          std::stop_token stop, int threads,
+                                          pipeline::LabelingResult& result);
+
+// RESOURCE_EXHAUSTED naming the limits, for a request refused for lack of a compute slot.
+ServiceError server_busy(const Admission& admission);
 // UNAVAILABLE, for requests arriving while the server drains.
-grpc::Status shutting_down();
+ServiceError shutting_down();
 
 }  // namespace primlabel::server

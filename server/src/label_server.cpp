@@ -36,12 +36,16 @@ LabelServer::LabelServer(ServerConfig config)
     : config_(std::move(config)),
       registry_(registry_options(config_)),
       auth_(config_.token, config_.token_for_all, config_.insecure_admin) {
-  admission_ = std::make_unique<Admission>(
-      effective_workers(config_), config_.queue,
-      [this](int admitted, int queued) { metrics_.set_admission(admitted, queued); });
+  receiving_ = std::make_unique<SlotBudget>(config_.max_receiving_streams);
+  admission_ =
+      std::make_unique<Admission>(effective_workers(config_), config_.queue,
+                                  [this](int, int queued) { requests_.set_queued(queued); });
   env_.config = &config_;
   env_.registry = &registry_;
   env_.admission = admission_.get();
+  env_.receiving = receiving_.get();
+  env_.requests = &requests_;
+  env_.timers = &timers_;
   env_.metrics = &metrics_;
   env_.auth = &auth_;
   env_.draining = &draining_;
@@ -159,7 +163,7 @@ void LabelServer::shutdown(std::chrono::milliseconds drain) {
   shut_down_ = true;
   log_info("shutting_down")
       .kv("drain_ms", std::int64_t(drain.count()))
-      .kv("in_flight", admission_->admitted());
+      .kv("in_flight", requests_.in_flight());
   {
     std::lock_guard lock(health_mutex_);
     draining_.store(true);
@@ -170,7 +174,7 @@ void LabelServer::shutdown(std::chrono::milliseconds drain) {
   // gRPC's own Shutdown deadline would also wait for idle client connections to close, which
   // clients without active calls notice only seconds later.
   const auto deadline = std::chrono::system_clock::now() + drain;
-  while (admission_->admitted() > 0 && std::chrono::system_clock::now() < deadline)
+  while (requests_.in_flight() > 0 && std::chrono::system_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   if (server_) {
     // Short calls (model queries) get a moment; labeling calls still running past the drain

@@ -54,6 +54,10 @@ class LabelServer {
   ModelRegistry registry_;
   TokenAuth auth_;
   std::atomic<bool> draining_{false};
+  // Before admission_: jobs still stopping when the workers are joined may touch them.
+  TimerService timers_;
+  std::unique_ptr<SlotBudget> receiving_;
+  RequestGauge requests_{metrics_};
   std::unique_ptr<Admission> admission_;
   ServiceEnvironment env_;
   std::unique_ptr<LabelerService> labeler_;

@@ -1,41 +1,23 @@
 #include "labeler_service.hpp"
 
-#include <grpcpp/support/method_handler.h>
-
-#include "label_stream.hpp"
-#include "registry_status.hpp"
+#include "grpc_status.hpp"
+#include "label_reactors.hpp"
+#include "registry_error.hpp"
 #include "request_record.hpp"
 
 namespace primlabel::server {
 
-namespace {
+LabelerService::LabelerService(const ServiceEnvironment& env) : env_(env) {}
 
-// Method indices in labeling.proto's Labeler service.
-constexpr int kLabelMethod = 0;
-constexpr int kLabelCloudMethod = 1;
+grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>* LabelerService::Label(
+    grpc::CallbackServerContext* context) {
+  return start_label_reactor(env_, context);
+}
 
-using RawHandler =
-    grpc::internal::BidiStreamingHandler<LabelerService, grpc::ByteBuffer, grpc::ByteBuffer>;
-
-}  // namespace
-
-LabelerService::LabelerService(const ServiceEnvironment& env) : env_(env) {
-  // The labeling methods read raw bytes (a malformed message gets a precise INVALID_ARGUMENT
-  // instead of looking like the end of the stream). LabelCloud stays unary on the wire.
-  MarkMethodStreamed(
-      kLabelMethod,
-      new RawHandler(
-          [](LabelerService* service, grpc::ServerContext* context, RawStream* stream) {
-            return serve_label_stream(service->env_, *context, *stream);
-          },
-          this));
-  MarkMethodStreamed(
-      kLabelCloudMethod,
-      new RawHandler(
-          [](LabelerService* service, grpc::ServerContext* context, RawStream* stream) {
-            return serve_label_cloud(service->env_, *context, *stream);
-          },
-          this));
+grpc::ServerUnaryReactor* LabelerService::LabelCloud(grpc::CallbackServerContext* context,
+                                                     const grpc::ByteBuffer* request,
+                                                     grpc::ByteBuffer* response) {
+  return start_label_cloud_reactor(env_, context, request, response);
 }
 
 void fill_model_info(const ServedModel& model, v1::ModelInfo& info) {
@@ -54,8 +36,8 @@ void fill_model_info(const ServedModel& model, v1::ModelInfo& info) {
 grpc::Status LabelerService::ListModels(grpc::ServerContext* context, const v1::ListModelsRequest*,
                                         v1::ListModelsResponse* response) {
   RequestRecord record("ListModels", *env_.metrics);
-  if (grpc::Status status = env_.auth->check(*context, false); !status.ok())
-    return record.finish(status);
+  if (auto refused = env_.auth->check(*context, false))
+    return record.finish(to_grpc_status(*refused));
   for (const ServedModel& model : env_.registry->list())
     fill_model_info(model, *response->add_models());
   return record.finish(grpc::Status::OK);
@@ -66,8 +48,8 @@ grpc::Status LabelerService::GetModelMetadata(grpc::ServerContext* context,
                                               v1::ModelMetadata* response) {
   RequestRecord record("GetModelMetadata", *env_.metrics);
   record.model = request->model();
-  if (grpc::Status status = env_.auth->check(*context, false); !status.ok())
-    return record.finish(status);
+  if (auto refused = env_.auth->check(*context, false))
+    return record.finish(to_grpc_status(*refused));
   try {
     const auto entry = env_.registry->resolve(request->model(), request->version());
     record.model = entry->name;
@@ -75,7 +57,7 @@ grpc::Status LabelerService::GetModelMetadata(grpc::ServerContext* context,
     record.model_resolved = true;
     *response = entry->metadata;
   } catch (const RegistryError& error) {
-    return record.finish(registry_status(error));
+    return record.finish(to_grpc_status(registry_error(error)));
   }
   return record.finish(grpc::Status::OK);
 }

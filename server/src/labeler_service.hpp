@@ -1,15 +1,24 @@
 #pragma once
-// primlabel.v1.Labeler: Label (streaming) and LabelCloud (unary) on raw messages (see
-// label_stream.hpp), ListModels and GetModelMetadata.
+// primlabel.v1.Labeler: Label (streaming) and LabelCloud (unary) on raw messages and gRPC's
+// callback API (see label_reactors.hpp), ListModels and GetModelMetadata.
 
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "service_environment.hpp"
 
 namespace primlabel::server {
 
-class LabelerService final : public v1::Labeler::Service {
+using LabelerBase = v1::Labeler::WithRawCallbackMethod_Label<
+    v1::Labeler::WithRawCallbackMethod_LabelCloud<v1::Labeler::Service>>;
+
+class LabelerService final : public LabelerBase {
  public:
   explicit LabelerService(const ServiceEnvironment& env);
+
+  grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>* Label(
+      grpc::CallbackServerContext* context) override;
+  grpc::ServerUnaryReactor* LabelCloud(grpc::CallbackServerContext* context,
+                                       const grpc::ByteBuffer* request,
+                                       grpc::ByteBuffer* response) override;
 
   grpc::Status ListModels(grpc::ServerContext* context, const v1::ListModelsRequest* request,
                           v1::ListModelsResponse* response) override;

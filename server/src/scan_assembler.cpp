@@ -1,5 +1,6 @@
 #include "scan_assembler.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -10,15 +11,15 @@ namespace primlabel::server {
 
 namespace {
 
-grpc::Status invalid(const std::string& message) {
-  return {grpc::StatusCode::INVALID_ARGUMENT, message};
-}
+ServiceError invalid(const std::string& message) { return {ErrorCode::kInvalidArgument, message}; }
 
 std::string describe_point(const Vec3f& p) {
   std::ostringstream text;
   text << "(" << p.x() << ", " << p.y() << ", " << p.z() << ")";
   return text.str();
 }
+
+constexpr std::uint64_t kMaxReservedPoints = 1u << 18;  // 3 MiB of xyz
 
 bool finite_non_negative(float value) { return std::isfinite(value) && value >= 0.0f; }
 
@@ -32,7 +33,7 @@ bool usable_normal(const Vec3f& n) {
 
 }  // namespace
 
-grpc::Status check_header(const v1::ScanHeader& header, const ScanLimits& limits) {
+std::optional<ServiceError> check_header(const v1::ScanHeader& header, const ScanLimits& limits) {
   if (header.expected_points() > limits.max_points)
     return invalid("the scan announces " + std::to_string(header.expected_points()) +
                    " points; this server takes at most " + std::to_string(limits.max_points));
@@ -48,7 +49,7 @@ grpc::Status check_header(const v1::ScanHeader& header, const ScanLimits& limits
     return invalid("the viewpoint must be finite");
   if (options.non_finite() != v1::NON_FINITE_DROP && options.non_finite() != v1::NON_FINITE_REJECT)
     return invalid("unknown options.non_finite policy " + std::to_string(options.non_finite()));
-  return grpc::Status::OK;
+  return std::nullopt;
 }
 
 ScanAssembler::ScanAssembler(const v1::ScanHeader& header, const ScanLimits& limits)
@@ -59,13 +60,16 @@ ScanAssembler::ScanAssembler(const v1::ScanHeader& header, const ScanLimits& lim
       limits_(limits) {
   cloud_.viewpoint.origin =
       Vec3f(header.viewpoint().x(), header.viewpoint().y(), header.viewpoint().z());
-  if (expected_points_ > 0) {
-    cloud_.xyz.reserve(expected_points_);
-    if (normals_) cloud_.normals.reserve(expected_points_);
+  // A header alone must not buy memory: announced points are reserved only up to a modest
+  // count, the rest grows as points really arrive.
+  const std::uint64_t reserved = std::min<std::uint64_t>(expected_points_, kMaxReservedPoints);
+  if (reserved > 0) {
+    cloud_.xyz.reserve(reserved);
+    if (normals_) cloud_.normals.reserve(reserved);
   }
 }
 
-grpc::Status ScanAssembler::add(const v1::PointChunk& chunk) {
+std::optional<ServiceError> ScanAssembler::add(const v1::PointChunk& chunk) {
   ++chunks_;
   const std::string where = "chunk " + std::to_string(chunks_);
   const std::string& xyz = chunk.xyz();
@@ -100,7 +104,7 @@ grpc::Status ScanAssembler::add(const v1::PointChunk& chunk) {
                    " bytes; this server takes at most " + std::to_string(limits_.max_bytes));
 
   // Eigen::Vector3f is three packed floats, so the packed array unpacks straight into place.
-  if (n == 0) return grpc::Status::OK;
+  if (n == 0) return std::nullopt;
   cloud_.xyz.resize(first + n);
   wire::unpack_le<float>(xyz, cloud_.xyz[first].data());
   if (normals_) {
@@ -128,15 +132,15 @@ grpc::Status ScanAssembler::add(const v1::PointChunk& chunk) {
   }
   cloud_.width = static_cast<std::uint32_t>(cloud_.size());
   cloud_.height = 1;
-  return grpc::Status::OK;
+  return std::nullopt;
 }
 
-grpc::Status ScanAssembler::finish() const {
+std::optional<ServiceError> ScanAssembler::finish() const {
   if (cloud_.empty()) return invalid("the scan has no points");
   if (expected_points_ > 0 && cloud_.size() != expected_points_)
     return invalid("the scan has " + std::to_string(cloud_.size()) + " points but the header " +
                    "announced " + std::to_string(expected_points_));
-  return grpc::Status::OK;
+  return std::nullopt;
 }
 
 }  // namespace primlabel::server

@@ -3,14 +3,15 @@
 // that fit the point layout, the point and byte limits, the announced point count, and
 // non-finite coordinates and client normals that are zero-length (shorter than 1e-3) or
 // non-finite (counted, the point then has no normal and gets label 0; or refused when the
-// request says NON_FINITE_REJECT). Every refusal names the chunk and, for a point, the point.
-
-#include <grpcpp/support/status.h>
+// request says NON_FINITE_REJECT). Every refusal is an INVALID_ARGUMENT naming the chunk and,
+// for a point, the point.
 
 #include <cstdint>
+#include <optional>
 
 #include "primlabel/core/point_cloud.hpp"
 #include "primlabel/v1/labeling.pb.h"
+#include "service_error.hpp"
 
 namespace primlabel::server {
 
@@ -24,9 +25,9 @@ class ScanAssembler {
   ScanAssembler(const v1::ScanHeader& header, const ScanLimits& limits);
 
   // Checks and appends one chunk (chunks are numbered from 1 in messages).
-  grpc::Status add(const v1::PointChunk& chunk);
+  std::optional<ServiceError> add(const v1::PointChunk& chunk);
   // After the last chunk: at least one point, and as many as the header announced.
-  grpc::Status finish() const;
+  std::optional<ServiceError> finish() const;
 
   PointCloud& cloud() { return cloud_; }
   std::uint64_t points() const { return cloud_.size(); }
@@ -46,6 +47,6 @@ class ScanAssembler {
 };
 
 // Checks a header before any point arrives: limits against expected_points and option values.
-grpc::Status check_header(const v1::ScanHeader& header, const ScanLimits& limits);
+std::optional<ServiceError> check_header(const v1::ScanHeader& header, const ScanLimits& limits);
 
 }  // namespace primlabel::server

@@ -161,6 +161,37 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
       ->envname("PRIMLABEL_DRAIN_SECONDS")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  // Streams against slow or hostile clients.
+  app.add_option("--max-receiving-streams", config.max_receiving_streams,
+                 "Label streams receiving points at once (apart from --workers + --queue)")
+      ->envname("PRIMLABEL_MAX_RECEIVING_STREAMS")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--stream-idle-seconds", config.stream_idle_seconds,
+                 "a receiving stream without a message for this long is finished")
+      ->envname("PRIMLABEL_STREAM_IDLE_SECONDS")
+      ->check(CLI::Range(0.01, 86400.0))
+      ->capture_default_str();
+  app.add_option("--min-receive-bytes-per-second", config.min_receive_bytes_per_second,
+                 "a receiving stream slower than this over a window is finished (0: no minimum)")
+      ->envname("PRIMLABEL_MIN_RECEIVE_BYTES_PER_SECOND")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--receive-rate-window-seconds", config.receive_rate_window_seconds,
+                 "the window of --min-receive-bytes-per-second, also its grace period")
+      ->envname("PRIMLABEL_RECEIVE_RATE_WINDOW_SECONDS")
+      ->check(CLI::Range(0.01, 86400.0))
+      ->capture_default_str();
+  app.add_option("--send-timeout-seconds", config.send_timeout_seconds,
+                 "a client that takes no answer message for this long is cancelled")
+      ->envname("PRIMLABEL_SEND_TIMEOUT_SECONDS")
+      ->check(CLI::Range(0.01, 86400.0))
+      ->capture_default_str();
+  app.add_option("--max-request-seconds", config.max_request_seconds,
+                 "the deadline of a labeling request whose client sets none (or a later one)")
+      ->envname("PRIMLABEL_MAX_REQUEST_SECONDS")
+      ->check(CLI::Range(0.01, 1e7))
+      ->capture_default_str();
   app.add_option("--tls-cert", config.tls_cert, "server certificate chain (PEM): enables TLS")
       ->envname("PRIMLABEL_TLS_CERT")
       ->check(CLI::ExistingFile);

@@ -29,6 +29,14 @@ struct ServerConfig {
   std::uint64_t response_chunk_bytes = 2u << 20;  // target size of one LabelChunk
   double drain_seconds = 20.0;  // on SIGTERM/SIGINT, in-flight requests get this long
 
+  // Streams against slow or hostile clients (see label_reactor.cpp).
+  int max_receiving_streams = 64;               // streams receiving points at once
+  double stream_idle_seconds = 10.0;            // longest wait for a stream's next message
+  double min_receive_bytes_per_second = 32768;  // a receiving stream's rate over each window
+  double receive_rate_window_seconds = 5.0;     // the window, also the grace before the first
+  double send_timeout_seconds = 30.0;           // longest wait for a client to take one message
+  double max_request_seconds = 120.0;           // the deadline of a request that sets none
+
   std::string tls_cert;  // PEM; with tls_key enables TLS
   std::string tls_key;
   std::string tls_client_ca;    // PEM; requires and verifies client certificates (mutual TLS)

@@ -1,14 +1,18 @@
 #pragma once
-// What the RPC handlers share: configuration, the model registry, admission, metrics, auth and
-// whether the server is draining. Owned by LabelServer, which outlives every handler.
+// What the RPC handlers share: configuration, the model registry, admission (compute slots),
+// the receiving-stream budget, the request gauge, the timer thread, metrics, auth and whether
+// the server is draining. Owned by LabelServer, which outlives every handler.
 
 #include <atomic>
 
 #include "admission.hpp"
 #include "auth.hpp"
 #include "model_registry.hpp"
+#include "request_gauge.hpp"
 #include "server_config.hpp"
 #include "server_metrics.hpp"
+#include "slot_budget.hpp"
+#include "timer_service.hpp"
 
 namespace primlabel::server {
 
@@ -16,6 +20,9 @@ struct ServiceEnvironment {
   const ServerConfig* config = nullptr;
   ModelRegistry* registry = nullptr;
   Admission* admission = nullptr;
+  SlotBudget* receiving = nullptr;
+  RequestGauge* requests = nullptr;
+  TimerService* timers = nullptr;
   ServerMetrics* metrics = nullptr;
   const TokenAuth* auth = nullptr;
   const std::atomic<bool>* draining = nullptr;

@@ -1,9 +1,9 @@
 #pragma once
-// The server's request decoding without the transport, as server/src/label_stream.cpp does it:
+// The server's request decoding without the transport, as server/src/label_service.cpp does it:
 // check_header, then a ScanAssembler over every chunk, then finish(), stopping at the first
-// refusal. This is the only file that knows what the assembler returns: when scan_assembler.*
-// moves from grpc::Status to ServiceError, only refused() changes.
+// refusal. This is the only file that knows what the assembler returns.
 
+#include <optional>
 #include <vector>
 
 #include "primlabel/v1/labeling.pb.h"
@@ -11,7 +11,7 @@
 
 namespace primlabel::fuzz {
 
-inline bool refused(const grpc::Status& status) { return !status.ok(); }
+inline bool refused(const std::optional<server::ServiceError>& error) { return error.has_value(); }
 
 // The server's defaults (server_config.hpp: --max-points, --max-request-bytes).
 inline server::ScanLimits server_default_limits() { return {10'000'000, 512ull << 20}; }

@@ -21,6 +21,7 @@ class BadInput : public ::testing::Test {
                 [](server::ServerConfig& c) {
                   c.max_points = 50000;
                   c.insecure_admin = true;  // the reload race below needs ReloadModels
+                  c.max_receiving_streams = 3;
                 }),
         cloud_(table_with_box_cloud(0.01f)) {}
 
@@ -224,7 +225,7 @@ TEST_F(BadInput, DeadlineExceededWhileLabeling) {
 }
 
 TEST_F(BadInput, BusyServerAnswersResourceExhaustedAtHeaderTime) {
-  // Capacity is 1 worker + 2 queued: hold three streams open after their headers.
+  // The receiving budget is 3 streams: hold three streams open after their headers.
   std::vector<std::unique_ptr<grpc::ClientContext>> contexts;
   std::vector<std::unique_ptr<grpc::ClientReaderWriter<v1::LabelRequest, v1::LabelResponse>>>
       streams;

@@ -11,7 +11,6 @@
 #include <thread>
 
 #include "model_registry.hpp"
-#include "primlabel/metrics/metrics.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {
@@ -369,8 +368,8 @@ TEST(HostileInput, MegabyteNamesAndScanIdsGiveShortStatusesLogsAndNoMetricSeries
     request_lines += line.find("event=request") != std::string::npos;
   }
   EXPECT_GE(request_lines, 6) << log.substr(0, 2000);
-  const std::string metrics = metrics::http_get(
-      "127.0.0.1:" + std::to_string(server.server->metrics_port()), "/metrics", 5000);
+  const std::string metrics = scrape::fetch_text(
+      "http://127.0.0.1:" + std::to_string(server.server->metrics_port()) + "/metrics");
   EXPECT_LT(metrics.size(), 200000u);
   EXPECT_EQ(metrics.find("xxxxxxxxxx"), std::string::npos);  // no series for made-up models
 }
@@ -380,9 +379,8 @@ TEST(HostileRegistry, HealthAndGaugesFollowTheRegistryWhoeverChangesIt) {
                     [](server::ServerConfig& c) { c.unload_after_missing_polls = 1; });
   auto& registry = server.server->registry();
   auto gauge = [&] {
-    const std::string text = metrics::http_get(
-        "127.0.0.1:" + std::to_string(server.server->metrics_port()), "/metrics", 5000);
-    return metrics::sum_samples(metrics::parse_exposition(text), "primlabel_models_loaded");
+    return scrape::sum_samples(scrape_metrics(server.server->metrics_port()),
+                               "primlabel_models_loaded");
   };
   EXPECT_EQ(gauge(), 1.0);
   // Neither the poller nor an admin RPC: a scan called directly still reaches health.
