@@ -1,5 +1,7 @@
 #include "label_service.hpp"
 
+#include "free_memory.hpp"
+
 namespace primlabel::server {
 
 namespace {
@@ -24,6 +26,12 @@ ServiceError receiving_busy(const SlotBudget& budget) {
 
 LabelSession::LabelSession(const ServiceEnvironment& env, RequestRecord& record)
     : env_(env), requests_(env.requests), record_(record) {}
+
+void LabelSession::free_result() {
+  const std::uint64_t points = result_.labels.size();
+  result_ = pipeline::LabelingResult{};
+  return_free_memory(points);
+}
 
 LabelSession::~LabelSession() {
   if (counted_) requests_->add_in_flight(-1);
@@ -69,8 +77,10 @@ std::optional<ServiceError> LabelSession::run(std::function<void()> done) {
   job_ = env_.admission->submit(*ticket_, [this, threads, done = std::move(done)] {
     job_error_ = run_label_job(plan_, assembler_->cloud(), stop_.get_token(), threads, result_);
     // The compute slot and the points go as soon as the result exists, not when it is sent.
+    const std::uint64_t points = assembler_->points();
     assembler_->cloud() = PointCloud{};
     ticket_.reset();
+    return_free_memory(points);
     done();
   });
   return std::nullopt;

@@ -47,7 +47,7 @@ class LabelSession {
   // The answer's per-point arrays in bytes, from the point count and the options.
   std::uint64_t answer_bytes() const { return points() * answer_bytes_per_point(plan_); }
   const pipeline::LabelingResult& result() const { return result_; }
-  void free_result() { result_ = pipeline::LabelingResult{}; }
+  void free_result();
 
  private:
   const ServiceEnvironment& env_;
