@@ -8,6 +8,8 @@
 #include <limits>
 #include <stdexcept>
 
+#include "../parallel.hpp"
+
 namespace primlabel::tabletop {
 
 void PlaneFitOptions::validate() const {
@@ -161,25 +163,28 @@ PlaneFit fit_plane(const std::vector<Vec3f>& points, const std::vector<std::uint
       if (block[h].usable && axis && std::abs(block[h].plane.head<3>().dot(*axis)) < min_cos)
         block[h].usable = false;  // outside the allowed tilt: not even scored
     }
+    primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel for num_threads(threads) schedule(static, 1)
-    for (int h = 0; h < count; ++h) {
-      Hypothesis& hyp = block[h];
-      if (!hyp.usable) continue;
-      double cost = 0.0;
-      std::size_t inliers = 0;
-      for (const Vec3f& p : subset) {
-        const double d = signed_distance(hyp.plane, p);
-        const double sq = d * d;
-        if (sq <= sq_t) {
-          cost += sq;
-          ++inliers;
-        } else {
-          cost += sq_t;
+    for (int h = 0; h < count; ++h)
+      barrier.run([&] {
+        Hypothesis& hyp = block[h];
+        if (!hyp.usable) return;
+        double cost = 0.0;
+        std::size_t inliers = 0;
+        for (const Vec3f& p : subset) {
+          const double d = signed_distance(hyp.plane, p);
+          const double sq = d * d;
+          if (sq <= sq_t) {
+            cost += sq;
+            ++inliers;
+          } else {
+            cost += sq_t;
+          }
         }
-      }
-      hyp.cost = cost;
-      hyp.inliers = inliers;
-    }
+        hyp.cost = cost;
+        hyp.inliers = inliers;
+      });
+    barrier.rethrow();
     for (const Hypothesis& hyp : block)
       if (hyp.usable && hyp.cost < best.cost) best = hyp;
     drawn += count;
