@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "../parallel.hpp"
+#include "primlabel/core/cancellation.hpp"
 
 namespace primlabel::tabletop {
 
@@ -154,6 +155,7 @@ PlaneFit fit_plane(const std::vector<Vec3f>& points, const std::vector<std::uint
   int drawn = 0;
   std::vector<Hypothesis> block;
   while (drawn < needed && drawn < options.max_iterations) {
+    throw_if_stopped(options.stop, "fitting the table plane");
     const int count = std::min<int>(kBlock, options.max_iterations - drawn);
     block.assign(count, Hypothesis{});
     for (int h = 0; h < count; ++h) {
