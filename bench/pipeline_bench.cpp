@@ -4,8 +4,12 @@
 // one made here per sensor the way primlabel-train's calibration usually ends: node-only weights
 // trained on one training scene plus an associative coupling of 0.25 (loopy BP runs as it would).
 // Prints, never asserts; the last line is JSON. With --repeat the fastest run counts.
+// With --stop-latency N it instead stops label_cloud N times at random moments of a run on the
+// LMS400 scene and on hostile inputs (100k coincident points, 20k points in a 1 mm cube, both on
+// a small table) and prints the p50 / p99 / max time from the stop request to the return.
 //
 //   primlabel-bench-pipeline --threads 1,2 --repeat 3
+//   primlabel-bench-pipeline --stop-latency 20
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -13,8 +17,11 @@
 #include <cstdio>
 #include <limits>
 #include <optional>
+#include <random>
 #include <sstream>
+#include <stop_token>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "primlabel/pipeline/labeling.hpp"
@@ -29,6 +36,7 @@ struct Arguments {
   std::vector<std::string> sensors = {"lms400", "kinect"};
   std::vector<int> threads = {2};
   int repeat = 1;
+  int stop_latency = 0;  // > 0: stops per input
 };
 
 struct Row {
@@ -85,7 +93,104 @@ Row measure(const LabelModel& model, const PointCloud& scene, int threads, int r
   return best;
 }
 
+// A small table (2,500 points, 1 cm apart, z = 0) plus `extra`.
+PointCloud table_with(const std::vector<Vec3f>& extra) {
+  PointCloud cloud;
+  for (int i = 0; i < 50; ++i)
+    for (int j = 0; j < 50; ++j) cloud.xyz.emplace_back(i * 0.01f, j * 0.01f, 0.0f);
+  cloud.xyz.insert(cloud.xyz.end(), extra.begin(), extra.end());
+  cloud.width = static_cast<std::uint32_t>(cloud.xyz.size());
+  cloud.viewpoint.origin = Vec3f(0.25f, 0.25f, 1.0f);
+  return cloud;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Stop latencies (ms) of `stops` runs, each stopped at a uniformly random moment of a full run.
+std::vector<double> stop_latencies(const LabelModel& model, const PointCloud& input, int threads,
+                                   int stops, double& full_s) {
+  pipeline::LabelingOptions options;
+  options.threads = threads;
+  {
+    PointCloud cloud = input;
+    const auto start = std::chrono::steady_clock::now();
+    pipeline::label_cloud(model, cloud, options);
+    full_s = seconds_since(start);
+  }
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> moment(0.0, full_s);
+  std::vector<double> latencies;
+  for (int s = 0; s < stops; ++s) {
+    PointCloud cloud = input;
+    std::stop_source source;
+    options.stop = source.get_token();
+    const double at = moment(rng);
+    std::chrono::steady_clock::time_point stopped{};
+    std::jthread stopper([&] {
+      std::this_thread::sleep_for(std::chrono::duration<double>(at));
+      stopped = std::chrono::steady_clock::now();
+      source.request_stop();
+    });
+    bool cancelled = false;
+    try {
+      pipeline::label_cloud(model, cloud, options);
+    } catch (const Cancelled&) {
+      cancelled = true;
+    }
+    const auto returned = std::chrono::steady_clock::now();
+    stopper.join();
+    if (cancelled)
+      latencies.push_back(std::chrono::duration<double, std::milli>(returned - stopped).count());
+  }
+  std::sort(latencies.begin(), latencies.end());
+  return latencies;
+}
+
+int run_stop_latency(const Arguments& args) {
+  const PointCloud scene =
+      pipeline::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400);
+  const LabelModel model =
+      args.model.empty() ? quick_model(synth::SensorKind::kLms400) : load_model(args.model);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> mm(0.0f, 0.001f);
+  std::vector<Vec3f> cube(20000);
+  for (Vec3f& p : cube) p = Vec3f(0.2f + mm(rng), 0.2f + mm(rng), mm(rng));
+  const std::vector<std::pair<std::string, PointCloud>> inputs = {
+      {"lms400-scene", scene},
+      {"coincident-100k", table_with(std::vector<Vec3f>(100000, Vec3f(0.2f, 0.2f, 0.0f)))},
+      {"cube-1mm-20k", table_with(cube)}};
+  const int threads = args.threads.front();
+  std::printf("%-16s %8s %9s %6s %9s %9s %9s\n", "input", "points", "full s", "stops", "p50 ms",
+              "p99 ms", "max ms");
+  std::ostringstream json;
+  json << "{\"bench\":\"stop_latency\",\"threads\":" << threads << ",\"rows\":[";
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    double full_s = 0;
+    const auto& [name, cloud] = inputs[i];
+    const std::vector<double> ms = stop_latencies(model, cloud, threads, args.stop_latency, full_s);
+    const auto at = [&](double q) {
+      return ms.empty() ? 0.0 : ms[std::min(ms.size() - 1, std::size_t(q * double(ms.size())))];
+    };
+    std::printf("%-16s %8zu %9.3f %6zu %9.1f %9.1f %9.1f\n", name.c_str(), cloud.size(), full_s,
+                ms.size(), at(0.5), at(0.99), ms.empty() ? 0.0 : ms.back());
+    std::fflush(stdout);
+    char buffer[256];
+    std::snprintf(buffer, sizeof buffer,
+                  "%s{\"input\":\"%s\",\"points\":%zu,\"full_s\":%.3f,\"stops\":%zu,"
+                  "\"p50_ms\":%.2f,\"p99_ms\":%.2f,\"max_ms\":%.2f}",
+                  i ? "," : "", name.c_str(), cloud.size(), full_s, ms.size(), at(0.5), at(0.99),
+                  ms.empty() ? 0.0 : ms.back());
+    json << buffer;
+  }
+  json << "]}";
+  std::printf("%s\n", json.str().c_str());
+  return 0;
+}
+
 int run(const Arguments& args) {
+  if (args.stop_latency > 0) return run_stop_latency(args);
   std::optional<LabelModel> given;
   if (!args.model.empty()) given = load_model(args.model);
   std::vector<Row> rows;
@@ -141,6 +246,9 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->check(CLI::PositiveNumber);
   app.add_option("--repeat", args.repeat, "runs per case, the fastest counts (default 1)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--stop-latency", args.stop_latency,
+                 "instead: stop this many runs per input at random moments, print the latency")
       ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
   try {

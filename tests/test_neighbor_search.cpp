@@ -241,5 +241,73 @@ TEST(NeighborSearchCancellation, AStopAfterTheBuildStillAnswersRadiusQueries) {
   }
 }
 
+// Sorted (distance, index) pairs strictly within r of q, by brute force.
+std::vector<std::pair<float, std::uint32_t>> brute_within(const std::vector<Vec3f>& pts,
+                                                          const Vec3f& q, float r) {
+  std::vector<std::pair<float, std::uint32_t>> out;
+  for (std::uint32_t i = 0; i < pts.size(); ++i) {
+    const float dx = q.x() - pts[i].x(), dy = q.y() - pts[i].y(), dz = q.z() - pts[i].z();
+    const float sq = (dx * dx + dy * dy) + dz * dz;
+    if (sq < r * r) out.emplace_back(sq, i);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// A point near +-FLT_MAX makes the grid's cell count overflow int64 (it threw length_error out
+// of an OpenMP region): the k-d tree answers instead, with the same neighbours.
+TEST(NeighborSearch, FarPointsFallBackToTheTreeWithTheSameAnswers) {
+  for (const float far : {1e18f, 1e30f, std::numeric_limits<float>::max()}) {
+    std::vector<Vec3f> pts;
+    for (int i = 0; i < 40; ++i)
+      for (int j = 0; j < 40; ++j) pts.emplace_back(i * 0.01f, j * 0.01f, 0.0f);
+    pts.emplace_back(far, far, far);
+    pts.emplace_back(-far, 0.0f, -far);
+    NeighborSearch search(pts);
+    NeighborList found;
+    for (const Vec3f& q : {pts[0], pts[820], pts.back(), Vec3f(far, -far, far)}) {
+      search.find(q, Neighborhood::Radius(0.025f), found);
+      const auto expected = brute_within(pts, q, 0.025f);
+      ASSERT_EQ(found.size(), expected.size()) << far;
+      for (std::size_t k = 0; k < found.size(); ++k)
+        EXPECT_EQ(found.indices[k], expected[k].second);
+      search.find(q, Neighborhood::Hybrid(0.025f, 5), found, /*sorted=*/false);
+      EXPECT_EQ(found.size(), std::min<std::size_t>(5, expected.size()));
+    }
+  }
+}
+
+TEST(NeighborSearch, AnInfiniteRadiusIsNotAValidNeighbourhood) {
+  EXPECT_FALSE(Neighborhood::Radius(std::numeric_limits<float>::infinity()).valid());
+  EXPECT_FALSE(Neighborhood::Radius(std::numeric_limits<float>::quiet_NaN()).valid());
+  EXPECT_TRUE(Neighborhood::Radius(std::numeric_limits<float>::max()).valid());
+}
+
+// Capped radius queries return the nearest `cap` (ties by index) whether the radius is read from
+// the grid, from the tree, or overflows into the nearest search; unsorted lists hold the same set.
+TEST(NeighborSearch, CappedRadiusIsTheNearestWithinTheRadiusOnDenseClusters) {
+  std::vector<Vec3f> pts;
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j) pts.emplace_back(i * 0.01f, j * 0.01f, 0.0f);
+  for (int c = 0; c < 3000; ++c)  // a dense clump and exact copies
+    pts.emplace_back(0.1f + (c % 10) * 1e-5f, 0.1f + (c / 10 % 10) * 1e-5f, (c / 100) * 1e-5f);
+  pts.insert(pts.end(), 500, Vec3f(0.2f, 0.2f, 0.0f));
+  NeighborSearch search(pts);
+  NeighborList sorted, unsorted;
+  for (const Vec3f& q : {pts[0], pts[310], pts[1500], pts.back()}) {
+    for (const int cap : {4, 64, 1024}) {
+      const auto expected = brute_within(pts, q, 0.03f);
+      search.find(q, Neighborhood::Hybrid(0.03f, cap), sorted, /*sorted=*/true);
+      search.find(q, Neighborhood::Hybrid(0.03f, cap), unsorted, /*sorted=*/false);
+      const std::size_t n = std::min<std::size_t>(cap, expected.size());
+      ASSERT_EQ(sorted.size(), n);
+      for (std::size_t k = 0; k < n; ++k) EXPECT_EQ(sorted.sq_dists[k], expected[k].first);
+      std::vector<std::uint32_t> a = sorted.indices, b = unsorted.indices;
+      std::sort(a.begin(), a.end()), std::sort(b.begin(), b.end());
+      EXPECT_EQ(a, b) << "cap " << cap;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace primlabel

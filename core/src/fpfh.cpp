@@ -8,6 +8,7 @@
 // SPFHs are stored row-major, one contiguous 33-float row per point, so pass 2 reads each
 // neighbour's signature in one cache-friendly, vectorisable sweep.
 
+#include <algorithm>
 #include <atomic>
 #include <limits>
 
@@ -144,63 +145,65 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
   detail::assign_checked(spfh_sums, n * 3, 0.0, options.stop, "FPFH");
   NeighborCache cache(n, options.neighbor_cache_bytes);
   detail::ProgressCounter progress(options.progress, 2 * n);
-#pragma omp parallel num_threads(threads)
-  {
+  struct Pass1Scratch {
     NeighborList neighbors;
-    SpfhScratch scratch;
-#pragma omp for schedule(dynamic, 1)
-    for (std::ptrdiff_t block = 0; block < blocks; ++block) {
-      if (options.stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
-      const std::size_t first = block * kBlock, last = std::min(n, first + kBlock);
-      for (std::size_t p = first; p < last; ++p) {
-        if (!usable[p]) continue;
-        detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, sorted, neighbors);
-        cache.store(p, neighbors);
-        if (neighbors.size() < 2) continue;
-        float* row = &spfh[p * kFpfhSize];
-        compute_spfh(cloud, p, neighbors, scratch, row);
-        for (int b = 0; b < kFpfhSize; ++b) spfh_sums[3 * p + b / kBins] += row[b];
-      }
-      progress.add(last - first);
-    }
-  }
+    SpfhScratch pairs;
+  };
+  detail::for_each_block(
+      threads, blocks, options.stop, [] { return Pass1Scratch(); },
+      [&](Pass1Scratch& scratch, std::ptrdiff_t block) {
+        const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+        for (std::size_t p = first; p < last; ++p) {
+          // Per point: a stop is honoured within one (capped) neighbourhood's time.
+          if (options.stop.stop_requested()) return;
+          if (!usable[p]) continue;
+          NeighborList& neighbors = scratch.neighbors;
+          detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, sorted,
+                                   neighbors);
+          cache.store(p, neighbors);
+          if (neighbors.size() < 2) continue;
+          float* row = &spfh[p * kFpfhSize];
+          compute_spfh(cloud, p, neighbors, scratch.pairs, row);
+          for (int b = 0; b < kFpfhSize; ++b) spfh_sums[3 * p + b / kBins] += row[b];
+        }
+        progress.add(last - first);
+      });
 
   throw_if_stopped(options.stop, "FPFH");
 
   std::vector<float> fpfh;
   detail::assign_checked(fpfh, n * kFpfhSize, 0.0f, options.stop, "FPFH");
-  std::size_t computed = 0, isolated = 0;
-#pragma omp parallel num_threads(threads) reduction(+ : computed, isolated)
-  {
-    NeighborList neighbors;
-#pragma omp for schedule(dynamic, 1)
-    for (std::ptrdiff_t block = 0; block < blocks; ++block) {
-      if (options.stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
-      const std::size_t first = block * kBlock, last = std::min(n, first + kBlock);
-      for (std::size_t p = first; p < last; ++p) {
-        float* out = &fpfh[p * kFpfhSize];
-        if (!usable[p]) {
-          std::fill(out, out + kFpfhSize, std::numeric_limits<float>::quiet_NaN());
-          continue;
+  std::atomic<std::size_t> computed{0}, isolated{0};
+  detail::for_each_block(
+      threads, blocks, options.stop, [] { return NeighborList(); },
+      [&](NeighborList& neighbors, std::ptrdiff_t block) {
+        std::size_t block_computed = 0, block_isolated = 0;
+        const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+        for (std::size_t p = first; p < last; ++p) {
+          if (options.stop.stop_requested()) return;
+          float* out = &fpfh[p * kFpfhSize];
+          if (!usable[p]) {
+            std::fill(out, out + kFpfhSize, std::numeric_limits<float>::quiet_NaN());
+            continue;
+          }
+          if (!cache.load(p, neighbors))
+            detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, sorted,
+                                     neighbors);
+          if (neighbors.size() < 2) {
+            ++block_isolated;  // stays all zero, as in PCL
+            continue;
+          }
+          weight_spfh(cloud, p, spfh, spfh_sums, neighbors, out);
+          if (options.fpfh_variant == FpfhVariant::kWithOwnSpfh)
+            for (int b = 0; b < kFpfhSize; ++b) out[b] += spfh[p * kFpfhSize + b];
+          ++block_computed;
         }
-        if (!cache.load(p, neighbors))
-          detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, sorted,
-                                   neighbors);
-        if (neighbors.size() < 2) {
-          ++isolated;  // stays all zero, as in PCL
-          continue;
-        }
-        weight_spfh(cloud, p, spfh, spfh_sums, neighbors, out);
-        if (options.fpfh_variant == FpfhVariant::kWithOwnSpfh)
-          for (int b = 0; b < kFpfhSize; ++b) out[b] += spfh[p * kFpfhSize + b];
-        ++computed;
-      }
-      progress.add(last - first);
-    }
-  }
+        computed += block_computed, isolated += block_isolated;
+        progress.add(last - first);
+      });
   throw_if_stopped(options.stop, "FPFH");
   progress.finish();
-  if (stats) *stats = FeatureStats{computed, isolated, n - computed - isolated};
+  if (stats) *stats = FeatureStats{computed.load(), isolated.load(), n - computed - isolated};
   return fpfh;
 }
 

@@ -46,6 +46,9 @@ using KdTree =
 
 // Points per stop check in the serial loops over the whole cloud (~1 ms of work each).
 constexpr std::size_t kCheckEvery = std::size_t(1) << 16;
+// A capped radius query on a grid reads its cells only when they hold at most this many points
+// per allowed neighbour (a sphere fills ~1/6 of the cells' box in 3D, ~1/3 on a surface).
+constexpr std::size_t kCandidatesPerNeighbor = 8;
 // Subtrees of at most this many points are built by nanoflann in one call (a few ms each).
 constexpr std::size_t kCheckedSubtree = std::size_t(1) << 16;
 
@@ -116,6 +119,84 @@ class RadiusCollector {
   NeighborList& out_;
 };
 
+// Collects points strictly inside the radius like RadiusCollector, but gives up (and ends the
+// search) once more than `limit` are found: a capped radius query then asks for the nearest
+// instead, so a dense cluster costs O(limit), not O(cluster).
+class BoundedRadiusCollector {
+ public:
+  BoundedRadiusCollector(float sq_radius, std::size_t limit,
+                         const std::vector<std::uint32_t>& to_cloud, NeighborList& out)
+      : sq_radius_(sq_radius), limit_(limit), to_cloud_(to_cloud), out_(out) {}
+  std::size_t size() const { return out_.indices.size(); }
+  bool full() const { return true; }
+  float worstDist() const { return sq_radius_; }
+  bool addPoint(float sq_dist, std::uint32_t compact_index) {
+    if (!(sq_dist < sq_radius_)) return true;
+    if (out_.indices.size() == limit_) {
+      overflowed_ = true;
+      return false;  // nanoflann stops the whole search
+    }
+    out_.indices.push_back(to_cloud_[compact_index]);
+    out_.sq_dists.push_back(sq_dist);
+    return true;
+  }
+  bool overflowed() const { return overflowed_; }
+
+ private:
+  float sq_radius_;
+  std::size_t limit_;
+  const std::vector<std::uint32_t>& to_cloud_;
+  NeighborList& out_;
+  bool overflowed_ = false;
+};
+
+// The `capacity` nearest points closer than `bound`, exactly the set nanoflann's KNNResultSet
+// keeps (with NANOFLANN_FIRST_MATCH: ordered by distance, then index), but in a max-heap: an
+// insertion costs O(log k), not O(k), so large caps stay cheap. Once full at distance 0 nothing
+// can enter any more; worstDist() < 0 then prunes every remaining subtree, where nanoflann would
+// visit every coincident point (N^2 for N duplicates).
+class NearestSet {
+ public:
+  NearestSet(std::size_t capacity, float bound) : capacity_(capacity), bound_(bound) {
+    heap_.reserve(capacity);
+  }
+  std::size_t size() const { return heap_.size(); }
+  bool full() const { return heap_.size() == capacity_; }
+  float worstDist() const {
+    if (!full()) return bound_;
+    const float worst = heap_.front().first;
+    return worst > 0.0f ? worst : -1.0f;
+  }
+  bool addPoint(float sq_dist, std::uint32_t compact_index) {
+    const Entry entry{sq_dist, compact_index};
+    if (!full()) {
+      heap_.push_back(entry);
+      std::push_heap(heap_.begin(), heap_.end());
+    } else if (entry < heap_.front()) {
+      std::pop_heap(heap_.begin(), heap_.end());
+      heap_.back() = entry;
+      std::push_heap(heap_.begin(), heap_.end());
+    }
+    return true;
+  }
+  // Sorted by (distance, compact index), translated to cloud indices.
+  void write(const std::vector<std::uint32_t>& to_cloud, NeighborList& out) {
+    std::sort_heap(heap_.begin(), heap_.end());
+    out.indices.resize(heap_.size());
+    out.sq_dists.resize(heap_.size());
+    for (std::size_t j = 0; j < heap_.size(); ++j) {
+      out.sq_dists[j] = heap_[j].first;
+      out.indices[j] = to_cloud[heap_[j].second];
+    }
+  }
+
+ private:
+  using Entry = std::pair<float, std::uint32_t>;
+  std::size_t capacity_;
+  float bound_;
+  std::vector<Entry> heap_;
+};
+
 void sort_by_distance(NeighborList& list) {
   const std::size_t n = list.size();
   std::vector<std::uint32_t> order(n);
@@ -161,13 +242,22 @@ class RadiusGrid {
       if (stop_at(i)) return nullptr;
       lo = lo.cwiseMin(points[i]), hi = hi.cwiseMax(points[i]);
     }
+    // Cell counts in double: a far point (up to FLT_MAX) makes the float extent infinite and its
+    // cell count overflow int64. Such clouds are left to the k-d tree.
+    if (!std::isfinite(1.0f / radius)) return nullptr;
+    const double max_cells = std::min(4.0 * double(points.size()) + 4096, double(1 << 28));
     std::int64_t dims[3];
     double cells = 1;
     for (int d = 0; d < 3; ++d) {
-      dims[d] = static_cast<std::int64_t>(std::floor((hi[d] - lo[d]) / radius)) + 1;
+      const double extent = (double(hi[d]) - double(lo[d])) / double(radius);
+      if (!(extent < max_cells)) return nullptr;  // also NaN
+      // The float quotient, as before, whenever it is finite: the same cells, so the same order.
+      const float quotient = (hi[d] - lo[d]) / radius;
+      const double span = std::isfinite(quotient) ? std::floor(quotient) : std::floor(extent);
+      dims[d] = static_cast<std::int64_t>(std::min(span, max_cells)) + 1;
       cells *= double(dims[d]);
     }
-    if (cells > 4.0 * double(points.size()) + 4096 || cells > double(1 << 28)) return nullptr;
+    if (cells > max_cells) return nullptr;
 
     auto grid = std::unique_ptr<RadiusGrid>(new RadiusGrid);
     grid->origin_ = lo;
@@ -194,13 +284,30 @@ class RadiusGrid {
     return grid;
   }
 
-  void find(const Vec3f& q, float sq_radius, float radius, NeighborList& out) const {
-    std::int64_t lo[3], hi[3];
+  // The cells a query of this radius reads, as [lo, hi] per axis; false when there are none.
+  bool cell_range(const Vec3f& q, float radius, std::int64_t lo[3], std::int64_t hi[3]) const {
     for (int d = 0; d < 3; ++d) {
       lo[d] = std::max<std::int64_t>(0, cell_coord(q[d] - radius, d));
       hi[d] = std::min<std::int64_t>(dims_[d] - 1, cell_coord(q[d] + radius, d));
-      if (lo[d] > hi[d]) return;
+      if (lo[d] > hi[d]) return false;
     }
+    return true;
+  }
+
+  // How many points the query would compare (its <= 9 runs), without reading them.
+  std::size_t candidates(const Vec3f& q, float radius) const {
+    std::int64_t lo[3], hi[3];
+    if (!cell_range(q, radius, lo, hi)) return 0;
+    std::size_t total = 0;
+    for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+      for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+        total += starts_[cell_index({hi[0], y, z}) + 1] - starts_[cell_index({lo[0], y, z})];
+    return total;
+  }
+
+  void find(const Vec3f& q, float sq_radius, float radius, NeighborList& out) const {
+    std::int64_t lo[3], hi[3];
+    if (!cell_range(q, radius, lo, hi)) return;
     for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
       for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
         const std::size_t first = starts_[cell_index({lo[0], y, z})];
@@ -225,13 +332,18 @@ class RadiusGrid {
 
  private:
   RadiusGrid() = default;
+  // Clamped to [-1, dims] before the conversion: a query far outside the grid (or one whose
+  // float offset overflows) must not convert an out-of-range or NaN value to an integer.
   std::int64_t cell_coord(float v, int d) const {
-    return static_cast<std::int64_t>(std::floor((v - origin_[d]) * inv_cell_));
+    const float c = std::floor((v - origin_[d]) * inv_cell_);
+    if (!(c >= -1.0f)) return -1;
+    if (!(c <= float(dims_[d]))) return dims_[d];
+    return static_cast<std::int64_t>(c);
   }
   std::array<std::int64_t, 3> cell_coords(const Vec3f& p) const {
-    return {std::min(cell_coord(p.x(), 0), dims_[0] - 1),
-            std::min(cell_coord(p.y(), 1), dims_[1] - 1),
-            std::min(cell_coord(p.z(), 2), dims_[2] - 1)};
+    return {std::clamp<std::int64_t>(cell_coord(p.x(), 0), 0, dims_[0] - 1),
+            std::clamp<std::int64_t>(cell_coord(p.y(), 1), 0, dims_[1] - 1),
+            std::clamp<std::int64_t>(cell_coord(p.z(), 2), 0, dims_[2] - 1)};
   }
   std::size_t cell_index(const std::array<std::int64_t, 3>& c) const {
     return static_cast<std::size_t>((c[2] * dims_[1] + c[1]) * dims_[0] + c[0]);
@@ -302,35 +414,56 @@ void NeighborSearch::find(const Vec3f& query, const Neighborhood& hood, Neighbor
   if (!is_finite(query) || impl_->compact.points.empty()) return;
   if (!hood.valid()) throw std::invalid_argument("invalid neighbourhood: " + hood.describe());
 
-  const bool knn_like = hood.k > 0 || hood.max_neighbors > 0;
-  if (!knn_like) {
+  if (hood.k > 0) {
+    nearest(query, std::min<std::size_t>(hood.k, impl_->compact.points.size()),
+            std::numeric_limits<float>::max(), out);
+    return;
+  }
+  const float sq_radius = hood.radius * hood.radius;
+  if (hood.max_neighbors == 0) {
     if (const RadiusGrid* grid = impl_->grid_for(hood.radius)) {
-      grid->find(query, hood.radius * hood.radius, hood.radius, out);
+      grid->find(query, sq_radius, hood.radius, out);
       if (sorted) sort_by_distance(out);
       return;
     }
-    RadiusCollector collector(hood.radius * hood.radius, impl_->to_cloud, out);
+    RadiusCollector collector(sq_radius, impl_->to_cloud, out);
     impl_->tree->findNeighbors(collector, query.data(), nanoflann::SearchParams(32, 0.0f, false));
     if (sorted) sort_by_distance(out);
     return;
   }
 
-  // k-nearest, or hybrid: the nearest max_neighbors, pruned at the radius from the start.
-  const std::size_t capacity =
-      std::min<std::size_t>(hood.k > 0 ? hood.k : hood.max_neighbors, impl_->compact.points.size());
-  out.indices.resize(capacity);
-  out.sq_dists.resize(capacity);
-  nanoflann::KNNResultSet<float, std::uint32_t> result(capacity);
-  result.init(out.indices.data(), out.sq_dists.data());
-  const float sq_radius = hood.radius * hood.radius;
-  if (hood.radius > 0.0f) out.sq_dists[capacity - 1] = sq_radius;
+  // Hybrid: the nearest max_neighbors within the radius. An unsorted query first tries the
+  // plain radius search, bounded so that it never reads more than a few times the cap; when the
+  // radius holds no more than the cap its answer is the same set (and, unsorted, the same list
+  // the uncapped radius search gives). Otherwise, or sorted, the nearest set answers.
+  const std::size_t cap = static_cast<std::size_t>(hood.max_neighbors);
+  if (!sorted) {
+    if (const RadiusGrid* grid = impl_->grid_for(hood.radius)) {
+      if (grid->candidates(query, hood.radius) <= kCandidatesPerNeighbor * cap) {
+        grid->find(query, sq_radius, hood.radius, out);
+        if (out.size() <= cap) return;
+        out.clear();
+      }
+    } else {
+      BoundedRadiusCollector collector(sq_radius, cap, impl_->to_cloud, out);
+      impl_->tree->findNeighbors(collector, query.data(), nanoflann::SearchParams(32, 0.0f, false));
+      if (!collector.overflowed()) return;
+      out.clear();
+    }
+  }
+  nearest(query, std::min(cap, impl_->compact.points.size()), sq_radius, out);
+}
+
+void NeighborSearch::nearest(const Vec3f& query, std::size_t capacity, float sq_bound,
+                             NeighborList& out) const {
+  NearestSet result(capacity, sq_bound);
   impl_->tree->findNeighbors(result, query.data(), nanoflann::SearchParams());
-  std::size_t found = result.size();
-  if (hood.radius > 0.0f)
-    while (found > 0 && !(out.sq_dists[found - 1] < sq_radius)) --found;
+  result.write(impl_->to_cloud, out);
+  // Points exactly at the bound are outside a radius ("strictly inside").
+  std::size_t found = out.size();
+  while (found > 0 && !(out.sq_dists[found - 1] < sq_bound)) --found;
   out.indices.resize(found);
   out.sq_dists.resize(found);
-  for (auto& index : out.indices) index = impl_->to_cloud[index];
 }
 
 }  // namespace primlabel

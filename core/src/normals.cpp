@@ -1,6 +1,8 @@
 #include "primlabel/core/normals.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <atomic>
 #include <limits>
 #include <stdexcept>
 
@@ -68,42 +70,44 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
                          "normal estimation");
   detail::assign_checked(cloud.curvature, n, kNaN, options.stop, "normal estimation");
 
-  std::size_t estimated = 0, too_few = 0, invalid_input = 0;
+  std::atomic<std::size_t> estimated{0}, too_few{0}, invalid_input{0};
   detail::ProgressCounter progress(options.progress, n);
   const int threads = detail::resolve_threads(options.threads);
-  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(n);
-
-#pragma omp parallel num_threads(threads) reduction(+ : estimated, too_few, invalid_input)
-  {
-    NeighborList neighbors;
-    bool stopped = false;  // per thread: once cancelled, the remaining points are skipped
-#pragma omp for schedule(dynamic, 512)
-    for (std::ptrdiff_t i = 0; i < count; ++i) {
-      if ((i & 255) == 0) stopped = stopped || options.stop.stop_requested();
-      if (stopped) continue;
-      const Vec3f& p = cloud.xyz[i];
-      if (!is_finite(p)) {
-        ++invalid_input;
-      } else {
-        search->find(p, options.neighborhood, neighbors, /*sorted=*/false);
-        Vec3f normal;
-        float curvature;
-        if (fit_normal(cloud.xyz, p, neighbors, normal, curvature)) {
-          // Face the sensor, as PCL's flipNormalTowardsViewpoint does.
-          if ((viewpoint - p).dot(normal) < 0.0f) normal = -normal;
-          cloud.normals[i] = normal;
-          cloud.curvature[i] = curvature;
-          ++estimated;
-        } else {
-          ++too_few;
+  constexpr std::size_t kBlock = 256;
+  const auto blocks = static_cast<std::ptrdiff_t>((n + kBlock - 1) / kBlock);
+  const auto make_scratch = [] { return NeighborList(); };
+  detail::for_each_block(
+      threads, blocks, options.stop, make_scratch,
+      [&](NeighborList& neighbors, std::ptrdiff_t block) {
+        std::size_t block_estimated = 0, block_too_few = 0, block_invalid = 0;
+        const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+        for (std::size_t i = first; i < last; ++i) {
+          // Checked per point: a stop is then honoured within one (capped) neighbourhood's time.
+          if (options.stop.stop_requested()) return;
+          const Vec3f& p = cloud.xyz[i];
+          if (!is_finite(p)) {
+            ++block_invalid;
+            continue;
+          }
+          search->find(p, options.neighborhood, neighbors, /*sorted=*/false);
+          Vec3f normal;
+          float curvature;
+          if (fit_normal(cloud.xyz, p, neighbors, normal, curvature)) {
+            // Face the sensor, as PCL's flipNormalTowardsViewpoint does.
+            if ((viewpoint - p).dot(normal) < 0.0f) normal = -normal;
+            cloud.normals[i] = normal;
+            cloud.curvature[i] = curvature;
+            ++block_estimated;
+          } else {
+            ++block_too_few;
+          }
         }
-      }
-      if ((i & 255) == 255) progress.add(256);
-    }
-  }
+        estimated += block_estimated, too_few += block_too_few, invalid_input += block_invalid;
+        progress.add(last - first);
+      });
   throw_if_stopped(options.stop, "normal estimation");
   progress.finish();
-  return NormalStats{estimated, too_few, invalid_input};
+  return NormalStats{estimated.load(), too_few.load(), invalid_input.load()};
 }
 
 }  // namespace primlabel

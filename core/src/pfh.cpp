@@ -3,6 +3,8 @@
 // 5 x 5 x 5 bins indexed by (alpha, phi, theta). O(k^2) per point: kept for the paper's
 // comparison with FPFH.
 
+#include <algorithm>
+#include <atomic>
 #include <limits>
 
 #include "feature_neighborhood.hpp"
@@ -54,40 +56,46 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
   const NeighborSearch& index = detail::ensure_search(cloud, search, owned, options.stop);
 
   const std::size_t n = cloud.size();
-  const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(n);
   std::vector<float> pfh;
   detail::assign_checked(pfh, n * kPfhSize, 0.0f, options.stop, "PFH");
-  std::size_t computed = 0, isolated = 0;
+  std::atomic<std::size_t> computed{0}, isolated{0};
   detail::ProgressCounter progress(options.progress, n);
-#pragma omp parallel num_threads(detail::resolve_threads(options.threads)) \
-    reduction(+ : computed, isolated)
-  {
+  constexpr std::size_t kBlock = 64;
+  const auto blocks = static_cast<std::ptrdiff_t>((n + kBlock - 1) / kBlock);
+  struct Scratch {
     NeighborList neighbors;
-    PfhScratch scratch;
-    bool stopped = false;  // per thread: once cancelled, the remaining points are skipped
-#pragma omp for schedule(dynamic, 64)
-    for (std::ptrdiff_t p = 0; p < count; ++p) {
-      if ((p & 63) == 0) stopped = stopped || options.stop.stop_requested();
-      if (stopped) continue;
-      float* out = &pfh[p * kPfhSize];
-      if (!usable[p]) {
-        std::fill(out, out + kPfhSize, std::numeric_limits<float>::quiet_NaN());
-      } else {
-        // Pair order decides which point is "first" only in exact ties; sorted lists match PCL's.
-        detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, true, neighbors);
-        if (neighbors.size() >= 2) {
-          compute_point_pfh(cloud, neighbors, scratch, out);
-          ++computed;
-        } else {
-          ++isolated;  // stays all zero
+    PfhScratch pairs;
+  };
+  const auto make_scratch = [] { return Scratch(); };
+  detail::for_each_block(
+      detail::resolve_threads(options.threads), blocks, options.stop, make_scratch,
+      [&](Scratch& scratch, std::ptrdiff_t block) {
+        std::size_t block_computed = 0, block_isolated = 0;
+        const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+        for (std::size_t p = first; p < last; ++p) {
+          if (options.stop.stop_requested()) return;  // per point: O(k^2) each
+          float* out = &pfh[p * kPfhSize];
+          if (!usable[p]) {
+            std::fill(out, out + kPfhSize, std::numeric_limits<float>::quiet_NaN());
+            continue;
+          }
+          // Pair order decides which point is "first" only in exact ties; sorted lists match
+          // PCL's.
+          detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, true,
+                                   scratch.neighbors);
+          if (scratch.neighbors.size() >= 2) {
+            compute_point_pfh(cloud, scratch.neighbors, scratch.pairs, out);
+            ++block_computed;
+          } else {
+            ++block_isolated;  // stays all zero
+          }
         }
-      }
-      if ((p & 63) == 63) progress.add(64);
-    }
-  }
+        computed += block_computed, isolated += block_isolated;
+        progress.add(last - first);
+      });
   throw_if_stopped(options.stop, "PFH");
   progress.finish();
-  if (stats) *stats = FeatureStats{computed, isolated, n - computed - isolated};
+  if (stats) *stats = FeatureStats{computed.load(), isolated.load(), n - computed - isolated};
   return pfh;
 }
 

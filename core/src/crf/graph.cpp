@@ -107,18 +107,21 @@ Graph assemble_symmetric(const BlockLists& lists, std::vector<std::uint8_t> acti
   // The parallel passes skip the rest of their chunk (1024 rows, starting at a multiple of
   // 1024) once stopped, and throw after the region.
   const auto skip = [&stop](long long i) { return i % 1024 == 0 && stop.stop_requested(); };
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(threads)
   {
     bool stopped = false;
 #pragma omp for schedule(dynamic, 1024)
-    for (long long i = 0; i < nn; ++i) {
-      if (stopped || (stopped = skip(i))) continue;
-      auto first = raw.begin() + bound[i];
-      auto last = raw.begin() + bound[i + 1];
-      std::sort(first, last);
-      unique_count[i] = static_cast<std::uint32_t>(std::unique(first, last) - first);
-    }
+    for (long long i = 0; i < nn; ++i)
+      barrier.run([&] {
+        if (stopped || (stopped = skip(i))) return;
+        auto first = raw.begin() + bound[i];
+        auto last = raw.begin() + bound[i + 1];
+        std::sort(first, last);
+        unique_count[i] = static_cast<std::uint32_t>(std::unique(first, last) - first);
+      });
   }
+  barrier.rethrow();
   throw_if_stopped(stop, kWhat);
 
   g.offsets.assign(n + 1, 0);
@@ -127,26 +130,30 @@ Graph assemble_symmetric(const BlockLists& lists, std::vector<std::uint8_t> acti
   g.reverse.resize(g.offsets[n]);
   throw_if_stopped(stop, kWhat);
 #pragma omp parallel for schedule(dynamic, 1024) num_threads(threads)
-  for (long long i = 0; i < nn; ++i) {
-    std::copy_n(raw.begin() + bound[i], unique_count[i], g.neighbors.begin() + g.offsets[i]);
-  }
+  for (long long i = 0; i < nn; ++i)
+    barrier.run([&] {
+      std::copy_n(raw.begin() + bound[i], unique_count[i], g.neighbors.begin() + g.offsets[i]);
+    });
+  barrier.rethrow();
   throw_if_stopped(stop, kWhat);
 #pragma omp parallel num_threads(threads)
   {
     bool stopped = false;
 #pragma omp for schedule(dynamic, 1024)
-    for (long long i = 0; i < nn; ++i) {
-      if (stopped || (stopped = skip(i))) continue;
-      for (std::uint32_t p = g.offsets[i]; p < g.offsets[i + 1]; ++p) {
-        const std::uint32_t j = g.neighbors[p];
-        const auto row_begin = g.neighbors.begin() + g.offsets[j];
-        const auto row_end = g.neighbors.begin() + g.offsets[j + 1];
-        g.reverse[p] = static_cast<std::uint32_t>(
-            std::lower_bound(row_begin, row_end, static_cast<std::uint32_t>(i)) -
-            g.neighbors.begin());
-      }
-    }
+    for (long long i = 0; i < nn; ++i)
+      barrier.run([&] {
+        if (stopped || (stopped = skip(i))) return;
+        for (std::uint32_t p = g.offsets[i]; p < g.offsets[i + 1]; ++p) {
+          const std::uint32_t j = g.neighbors[p];
+          const auto row_begin = g.neighbors.begin() + g.offsets[j];
+          const auto row_end = g.neighbors.begin() + g.offsets[j + 1];
+          g.reverse[p] = static_cast<std::uint32_t>(
+              std::lower_bound(row_begin, row_end, static_cast<std::uint32_t>(i)) -
+              g.neighbors.begin());
+        }
+      });
   }
+  barrier.rethrow();
   throw_if_stopped(stop, kWhat);
   return g;
 }
@@ -232,29 +239,26 @@ Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descr
   const Neighborhood query = query_with_self(options.neighborhood);
   const int cap = neighbor_cap(options.neighborhood);
   BlockLists lists(n);
-  const long long blocks = static_cast<long long>(lists.num_blocks());
-#pragma omp parallel num_threads(threads)
-  {
-    NeighborList found;
-#pragma omp for schedule(dynamic, 1)
-    for (long long b = 0; b < blocks; ++b) {
-      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
-      lists.begin_block(b);
-      const std::size_t last = std::min(n, std::size_t(b + 1) * BlockLists::kListBlock);
-      for (std::size_t i = b * BlockLists::kListBlock; i < last; ++i) {
-        if (active[i]) {
-          index->find(points[i], query, found, /*sorted=*/cap >= 0);
-          for (std::uint32_t f : found.indices) {
-            const std::uint32_t j = to_point(f);
-            if (j == static_cast<std::uint32_t>(i)) continue;
-            if (cap >= 0 && static_cast<int>(lists.list_size(b)) >= cap) break;
-            lists.push_back(b, j);
+  const auto blocks = static_cast<std::ptrdiff_t>(lists.num_blocks());
+  primlabel::detail::for_each_block(
+      threads, blocks, stop, [] { return NeighborList(); },
+      [&](NeighborList& found, std::ptrdiff_t b) {
+        lists.begin_block(b);
+        const std::size_t last = std::min(n, std::size_t(b + 1) * BlockLists::kListBlock);
+        for (std::size_t i = b * BlockLists::kListBlock; i < last; ++i) {
+          if (stop.stop_requested()) return;  // per node: within one neighbourhood's time
+          if (active[i]) {
+            index->find(points[i], query, found, /*sorted=*/cap >= 0);
+            for (std::uint32_t f : found.indices) {
+              const std::uint32_t j = to_point(f);
+              if (j == static_cast<std::uint32_t>(i)) continue;
+              if (cap >= 0 && static_cast<int>(lists.list_size(b)) >= cap) break;
+              lists.push_back(b, j);
+            }
           }
+          lists.end_node(b);
         }
-        lists.end_node(b);
-      }
-    }
-  }
+      });
   throw_if_stopped(stop, kWhat);
   return assemble_symmetric(lists, std::move(active), threads, stop);
 }

@@ -45,31 +45,34 @@ void outputs_from_rows(const float* rows, bool log_scores, const CrfModel& model
   const int k_count = model.num_classes();
   const int kp = detail::padded_classes(k_count);
   float* marginals = options.compute_marginals ? result.marginals.data() : nullptr;
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(threads)
   {
     std::vector<double> p(k_count);
 #pragma omp for schedule(static)
-    for (long long i = 0; i < n; ++i) {
-      if (!graph.active[i]) {
-        result.labels[i] = options.unknown_label;
-        if (marginals)
-          for (int k = 0; k < k_count; ++k)
-            marginals[std::size_t(k) * n + i] = std::numeric_limits<float>::quiet_NaN();
-        continue;
-      }
-      const float* row = rows + std::size_t(i) * kp;
-      int best = 0;  // first maximum: ties go to the lower class index
-      for (int k = 1; k < k_count; ++k)
-        if (row[k] > row[best]) best = k;
-      result.labels[i] = model.class_ids[best];
-      if (!marginals) continue;
-      double sum = 0.0;
-      for (int k = 0; k < k_count; ++k)
-        sum += (p[k] = log_scores ? std::exp(double(row[k]) - row[best]) : double(row[k]));
-      for (int k = 0; k < k_count; ++k)
-        marginals[std::size_t(k) * n + i] = static_cast<float>(p[k] / sum);
-    }
+    for (long long i = 0; i < n; ++i)
+      barrier.run([&] {
+        if (!graph.active[i]) {
+          result.labels[i] = options.unknown_label;
+          if (marginals)
+            for (int k = 0; k < k_count; ++k)
+              marginals[std::size_t(k) * n + i] = std::numeric_limits<float>::quiet_NaN();
+          return;
+        }
+        const float* row = rows + std::size_t(i) * kp;
+        int best = 0;  // first maximum: ties go to the lower class index
+        for (int k = 1; k < k_count; ++k)
+          if (row[k] > row[best]) best = k;
+        result.labels[i] = model.class_ids[best];
+        if (!marginals) return;
+        double sum = 0.0;
+        for (int k = 0; k < k_count; ++k)
+          sum += (p[k] = log_scores ? std::exp(double(row[k]) - row[best]) : double(row[k]));
+        for (int k = 0; k < k_count; ++k)
+          marginals[std::size_t(k) * n + i] = static_cast<float>(p[k] / sum);
+      });
   }
+  barrier.rethrow();
 }
 
 // phi_i(k) = exp(theta_i(k) - max_k theta_i(k)), pads 0.
@@ -77,13 +80,16 @@ void node_potentials_padded(const float* theta, std::size_t n, int k_count, int 
                             float* phi) {
   const int kp = detail::padded_classes(k_count);
   const long long count = static_cast<long long>(n);
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel for schedule(static) num_threads(threads)
-  for (long long i = 0; i < count; ++i) {
-    const Eigen::Map<const Eigen::ArrayXf> t(theta + i * kp, k_count);
-    Eigen::Map<Eigen::ArrayXf> out(phi + i * kp, kp);
-    out.head(k_count) = (t - t.maxCoeff()).exp();
-    out.tail(kp - k_count).setZero();
-  }
+  for (long long i = 0; i < count; ++i)
+    barrier.run([&] {
+      const Eigen::Map<const Eigen::ArrayXf> t(theta + i * kp, k_count);
+      Eigen::Map<Eigen::ArrayXf> out(phi + i * kp, kp);
+      out.head(k_count) = (t - t.maxCoeff()).exp();
+      out.tail(kp - k_count).setZero();
+    });
+  barrier.rethrow();
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "../parallel.hpp"
+
 namespace primlabel::crf::detail {
 namespace {
 
@@ -43,11 +45,14 @@ void node_product(const Graph& graph, std::size_t i, const double* phi_row, cons
 RowMatrixXd node_potentials(const RowMatrixXf& node_scores, int threads) {
   RowMatrixXd phi(node_scores.rows(), node_scores.cols());
   const long long n = node_scores.rows();
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel for schedule(static) num_threads(threads)
-  for (long long i = 0; i < n; ++i) {
-    const float mx = node_scores.row(i).maxCoeff();
-    phi.row(i) = (node_scores.row(i).array() - mx).cast<double>().exp();
-  }
+  for (long long i = 0; i < n; ++i)
+    barrier.run([&] {
+      const float mx = node_scores.row(i).maxCoeff();
+      phi.row(i) = (node_scores.row(i).array() - mx).cast<double>().exp();
+    });
+  barrier.rethrow();
   return phi;
 }
 
@@ -56,13 +61,16 @@ void edge_scores_to_potentials_minus_one(RowMatrixXf& edge_scores, int threads) 
   constexpr Eigen::Index kChunk = 1 << 14;
   const Eigen::Index total = edge_scores.size();
   const long long chunks = static_cast<long long>((total + kChunk - 1) / kChunk);
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel for schedule(static) num_threads(threads)
-  for (long long c = 0; c < chunks; ++c) {
-    const Eigen::Index first = c * kChunk;
-    const Eigen::Index count = std::min(kChunk, total - first);
-    Eigen::Map<Eigen::ArrayXf> chunk(edge_scores.data() + first, count);
-    chunk = chunk.min(kMaxEdgeScore).exp() - 1.0f;
-  }
+  for (long long c = 0; c < chunks; ++c)
+    barrier.run([&] {
+      const Eigen::Index first = c * kChunk;
+      const Eigen::Index count = std::min(kChunk, total - first);
+      Eigen::Map<Eigen::ArrayXf> chunk(edge_scores.data() + first, count);
+      chunk = chunk.min(kMaxEdgeScore).exp() - 1.0f;
+    });
+  barrier.rethrow();
 }
 
 LoopyBp::LoopyBp(const Graph& graph, int num_classes)
@@ -169,16 +177,19 @@ template <int KC>
 float update_all(const UpdateContext& c, int k_count, int threads) {
   const long long n = static_cast<long long>(c.graph.num_nodes());
   float max_change = 0.0f;
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(threads) reduction(max : max_change)
   {
     FlushSubnormals flush;
     NodeUpdater<KC> updater(k_count);
 #pragma omp for schedule(dynamic, 512)
-    for (long long i = 0; i < n; ++i) {
-      if (c.graph.offsets[i] == c.graph.offsets[i + 1]) continue;
-      max_change = std::max(max_change, updater.update(c, i));
-    }
+    for (long long i = 0; i < n; ++i)
+      barrier.run([&] {
+        if (c.graph.offsets[i] == c.graph.offsets[i + 1]) return;
+        max_change = std::max(max_change, updater.update(c, i));
+      });
   }
+  barrier.rethrow();
   return max_change;
 }
 
@@ -235,19 +246,22 @@ RowMatrixXd LoopyBp::beliefs(const RowMatrixXd& phi, int threads) const {
   const int k_count = num_classes_;
   const long long n = static_cast<long long>(graph_.num_nodes());
   RowMatrixXd out = RowMatrixXd::Zero(n, k_count);
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel for schedule(dynamic, 512) num_threads(threads)
-  for (long long i = 0; i < n; ++i) {
-    if (!graph_.active[i]) continue;
-    double* b = out.row(i).data();
-    node_product(graph_, i, phi.row(i).data(), messages_.data(), k_count, b);
-    double sum = 0.0;
-    for (int k = 0; k < k_count; ++k) sum += b[k];
-    if (sum > 0.0 && std::isfinite(sum)) {
-      for (int k = 0; k < k_count; ++k) b[k] /= sum;
-    } else {
-      for (int k = 0; k < k_count; ++k) b[k] = 1.0 / k_count;
-    }
-  }
+  for (long long i = 0; i < n; ++i)
+    barrier.run([&] {
+      if (!graph_.active[i]) return;
+      double* b = out.row(i).data();
+      node_product(graph_, i, phi.row(i).data(), messages_.data(), k_count, b);
+      double sum = 0.0;
+      for (int k = 0; k < k_count; ++k) sum += b[k];
+      if (sum > 0.0 && std::isfinite(sum)) {
+        for (int k = 0; k < k_count; ++k) b[k] /= sum;
+      } else {
+        for (int k = 0; k < k_count; ++k) b[k] = 1.0 / k_count;
+      }
+    });
+  barrier.rethrow();
   return out;
 }
 
@@ -402,40 +416,43 @@ float fast_update_all(const FastIteration& it, int threads) {
   const long long n = static_cast<long long>(g.num_nodes());
   const int kp = padded_classes(it.pr.classes);
   float max_change = 0.0f;
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(threads) reduction(max : max_change)
   {
     FlushSubnormals flush;
     FastNodeUpdater<KP> updater(it.pr.classes, kp);
     bool stopped = false;  // per thread: once cancelled, the remaining nodes are skipped
 #pragma omp for schedule(dynamic, 1024)
-    for (long long i = 0; i < n; ++i) {
-      if ((i & 1023) == 0) stopped = stopped || it.stop.stop_requested();
-      if (stopped) continue;
-      const std::uint32_t begin = g.offsets[i], end = g.offsets[i + 1];
-      if (begin == end) continue;
-      // A node whose messages and inputs all settled (moved < tolerance last iteration) would
-      // only repeat itself: skip it. Decided from the previous iteration alone, so the result
-      // still does not depend on the thread count.
-      bool needed = it.first || it.moved_before[i];
-      for (std::uint32_t p = begin; !needed && p < end; ++p)
-        needed = it.moved_before[g.neighbors[p]] != 0;
-      if (!needed) {
-        if (!it.same[i]) {
-          std::copy(it.old + std::size_t(begin) * kp, it.old + std::size_t(end) * kp,
-                    it.next + std::size_t(begin) * kp);
-          it.same[i] = 1;
+    for (long long i = 0; i < n; ++i)
+      barrier.run([&] {
+        if ((i & 1023) == 0) stopped = stopped || it.stop.stop_requested();
+        if (stopped) return;
+        const std::uint32_t begin = g.offsets[i], end = g.offsets[i + 1];
+        if (begin == end) return;
+        // A node whose messages and inputs all settled (moved < tolerance last iteration) would
+        // only repeat itself: skip it. Decided from the previous iteration alone, so the result
+        // still does not depend on the thread count.
+        bool needed = it.first || it.moved_before[i];
+        for (std::uint32_t p = begin; !needed && p < end; ++p)
+          needed = it.moved_before[g.neighbors[p]] != 0;
+        if (!needed) {
+          if (!it.same[i]) {
+            std::copy(it.old + std::size_t(begin) * kp, it.old + std::size_t(end) * kp,
+                      it.next + std::size_t(begin) * kp);
+            it.same[i] = 1;
+          }
+          it.moved[i] = 0;
+          return;
         }
-        it.moved[i] = 0;
-        continue;
-      }
-      it.same[i] = 0;
-      float message_change = 0.0f;
-      const float change = updater.update(message_change, g, it.pr, it.old, it.next, it.beliefs,
-                                          it.first, it.keep, it.max_product, i);
-      it.moved[i] = message_change >= it.tolerance;
-      max_change = std::max(max_change, change);
-    }
+        it.same[i] = 0;
+        float message_change = 0.0f;
+        const float change = updater.update(message_change, g, it.pr, it.old, it.next, it.beliefs,
+                                            it.first, it.keep, it.max_product, i);
+        it.moved[i] = message_change >= it.tolerance;
+        max_change = std::max(max_change, change);
+      });
   }
+  barrier.rethrow();
   return max_change;
 }
 
@@ -509,42 +526,45 @@ void fast_bp_outputs(const FastBpProblem& problem, const FastBpBuffers& buffers,
   const int kp = padded_classes(k_count);
   const long long n = static_cast<long long>(g.num_nodes());
   const float* messages = buffers.messages.data();
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(threads)
   {
     FlushSubnormals flush;
     std::vector<double> b(kp);
 #pragma omp for schedule(dynamic, 1024)
-    for (long long i = 0; i < n; ++i) {
-      if (!g.active[i]) {
-        labels[i] = unknown_label;
-        if (marginals)
-          for (int k = 0; k < k_count; ++k)
-            marginals[std::size_t(k) * n + i] = std::numeric_limits<float>::quiet_NaN();
-        continue;
-      }
-      for (int k = 0; k < kp; ++k) b[k] = problem.phi[std::size_t(i) * kp + k];
-      int since_rescale = 0;
-      for (std::uint32_t q = g.offsets[i]; q < g.offsets[i + 1]; ++q) {
-        const float* in = messages + std::size_t(g.reverse[q]) * kp;
-        for (int k = 0; k < kp; ++k) b[k] *= in[k];
-        if (++since_rescale == kRescaleEvery) {
-          scale_to_max_one(b.data(), kp);
-          since_rescale = 0;
+    for (long long i = 0; i < n; ++i)
+      barrier.run([&] {
+        if (!g.active[i]) {
+          labels[i] = unknown_label;
+          if (marginals)
+            for (int k = 0; k < k_count; ++k)
+              marginals[std::size_t(k) * n + i] = std::numeric_limits<float>::quiet_NaN();
+          return;
         }
-      }
-      int best = 0;  // first maximum: ties go to the lower class index
-      for (int k = 1; k < k_count; ++k)
-        if (b[k] > b[best]) best = k;
-      labels[i] = class_ids[best];
-      if (marginals) {
-        double sum = 0.0;
-        for (int k = 0; k < k_count; ++k) sum += b[k];
-        const bool ok = sum > 0.0 && std::isfinite(sum);
-        for (int k = 0; k < k_count; ++k)
-          marginals[std::size_t(k) * n + i] = static_cast<float>(ok ? b[k] / sum : 1.0 / k_count);
-      }
-    }
+        for (int k = 0; k < kp; ++k) b[k] = problem.phi[std::size_t(i) * kp + k];
+        int since_rescale = 0;
+        for (std::uint32_t q = g.offsets[i]; q < g.offsets[i + 1]; ++q) {
+          const float* in = messages + std::size_t(g.reverse[q]) * kp;
+          for (int k = 0; k < kp; ++k) b[k] *= in[k];
+          if (++since_rescale == kRescaleEvery) {
+            scale_to_max_one(b.data(), kp);
+            since_rescale = 0;
+          }
+        }
+        int best = 0;  // first maximum: ties go to the lower class index
+        for (int k = 1; k < k_count; ++k)
+          if (b[k] > b[best]) best = k;
+        labels[i] = class_ids[best];
+        if (marginals) {
+          double sum = 0.0;
+          for (int k = 0; k < k_count; ++k) sum += b[k];
+          const bool ok = sum > 0.0 && std::isfinite(sum);
+          for (int k = 0; k < k_count; ++k)
+            marginals[std::size_t(k) * n + i] = static_cast<float>(ok ? b[k] / sum : 1.0 / k_count);
+        }
+      });
   }
+  barrier.rethrow();
 }
 
 }  // namespace primlabel::crf::detail

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "../parallel.hpp"
+
 namespace primlabel::crf::detail {
 namespace {
 
@@ -62,20 +64,23 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, MeanFieldBuffe
   float* next = next_buf.resize(g.num_nodes() * kp);
   // Start from the node-only posterior, in both buffers: rows without neighbours are never
   // rewritten.
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(settings.threads)
   {
     FlushSubnormals flush;  // exp of very negative scores would run into slow subnormals
     MeanFieldUpdater<KP> updater(pr.classes, kp);
 #pragma omp for schedule(static)
-    for (long long i = 0; i < n; ++i) {
-      if (g.active[i]) {
-        updater.start(pr, i, q);
-      } else {
-        std::fill_n(q + i * kp, kp, 0.0f);
-      }
-      std::copy_n(q + i * kp, kp, next + i * kp);
-    }
+    for (long long i = 0; i < n; ++i)
+      barrier.run([&] {
+        if (g.active[i]) {
+          updater.start(pr, i, q);
+        } else {
+          std::fill_n(q + i * kp, kp, 0.0f);
+        }
+        std::copy_n(q + i * kp, kp, next + i * kp);
+      });
   }
+  barrier.rethrow();
   std::uint8_t* moved_before = buffers.moved.resize(g.num_nodes());
   std::uint8_t* moved = buffers.moved_next.resize(g.num_nodes());
   std::uint8_t* same = buffers.same.resize(g.num_nodes());
@@ -85,35 +90,38 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, MeanFieldBuffe
   for (int iteration = 1; iteration <= settings.max_iterations; ++iteration) {
     if (settings.stop.stop_requested()) break;
     float max_change = 0.0f;
+    primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(settings.threads) reduction(max : max_change)
     {
       FlushSubnormals flush;
       MeanFieldUpdater<KP> updater(pr.classes, kp);
       bool stopped = false;  // per thread: once cancelled, the remaining nodes are skipped
 #pragma omp for schedule(dynamic, 1024)
-      for (long long i = 0; i < n; ++i) {
-        if ((i & 1023) == 0) stopped = stopped || settings.stop.stop_requested();
-        if (stopped) continue;
-        if (g.offsets[i] == g.offsets[i + 1]) continue;  // no neighbours: q is final
-        // Skip a node whose q and neighbours' q all settled last iteration (decided from the
-        // previous iteration alone: thread-count independent).
-        bool needed = moved_before[i] != 0;
-        for (std::uint32_t p = g.offsets[i]; !needed && p < g.offsets[i + 1]; ++p)
-          needed = moved_before[g.neighbors[p]] != 0;
-        if (!needed) {
-          if (!same[i]) {
-            std::copy_n(q + i * kp, kp, next + i * kp);
-            same[i] = 1;
+      for (long long i = 0; i < n; ++i)
+        barrier.run([&] {
+          if ((i & 1023) == 0) stopped = stopped || settings.stop.stop_requested();
+          if (stopped) return;
+          if (g.offsets[i] == g.offsets[i + 1]) return;  // no neighbours: q is final
+          // Skip a node whose q and neighbours' q all settled last iteration (decided from the
+          // previous iteration alone: thread-count independent).
+          bool needed = moved_before[i] != 0;
+          for (std::uint32_t p = g.offsets[i]; !needed && p < g.offsets[i + 1]; ++p)
+            needed = moved_before[g.neighbors[p]] != 0;
+          if (!needed) {
+            if (!same[i]) {
+              std::copy_n(q + i * kp, kp, next + i * kp);
+              same[i] = 1;
+            }
+            moved[i] = 0;
+            return;
           }
-          moved[i] = 0;
-          continue;
-        }
-        same[i] = 0;
-        const float change = updater.update(pr, q, next, settings.damping, i);
-        moved[i] = change >= settings.tolerance;
-        max_change = std::max(max_change, change);
-      }
+          same[i] = 0;
+          const float change = updater.update(pr, q, next, settings.damping, i);
+          moved[i] = change >= settings.tolerance;
+          max_change = std::max(max_change, change);
+        });
     }
+    barrier.rethrow();
     std::swap(q_buf, next_buf);
     std::swap(q, next);
     std::swap(moved_before, moved);

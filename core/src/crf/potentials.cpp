@@ -51,31 +51,36 @@ std::size_t number_edges(const Graph& graph, int threads, ScratchBuffer<std::uin
   const std::uint32_t* neighbors = graph.neighbors.data();
   const std::uint32_t* reverse = graph.reverse.data();
   // Fixed node blocks and a serial prefix sum: the numbering never depends on the threads.
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel for schedule(static) num_threads(threads)
-  for (long long b = 0; b < blocks; ++b) {
-    if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
-    std::uint32_t count = 0;
-    const long long last = std::min(n, (b + 1) * kNodeBlock);
-    for (long long i = b * kNodeBlock; i < last; ++i)
-      for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p) count += neighbors[p] > i;
-    first[b + 1] = count;
-  }
+  for (long long b = 0; b < blocks; ++b)
+    barrier.run([&] {
+      if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
+      std::uint32_t count = 0;
+      const long long last = std::min(n, (b + 1) * kNodeBlock);
+      for (long long i = b * kNodeBlock; i < last; ++i)
+        for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p) count += neighbors[p] > i;
+      first[b + 1] = count;
+    });
+  barrier.rethrow();
   throw_if_stopped(stop, kWhat);
   first[0] = 0;
   for (long long b = 0; b < blocks; ++b) first[b + 1] += first[b];
 #pragma omp parallel for schedule(static) num_threads(threads)
-  for (long long b = 0; b < blocks; ++b) {
-    if (stop.stop_requested()) continue;
-    std::uint32_t e = first[b];
-    const long long last = std::min(n, (b + 1) * kNodeBlock);
-    for (long long i = b * kNodeBlock; i < last; ++i)
-      for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p)
-        if (neighbors[p] > i) {
-          of[p] = e;
-          of[reverse[p]] = e;  // each slot is written once, by the owner of its edge
-          ++e;
-        }
-  }
+  for (long long b = 0; b < blocks; ++b)
+    barrier.run([&] {
+      if (stop.stop_requested()) return;
+      std::uint32_t e = first[b];
+      const long long last = std::min(n, (b + 1) * kNodeBlock);
+      for (long long i = b * kNodeBlock; i < last; ++i)
+        for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p)
+          if (neighbors[p] > i) {
+            of[p] = e;
+            of[reverse[p]] = e;  // each slot is written once, by the owner of its edge
+            ++e;
+          }
+    });
+  barrier.rethrow();
   throw_if_stopped(stop, kWhat);
   return first[blocks];
 }
@@ -94,53 +99,59 @@ void node_scores_padded(const CrfModel& model, std::span<const float> descriptor
     RowMatrixXf table = RowMatrixXf::Zero(dim, kp);  // node_feature_dim x padded K
     table.leftCols(k_count) = model.node_weights.transpose();
     const float* bias = table.row(dim - 1).data();
+    primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (long long b = 0; b < blocks; ++b) {
-      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
-      const long long last = std::min(n, (b + 1) * kNodeBlock);
-      for (long long i = b * kNodeBlock; i < last; ++i) {
-        float* row = out + i * kp;
-        if (!graph.active[i]) {
-          std::fill_n(row, kp, 0.0f);
-          continue;
+    for (long long b = 0; b < blocks; ++b)
+      barrier.run([&] {
+        if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
+        const long long last = std::min(n, (b + 1) * kNodeBlock);
+        for (long long i = b * kNodeBlock; i < last; ++i) {
+          float* row = out + i * kp;
+          if (!graph.active[i]) {
+            std::fill_n(row, kp, 0.0f);
+            continue;
+          }
+          std::copy_n(bias, kp, row);
+          const float* descriptor = descriptors.data() + i * d;
+          for (int f = 0; f < d; ++f) {
+            const TentPair p = tent_pair(model.feature_scale * descriptor[f], f, model.node_knots);
+            const float* lo = table.data() + std::size_t(p.column) * kp;
+            for (int k = 0; k < kp; ++k) row[k] += p.lower * lo[k] + p.upper * lo[k + kp];
+          }
         }
-        std::copy_n(bias, kp, row);
-        const float* descriptor = descriptors.data() + i * d;
-        for (int f = 0; f < d; ++f) {
-          const TentPair p = tent_pair(model.feature_scale * descriptor[f], f, model.node_knots);
-          const float* lo = table.data() + std::size_t(p.column) * kp;
-          for (int k = 0; k < kp; ++k) row[k] += p.lower * lo[k] + p.upper * lo[k + kp];
-        }
-      }
-    }
+      });
+    barrier.rethrow();
     throw_if_stopped(stop, kWhat);
     return;
   }
   const Eigen::MatrixXf weights_t = model.node_weights.transpose();  // node_feature_dim x K
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(threads)
   {
     RowMatrixXf features(kNodeBlock, dim);
     RowMatrixXf scores(kNodeBlock, k_count);
 #pragma omp for schedule(static)
-    for (long long b = 0; b < blocks; ++b) {
-      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
-      const long long first = b * kNodeBlock;
-      const long long count = std::min(kNodeBlock, n - first);
-      for (long long r = 0; r < count; ++r) {
-        const long long i = first + r;
-        if (graph.active[i])
-          node_features(model, descriptors.data() + i * d, features.row(r).data());
-        else
-          features.row(r).setZero();
-      }
-      scores.topRows(count).noalias() = features.topRows(count) * weights_t;
-      for (long long r = 0; r < count; ++r) {
-        float* row = out + (first + r) * kp;
-        std::copy_n(scores.row(r).data(), k_count, row);
-        std::fill(row + k_count, row + kp, 0.0f);
-      }
-    }
+    for (long long b = 0; b < blocks; ++b)
+      barrier.run([&] {
+        if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
+        const long long first = b * kNodeBlock;
+        const long long count = std::min(kNodeBlock, n - first);
+        for (long long r = 0; r < count; ++r) {
+          const long long i = first + r;
+          if (graph.active[i])
+            node_features(model, descriptors.data() + i * d, features.row(r).data());
+          else
+            features.row(r).setZero();
+        }
+        scores.topRows(count).noalias() = features.topRows(count) * weights_t;
+        for (long long r = 0; r < count; ++r) {
+          float* row = out + (first + r) * kp;
+          std::copy_n(scores.row(r).data(), k_count, row);
+          std::fill(row + k_count, row + kp, 0.0f);
+        }
+      });
   }
+  barrier.rethrow();
   throw_if_stopped(stop, kWhat);
 }
 
@@ -164,16 +175,20 @@ void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors
     }
     const long long edges = static_cast<long long>(block_first_edge[blocks]);
     const long long edge_blocks = (edges + kEdgeBlock - 1) / kEdgeBlock;
+    primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel for schedule(static) num_threads(threads)
-    for (long long eb = 0; eb < edge_blocks; ++eb) {
-      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
-      const long long last = std::min(edges, (eb + 1) * kEdgeBlock);
-      for (long long e = eb * kEdgeBlock; e < last; ++e)
-        std::copy(row.begin(), row.end(), out + std::size_t(e) * kp);
-    }
+    for (long long eb = 0; eb < edge_blocks; ++eb)
+      barrier.run([&] {
+        if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
+        const long long last = std::min(edges, (eb + 1) * kEdgeBlock);
+        for (long long e = eb * kEdgeBlock; e < last; ++e)
+          std::copy(row.begin(), row.end(), out + std::size_t(e) * kp);
+      });
+    barrier.rethrow();
     throw_if_stopped(stop, kWhat);
     return;
   }
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(threads)
   {
     RowMatrixXf features(kEdgeBatch, d + 1);
@@ -197,24 +212,26 @@ void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors
       m = 0;
     };
 #pragma omp for schedule(static)
-    for (long long b = 0; b < blocks; ++b) {
-      if (stop.stop_requested()) continue;  // cancelled: skip the remaining blocks
-      batch_first = block_first_edge[b];
-      const long long last = std::min(n, (b + 1) * kNodeBlock);
-      for (long long i = b * kNodeBlock; i < last; ++i) {
-        const ConstRowMap xi(descriptors.data() + i * d, d);
-        for (std::uint32_t p = graph.offsets[i]; p < graph.offsets[i + 1]; ++p) {
-          const std::uint32_t j = graph.neighbors[p];
-          if (j < i) continue;  // edges in the order number_edges gives them
-          features.row(m).head(d) =
-              scale2 * xi.cwiseProduct(ConstRowMap(descriptors.data() + std::size_t(j) * d, d));
-          features(m, d) = 1.0f;
-          if (++m == kEdgeBatch) flush();
+    for (long long b = 0; b < blocks; ++b)
+      barrier.run([&] {
+        if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
+        batch_first = block_first_edge[b];
+        const long long last = std::min(n, (b + 1) * kNodeBlock);
+        for (long long i = b * kNodeBlock; i < last; ++i) {
+          const ConstRowMap xi(descriptors.data() + i * d, d);
+          for (std::uint32_t p = graph.offsets[i]; p < graph.offsets[i + 1]; ++p) {
+            const std::uint32_t j = graph.neighbors[p];
+            if (j < i) continue;  // edges in the order number_edges gives them
+            features.row(m).head(d) =
+                scale2 * xi.cwiseProduct(ConstRowMap(descriptors.data() + std::size_t(j) * d, d));
+            features(m, d) = 1.0f;
+            if (++m == kEdgeBatch) flush();
+          }
         }
-      }
-      flush();  // batches never span blocks, so they do not depend on the schedule
-    }
+        flush();  // batches never span blocks, so they do not depend on the schedule
+      });
   }
+  barrier.rethrow();
   throw_if_stopped(stop, kWhat);
 }
 

@@ -186,31 +186,34 @@ SvmPrediction SvmClassifier::predict(std::span<const float> descriptors,
   out.labels.assign(n, unknown_label);
   out.probabilities.setZero(n, k_count);
   const bool with_probability = svm_check_probability_model(model);
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(primlabel::detail::resolve_threads(threads))
   {
     std::vector<svm_node> row;
     std::vector<double> estimates(m.column_of_label.size());
 #pragma omp for schedule(dynamic, 64)
-    for (long long i = 0; i < n; ++i) {
-      if (stop.stop_requested()) continue;  // cancelled: skip the remaining points
-      const float* d = descriptors.data() + i * m.dim;
-      if (!std::all_of(d, d + m.dim, [](float v) { return std::isfinite(v); })) {
-        out.probabilities.row(i).setConstant(std::numeric_limits<float>::quiet_NaN());
-        continue;
-      }
-      to_nodes(d, m.dim, m.scale, row);
-      double label;
-      if (with_probability) {
-        label = svm_predict_probability(model, row.data(), estimates.data());
-        for (std::size_t c = 0; c < estimates.size(); ++c)
-          out.probabilities(i, m.column_of_label[c]) = static_cast<float>(estimates[c]);
-      } else {
-        label = svm_predict(model, row.data());
-        out.probabilities(i, static_cast<int>(label)) = 1.0f;
-      }
-      out.labels[i] = m.class_ids[static_cast<int>(label)];
-    }
+    for (long long i = 0; i < n; ++i)
+      barrier.run([&] {
+        if (stop.stop_requested()) return;  // cancelled: skip the remaining points
+        const float* d = descriptors.data() + i * m.dim;
+        if (!std::all_of(d, d + m.dim, [](float v) { return std::isfinite(v); })) {
+          out.probabilities.row(i).setConstant(std::numeric_limits<float>::quiet_NaN());
+          return;
+        }
+        to_nodes(d, m.dim, m.scale, row);
+        double label;
+        if (with_probability) {
+          label = svm_predict_probability(model, row.data(), estimates.data());
+          for (std::size_t c = 0; c < estimates.size(); ++c)
+            out.probabilities(i, m.column_of_label[c]) = static_cast<float>(estimates[c]);
+        } else {
+          label = svm_predict(model, row.data());
+          out.probabilities(i, static_cast<int>(label)) = 1.0f;
+        }
+        out.labels[i] = m.class_ids[static_cast<int>(label)];
+      });
   }
+  barrier.rethrow();
   throw_if_stopped(stop, "SVM prediction");
   return out;
 }

@@ -16,6 +16,12 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 }  // namespace
 
+Neighborhood capped(const Neighborhood& hood) {
+  Neighborhood out = hood;
+  if (out.radius > 0.0f && out.max_neighbors == 0) out.max_neighbors = kDefaultMaxNeighbors;
+  return out;
+}
+
 DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings, int threads) {
   DescribeOptions options;
   options.threads = threads;
@@ -38,7 +44,7 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   if (!options.use_cloud_normals) {
     const auto start = std::chrono::steady_clock::now();
     NormalOptions normal_options;
-    normal_options.neighborhood = settings.normals;
+    normal_options.neighborhood = capped(settings.normals);
     normal_options.threads = options.threads;
     normal_options.stop = options.stop;
     estimate_normals(cloud, normal_options, out.search.get());
@@ -47,7 +53,7 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
 
   const auto start = std::chrono::steady_clock::now();
   FeatureOptions feature_options;
-  feature_options.neighborhood = settings.features;
+  feature_options.neighborhood = capped(settings.features);
   feature_options.fpfh_variant = settings.fpfh_variant;
   feature_options.threads = options.threads;
   feature_options.stop = options.stop;
@@ -61,7 +67,9 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
 
 crf::Graph build_scene_graph(const PointCloud& cloud, const DescribedCloud& described,
                              const crf::GraphOptions& options) {
-  return crf::build_graph(cloud.xyz, described.descriptors, described.descriptor_dim, options,
+  crf::GraphOptions bounded = options;
+  bounded.neighborhood = capped(options.neighborhood);
+  return crf::build_graph(cloud.xyz, described.descriptors, described.descriptor_dim, bounded,
                           described.search.get());
 }
 

@@ -11,6 +11,7 @@
 
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/crf/inference.hpp"
+#include "primlabel/pipeline/duplicates.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/svm_model.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
@@ -44,8 +45,9 @@ FeatureSettings effective_features(const LabelModel& model, const LabelingOption
   return settings;
 }
 
-LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& features,
-                                PointCloud& cloud, const LabelingOptions& options) {
+// Every point of `cloud` described and labeled (no duplicates expected, see label_all_points).
+LabelingResult label_distinct_points(const LabelModel& model, const FeatureSettings& features,
+                                     PointCloud& cloud, const LabelingOptions& options) {
   LabelingResult result;
   result.class_ids = model.class_ids();
   DescribeOptions describe_options;
@@ -124,12 +126,48 @@ void copy_point(const LabelingResult& part, std::size_t from, LabelingResult& wh
   }
 }
 
+// Exact duplicates are described once, at their lowest index, and every copy gets that copy's
+// results (as voxels fan out to their members below).
+LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& features,
+                                PointCloud& cloud, const LabelingOptions& options) {
+  const DuplicateMap duplicates = find_duplicates(cloud.xyz, options.stop);
+  if (!duplicates.any()) return label_distinct_points(model, features, cloud, options);
+  const std::vector<std::uint32_t>& keep = duplicates.representatives;
+  PointCloud distinct;
+  distinct.resize_unorganized(keep.size());
+  distinct.viewpoint = cloud.viewpoint;
+  for (std::size_t j = 0; j < keep.size(); ++j) distinct.xyz[j] = cloud.xyz[keep[j]];
+  if (options.use_cloud_normals) {
+    distinct.normals.resize(keep.size());
+    for (std::size_t j = 0; j < keep.size(); ++j) distinct.normals[j] = cloud.normals[keep[j]];
+  }
+  const LabelingResult partial = label_distinct_points(model, features, distinct, options);
+  LabelingResult result = unknown_result(cloud.size(), partial, options);
+  result.labeled_points = 0;
+  if (!options.use_cloud_normals) {
+    cloud.normals.assign(cloud.size(), Vec3f::Constant(kNaN));
+    cloud.curvature.assign(cloud.size(), kNaN);
+  }
+  const std::uint32_t unknown = class_id(PrimitiveClass::kUnknown);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const std::uint32_t j = duplicates.slot_of[i];
+    copy_point(partial, j, result, i);
+    if (partial.labels[j] != unknown) ++result.labeled_points;
+    if (!options.use_cloud_normals) {
+      cloud.normals[i] = distinct.normals[j];
+      cloud.curvature[i] = distinct.curvature[j];
+    }
+  }
+  return result;
+}
+
 // Table-top only: label the sub-cloud of table and object points, scatter back.
 LabelingResult label_tabletop(const LabelModel& model, const FeatureSettings& features,
                               PointCloud& cloud, const LabelingOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   tabletop::TabletopOptions tabletop_options;
   tabletop_options.threads = options.threads;
+  tabletop_options.stop = options.stop;
   const tabletop::TabletopResult segmented = tabletop::segment_tabletop(cloud, tabletop_options);
   const std::vector<std::uint8_t> mask = tabletop::tabletop_mask(segmented, cloud.size());
   PointCloud sub;
@@ -195,8 +233,8 @@ PointCloud voxel_cloud(const PointCloud& cloud, const tabletop::VoxelGrid& grid,
 LabelingResult label_voxels(const LabelModel& model, const FeatureSettings& features,
                             PointCloud& cloud, float voxel_size, const LabelingOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  const tabletop::VoxelGrid grid =
-      tabletop::voxel_downsample(cloud.xyz, tabletop::finite_indices(cloud.xyz), voxel_size);
+  const tabletop::VoxelGrid grid = tabletop::voxel_downsample(
+      cloud.xyz, tabletop::finite_indices(cloud.xyz), voxel_size, options.stop);
   PointCloud voxels = voxel_cloud(cloud, grid, options.use_cloud_normals);
   const double voxel_seconds = seconds_since(start);
   throw_if_stopped(options.stop, "labeling");

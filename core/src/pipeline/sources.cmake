@@ -2,6 +2,7 @@
 # primlabel-train and primlabel-eval tools. Included by core/CMakeLists.txt.
 target_sources(primlabel_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/describe.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/duplicates.cpp
   ${CMAKE_CURRENT_LIST_DIR}/label_cloud.cpp
   ${CMAKE_CURRENT_LIST_DIR}/training.cpp
   ${CMAKE_CURRENT_LIST_DIR}/svm_model.cpp

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "../parallel.hpp"
 #include "primlabel/core/neighbor_search.hpp"
 #include "scan_common.hpp"
 
@@ -15,21 +16,24 @@ void label_unseen_creases_as_surface(std::vector<Return>& returns, double label_
   const double fraction = kObservedCreaseFraction;
 
   std::vector<std::uint32_t> relabeled(returns.size());
+  primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel
   {
     NeighborList neighbors;
 #pragma omp for schedule(dynamic, 256)
-    for (long long i = 0; i < static_cast<long long>(returns.size()); ++i) {
-      const Return& r = returns[i];
-      relabeled[i] = r.label;
-      if (r.part < 0 || r.label == r.surface_label) continue;
-      search.find(r.surface_xyz, hood, neighbors, /*sorted=*/false);
-      std::size_t across = 0;
-      for (std::uint32_t j : neighbors.indices)
-        across += returns[j].object != r.object || returns[j].part != r.part;
-      if (double(across) < fraction * double(neighbors.size())) relabeled[i] = r.surface_label;
-    }
+    for (long long i = 0; i < static_cast<long long>(returns.size()); ++i)
+      barrier.run([&] {
+        const Return& r = returns[i];
+        relabeled[i] = r.label;
+        if (r.part < 0 || r.label == r.surface_label) return;
+        search.find(r.surface_xyz, hood, neighbors, /*sorted=*/false);
+        std::size_t across = 0;
+        for (std::uint32_t j : neighbors.indices)
+          across += returns[j].object != r.object || returns[j].part != r.part;
+        if (double(across) < fraction * double(neighbors.size())) relabeled[i] = r.surface_label;
+      });
   }
+  barrier.rethrow();
   for (std::size_t i = 0; i < returns.size(); ++i) returns[i].label = relabeled[i];
 }
 

@@ -8,6 +8,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "../parallel.hpp"
+#include "primlabel/core/cancellation.hpp"
+
 namespace primlabel::tabletop {
 
 void PlaneFitOptions::validate() const {
@@ -152,6 +155,7 @@ PlaneFit fit_plane(const std::vector<Vec3f>& points, const std::vector<std::uint
   int drawn = 0;
   std::vector<Hypothesis> block;
   while (drawn < needed && drawn < options.max_iterations) {
+    throw_if_stopped(options.stop, "fitting the table plane");
     const int count = std::min<int>(kBlock, options.max_iterations - drawn);
     block.assign(count, Hypothesis{});
     for (int h = 0; h < count; ++h) {
@@ -161,25 +165,28 @@ PlaneFit fit_plane(const std::vector<Vec3f>& points, const std::vector<std::uint
       if (block[h].usable && axis && std::abs(block[h].plane.head<3>().dot(*axis)) < min_cos)
         block[h].usable = false;  // outside the allowed tilt: not even scored
     }
+    primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel for num_threads(threads) schedule(static, 1)
-    for (int h = 0; h < count; ++h) {
-      Hypothesis& hyp = block[h];
-      if (!hyp.usable) continue;
-      double cost = 0.0;
-      std::size_t inliers = 0;
-      for (const Vec3f& p : subset) {
-        const double d = signed_distance(hyp.plane, p);
-        const double sq = d * d;
-        if (sq <= sq_t) {
-          cost += sq;
-          ++inliers;
-        } else {
-          cost += sq_t;
+    for (int h = 0; h < count; ++h)
+      barrier.run([&] {
+        Hypothesis& hyp = block[h];
+        if (!hyp.usable) return;
+        double cost = 0.0;
+        std::size_t inliers = 0;
+        for (const Vec3f& p : subset) {
+          const double d = signed_distance(hyp.plane, p);
+          const double sq = d * d;
+          if (sq <= sq_t) {
+            cost += sq;
+            ++inliers;
+          } else {
+            cost += sq_t;
+          }
         }
-      }
-      hyp.cost = cost;
-      hyp.inliers = inliers;
-    }
+        hyp.cost = cost;
+        hyp.inliers = inliers;
+      });
+    barrier.rethrow();
     for (const Hypothesis& hyp : block)
       if (hyp.usable && hyp.cost < best.cost) best = hyp;
     drawn += count;

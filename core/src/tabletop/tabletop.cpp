@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "primlabel/core/cancellation.hpp"
 #include "primlabel/tabletop/convex_hull.hpp"
 #include "primlabel/tabletop/plane_grid.hpp"
 #include "primlabel/tabletop/voxel_grid.hpp"
@@ -66,6 +67,8 @@ const char* to_string(TabletopStatus status) {
 
 namespace {
 
+constexpr const char* kWhat = "table-top segmentation";
+
 using Clock = std::chrono::steady_clock;
 
 double ms_since(Clock::time_point start) {
@@ -107,6 +110,7 @@ std::vector<std::vector<std::uint32_t>> expand_voxel_clusters(
 
 TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& options) {
   options.validate();
+  throw_if_stopped(options.stop, kWhat);
   const auto start = Clock::now();
   TabletopResult result;
   const std::vector<Vec3f>& xyz = cloud.xyz;
@@ -124,7 +128,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   VoxelGrid grid;
   std::vector<std::uint32_t> all_voxels;
   if (voxelized) {
-    grid = voxel_downsample(xyz, valid, options.voxel_leaf);
+    grid = voxel_downsample(xyz, valid, options.voxel_leaf, options.stop);
     all_voxels.resize(grid.centroids.size());
     std::iota(all_voxels.begin(), all_voxels.end(), 0u);
   }
@@ -137,6 +141,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   PlaneFitOptions plane_options = options.plane;
   plane_options.seed = options.seed;
   plane_options.threads = options.threads;
+  plane_options.stop = options.stop;
   Vec3f prior = sensor_up(cloud.viewpoint);
   if (options.up_source == UpAxisSource::kGiven) prior = options.up.normalized();
   plane_options.axis = prior;
@@ -168,6 +173,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   result.up = plane.head<3>();
   result.tilt_deg = angle_between_deg(plane.head<3>(), prior);
 
+  throw_if_stopped(options.stop, kWhat);
   // 3. The table: points in the band around the plane, in the pieces connected to its bulk.
   const auto table_start = Clock::now();
   std::vector<float> height(xyz.size(), std::numeric_limits<float>::quiet_NaN());
@@ -229,6 +235,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   for (const Vec2f& q : hull) result.hull.push_back(on_plane + q.x() * u + q.y() * v);
   result.timings.table_ms = ms_since(table_start);
 
+  throw_if_stopped(options.stop, kWhat);
   // 4. Objects: what stands on the table, inside its boundary, grouped by proximity.
   const auto objects_start = Clock::now();
   const float min_height = options.min_object_height.value_or(-options.table_band);
@@ -240,7 +247,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   }
   if (voxelized) {
     // Cluster the voxels holding candidates, at their candidates' centroid.
-    VoxelGrid object_grid = voxel_downsample(xyz, candidates, options.voxel_leaf);
+    VoxelGrid object_grid = voxel_downsample(xyz, candidates, options.voxel_leaf, options.stop);
     std::vector<std::uint32_t> voxels(object_grid.centroids.size());
     std::iota(voxels.begin(), voxels.end(), 0u);
     ClusterOptions unlimited = options.clusters;
@@ -252,12 +259,14 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   } else {
     result.clusters = euclidean_clusters(xyz, candidates, options.clusters);
   }
+  throw_if_stopped(options.stop, kWhat);
   // 5. Objects as wholes: split stacked objects first, so that the lower object's occluded
   // parts can still be joined to what remains of it.
   const auto refine_start = Clock::now();
   result.clusters = split_stacked(xyz, height, plane, std::move(result.clusters), options.split);
   result.clusters =
       merge_occluded(cloud, height, band_grid, std::move(result.clusters), options.merge);
+  throw_if_stopped(options.stop, kWhat);
   result.timings.refine_ms = ms_since(refine_start);
   result.timings.objects_ms = ms_since(objects_start);
 

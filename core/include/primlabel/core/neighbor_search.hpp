@@ -3,6 +3,7 @@
 // k-d tree). Results are sorted by ascending squared distance, ties by ascending index, so the
 // same query always returns the same list.
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <stop_token>
@@ -24,7 +25,11 @@ struct Neighborhood {
   static Neighborhood Knn(int k) { return {0.0f, k, 0}; }
   static Neighborhood Hybrid(float r, int max_nn) { return {r, 0, max_nn}; }
 
-  bool valid() const { return (radius > 0.0f && k == 0) || (radius == 0.0f && k > 0); }
+  // A radius must be finite (an infinite one would make every query read the whole cloud).
+  bool valid() const {
+    return (radius > 0.0f && std::isfinite(radius) && k == 0 && max_neighbors >= 0) ||
+           (radius == 0.0f && k > 0);
+  }
   std::string describe() const;
 };
 
@@ -55,6 +60,9 @@ class NeighborSearch {
   // the cloud, at distance 0). k-nearest results are always sorted; radius results are sorted
   // unless `sorted` is false, in which case their order is still deterministic (tree order) and
   // the O(n log n) sort is saved. A non-finite query has no neighbours.
+  // A hybrid query costs O(max_neighbors log max_neighbors) whatever the cloud: the radius is
+  // read directly only while it holds few points, else the nearest are searched, and the search
+  // stops as soon as max_neighbors points at distance 0 are found (coincident points).
   // Thread-safe: the tree is read-only after construction.
   void find(const Vec3f& query, const Neighborhood& hood, NeighborList& out,
             bool sorted = true) const;
@@ -62,6 +70,9 @@ class NeighborSearch {
   std::size_t indexed_points() const;
 
  private:
+  // The `capacity` nearest points strictly closer than sq_bound, sorted.
+  void nearest(const Vec3f& query, std::size_t capacity, float sq_bound, NeighborList& out) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -31,11 +31,21 @@ struct DescribedCloud {
 // Thrown by describe_cloud and label_cloud when their stop token is requested.
 using Cancelled = primlabel::Cancelled;
 
+// A radius neighbourhood without a cap (max_neighbors 0) gets this one wherever the pipeline
+// describes a cloud or builds its graph, for training and labeling alike: the nearest 1024 within
+// the radius. Each point then costs a bounded amount whatever the input (points packed into a
+// millimetre cost O(n * 1024), not O(n^2)). The default LMS400 scenes have at most 628 points
+// within the 25 mm feature radius (111 within 10 mm), so their features are unchanged.
+inline constexpr int kDefaultMaxNeighbors = 1024;
+// `hood` with kDefaultMaxNeighbors when it is a radius neighbourhood without a cap; a model's own
+// cap and k-nearest neighbourhoods are kept.
+Neighborhood capped(const Neighborhood& hood);
+
 struct DescribeOptions {
   int threads = 0;  // 0 = OpenMP default
   // Keep cloud.normals (one per point, e.g. from the sensor) instead of estimating them.
   bool use_cloud_normals = false;
-  std::stop_token stop;  // checked per block of points; throws Cancelled
+  std::stop_token stop;  // checked per point and inside the index builds; throws Cancelled
 };
 
 // Throws std::invalid_argument for settings describe_cloud cannot honour (voxel downsampling:
@@ -66,8 +76,8 @@ struct LabelingOptions {
   // allow it (radii_overridable), else label_cloud throws std::invalid_argument.
   float normal_radius = 0.0f;
   float feature_radius = 0.0f;
-  // Checked between stages and per block of points inside them; label_cloud then throws
-  // Cancelled (within a block's time: a few milliseconds).
+  // Checked between stages and per point inside them (and in the table-top stage, the voxel
+  // filter and the index builds); label_cloud then throws Cancelled, within milliseconds.
   std::stop_token stop;
 };
 
@@ -89,6 +99,8 @@ struct LabelingResult {
 
 // Labels every point with the model's own feature, graph and inference settings (and the
 // overrides in `options`). Points with non-finite coordinates or no descriptor get class 0.
+// Exact duplicates are described once (duplicates.hpp): every copy gets the labels,
+// probabilities, descriptor and normal of its lowest-index copy.
 // Throws ModelError when an SVM model's libsvm text does not load, std::invalid_argument for
 // overrides the model does not allow or missing normals, and Cancelled when options.stop is
 // requested.

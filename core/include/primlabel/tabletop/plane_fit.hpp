@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
+#include <stop_token>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,8 @@ struct PlaneFitOptions {
   std::size_t min_inliers = 100;           // fewer inliers than this is "no plane"
   int refine_iterations = 5;               // least-squares refit / re-select rounds
   std::uint64_t seed = 1;
-  int threads = 0;  // 0 = OpenMP default
+  int threads = 0;       // 0 = OpenMP default
+  std::stop_token stop;  // checked per round of hypotheses; fit_plane then throws Cancelled
 
   void validate() const;  // throws std::invalid_argument naming the bad option
 };

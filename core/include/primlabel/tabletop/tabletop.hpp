@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
+#include <stop_token>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,9 @@ struct TabletopOptions {
 
   std::uint64_t seed = 1;  // RANSAC seed (copied into plane.seed)
   int threads = 0;         // 0 = OpenMP default; results do not depend on it
+  // Checked between the stages, per round of the plane fit and inside the voxel filter;
+  // segment_tabletop then throws Cancelled.
+  std::stop_token stop;
 
   void validate() const;  // throws std::invalid_argument naming the bad option
 };

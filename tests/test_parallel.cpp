@@ -1,0 +1,72 @@
+// The OpenMP helpers: no exception may leave a parallel region (std::terminate), the first one
+// becomes an exception of the call, and the other threads stop early.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <stdexcept>
+
+#include "parallel.hpp"
+#include "primlabel/core/features.hpp"
+#include "primlabel/core/normals.hpp"
+
+namespace primlabel {
+namespace {
+
+TEST(Parallel, AnExceptionInABlockIsRethrownAfterTheRegion) {
+  std::atomic<int> ran{0};
+  const auto make_scratch = [] { return 0; };
+  EXPECT_THROW(detail::for_each_block(2, 10000, {}, make_scratch,
+                                      [&](int&, std::ptrdiff_t block) {
+                                        ++ran;
+                                        if (block == 3) throw std::runtime_error("block 3");
+                                      }),
+               std::runtime_error);
+  EXPECT_LT(ran.load(), 10000);  // the others stopped early
+}
+
+TEST(Parallel, AFailingScratchIsAnExceptionToo) {
+  const auto make_scratch = []() -> int { throw std::bad_alloc(); };
+  EXPECT_THROW(detail::for_each_block(2, 100, {}, make_scratch, [](int&, std::ptrdiff_t) {}),
+               std::bad_alloc);
+}
+
+TEST(Parallel, TheBarrierKeepsTheFirstException) {
+  detail::ExceptionBarrier barrier;
+#pragma omp parallel for num_threads(2)
+  for (int i = 0; i < 1000; ++i)
+    barrier.run([&] { throw std::invalid_argument("item " + std::to_string(i)); });
+  EXPECT_TRUE(barrier.failed());
+  EXPECT_THROW(barrier.rethrow(), std::invalid_argument);
+}
+
+PointCloud grid_cloud() {
+  PointCloud cloud;
+  for (int i = 0; i < 100; ++i)
+    for (int j = 0; j < 100; ++j) cloud.xyz.emplace_back(i * 0.01f, j * 0.01f, 0.0f);
+  cloud.resize_unorganized(cloud.xyz.size());
+  return cloud;
+}
+
+// A progress callback runs inside the parallel loops: what it throws reaches the caller.
+TEST(Parallel, AThrowingProgressCallbackBecomesAnExceptionOfTheCall) {
+  PointCloud cloud = grid_cloud();
+  NormalOptions normals;
+  normals.threads = 2;
+  normals.progress = [](std::size_t done, std::size_t) {
+    if (done < 10000) throw std::runtime_error("progress says no");
+  };
+  EXPECT_THROW(estimate_normals(cloud, normals), std::runtime_error);
+  normals.progress = {};
+  estimate_normals(cloud, normals);
+  FeatureOptions features;
+  features.threads = 2;
+  features.progress = normals.progress = [](std::size_t done, std::size_t) {
+    if (done < 20000) throw std::runtime_error("progress says no");
+  };
+  EXPECT_THROW(compute_fpfh(cloud, features), std::runtime_error);
+  EXPECT_THROW(compute_pfh(cloud, features), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace primlabel
