@@ -126,6 +126,32 @@ void copy_point(const LabelingResult& part, std::size_t from, LabelingResult& wh
   }
 }
 
+// The results of `part` (a cloud of distinct points or voxels) carried to every point of the
+// whole cloud through `slot_of` (kNoVoxel: the point was not described and stays unknown),
+// normals and curvature included unless the cloud's own normals were used.
+LabelingResult fan_out(const LabelingResult& partial, const PointCloud& part,
+                       const std::vector<std::uint32_t>& slot_of, PointCloud& cloud,
+                       const LabelingOptions& options) {
+  LabelingResult result = unknown_result(cloud.size(), partial, options);
+  result.labeled_points = 0;
+  if (!options.use_cloud_normals) {
+    cloud.normals.assign(cloud.size(), Vec3f::Constant(kNaN));
+    cloud.curvature.assign(cloud.size(), kNaN);
+  }
+  const std::uint32_t unknown = class_id(PrimitiveClass::kUnknown);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const std::uint32_t j = slot_of[i];
+    if (j == tabletop::kNoVoxel) continue;
+    copy_point(partial, j, result, i);
+    if (partial.labels[j] != unknown) ++result.labeled_points;
+    if (!options.use_cloud_normals) {
+      cloud.normals[i] = part.normals[j];
+      cloud.curvature[i] = part.curvature[j];
+    }
+  }
+  return result;
+}
+
 // Exact duplicates are described once, at their lowest index, and every copy gets that copy's
 // results (as voxels fan out to their members below).
 LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& features,
@@ -142,23 +168,7 @@ LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& 
     for (std::size_t j = 0; j < keep.size(); ++j) distinct.normals[j] = cloud.normals[keep[j]];
   }
   const LabelingResult partial = label_distinct_points(model, features, distinct, options);
-  LabelingResult result = unknown_result(cloud.size(), partial, options);
-  result.labeled_points = 0;
-  if (!options.use_cloud_normals) {
-    cloud.normals.assign(cloud.size(), Vec3f::Constant(kNaN));
-    cloud.curvature.assign(cloud.size(), kNaN);
-  }
-  const std::uint32_t unknown = class_id(PrimitiveClass::kUnknown);
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const std::uint32_t j = duplicates.slot_of[i];
-    copy_point(partial, j, result, i);
-    if (partial.labels[j] != unknown) ++result.labeled_points;
-    if (!options.use_cloud_normals) {
-      cloud.normals[i] = distinct.normals[j];
-      cloud.curvature[i] = distinct.curvature[j];
-    }
-  }
-  return result;
+  return fan_out(partial, distinct, duplicates.slot_of, cloud, options);
 }
 
 // Table-top only: label the sub-cloud of table and object points, scatter back.
@@ -240,24 +250,8 @@ LabelingResult label_voxels(const LabelModel& model, const FeatureSettings& feat
   throw_if_stopped(options.stop, "labeling");
 
   const LabelingResult partial = label_points(model, features, voxels, options);
-  LabelingResult result = unknown_result(cloud.size(), partial, options);
+  LabelingResult result = fan_out(partial, voxels, grid.voxel_of_point, cloud, options);
   result.prefilter_seconds = partial.prefilter_seconds + voxel_seconds;
-  result.labeled_points = 0;
-  if (!options.use_cloud_normals) {
-    cloud.normals.assign(cloud.size(), Vec3f::Constant(kNaN));
-    cloud.curvature.assign(cloud.size(), kNaN);
-  }
-  const std::uint32_t unknown = class_id(PrimitiveClass::kUnknown);
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const std::uint32_t v = grid.voxel_of_point[i];
-    if (v == tabletop::kNoVoxel) continue;
-    copy_point(partial, v, result, i);
-    if (partial.labels[v] != unknown) ++result.labeled_points;
-    if (!options.use_cloud_normals) {
-      cloud.normals[i] = voxels.normals[v];
-      cloud.curvature[i] = voxels.curvature[v];
-    }
-  }
   return result;
 }
 
