@@ -61,11 +61,11 @@ class HostileGeometry : public ::testing::Test {
 TEST_F(HostileGeometry, FarPointsMixedWithAScanGetAnAnswerAndTheScanKeepsItsLabels) {
   for (const float far : {1e18f, 1e30f, FLT_MAX, -FLT_MAX}) {
     SCOPED_TRACE(far);
-    PointCloud cloud = table_;
-    cloud.xyz.push_back({far, 0.0f, 0.0f});
-    cloud.xyz.push_back({0.1f, far, -far});
-    cloud.xyz.push_back({far, far, far});
-    cloud.resize_unorganized(cloud.xyz.size());
+    std::vector<Vec3f> points = table_.xyz;
+    points.push_back({far, 0.0f, 0.0f});
+    points.push_back({0.1f, far, -far});
+    points.push_back({far, far, far});
+    const PointCloud cloud = cloud_of(std::move(points));
     const LabelAnswer answer = send(cloud, std::chrono::seconds(60));
     ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
     ASSERT_EQ(answer.labels.size(), cloud.size());
