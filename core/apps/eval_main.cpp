@@ -16,6 +16,7 @@
 #include <string>
 
 #include "cli_common.hpp"
+#include "primlabel/build_version.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/pipeline/confusion_plot.hpp"
@@ -230,6 +231,7 @@ int fig4(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Label clouds with a trained model and score them, or re-measure Table I."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-eval"));
   app.name("primlabel-eval");
   Arguments args;
   auto* files = app.add_option("files", args.files, "clouds to label (.pcd or .ply)");

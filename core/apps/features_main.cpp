@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "cli_common.hpp"
+#include "primlabel/build_version.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "primlabel/core/features.hpp"
 #include "primlabel/core/neighbor_search.hpp"
@@ -101,6 +102,7 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Estimate normals and FPFH/PFH descriptors for every point of a PCD/PLY cloud."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-features"));
   app.name("primlabel-features");
   Arguments args;
   app.add_option("input", args.input, "input cloud (.pcd or .ply)")->required();

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "cli_common.hpp"
+#include "primlabel/build_version.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/render/colorize.hpp"
@@ -103,6 +104,7 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Render a point cloud to PNG, coloured by label, segment, rgb or a field."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-render"));
   app.name("primlabel-render");
   Arguments args;
   app.add_option("input", args.input, "input cloud (.pcd or .ply)")->required();

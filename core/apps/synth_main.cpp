@@ -12,6 +12,7 @@
 #include <map>
 
 #include "cli_common.hpp"
+#include "primlabel/build_version.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/synth/generate.hpp"
@@ -150,6 +151,7 @@ int usage_error(const std::string& message) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Labeled synthetic table scenes from a simulated laser line scanner or Kinect."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-synth"));
   app.name("primlabel-synth");
   Arguments args;
   app.add_option("--scene", args.scene,

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli_common.hpp"
+#include "primlabel/build_version.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "primlabel/render/render.hpp"
 #include "primlabel/tabletop/segmentation_eval.hpp"
@@ -148,6 +149,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Find the table (largest horizontal plane) and the objects on it in a scan; "
       "score against mOSD labels; render to PNG."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-tabletop"));
   app.name("primlabel-tabletop");
   Arguments args;
   TabletopOptions& o = args.options;

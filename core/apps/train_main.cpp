@@ -12,6 +12,7 @@
 #include <fstream>
 
 #include "cli_common.hpp"
+#include "primlabel/build_version.hpp"
 #include "primlabel/pipeline/curve_plot.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/labeled_cloud.hpp"
@@ -158,6 +159,7 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Train a point labeling model (CRF, node-only or SVM) from labeled clouds."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-train"));
   app.name("primlabel-train");
   Arguments args;
   auto* synth_train =

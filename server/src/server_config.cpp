@@ -7,6 +7,8 @@
 #include <sstream>
 #include <thread>
 
+#include "primlabel/build_version.hpp"
+
 namespace primlabel::server {
 
 namespace {
@@ -91,6 +93,7 @@ int effective_threads_per_job(const ServerConfig& config) {
 ServerConfig parse_server_config(int argc, const char* const* argv) {
   ServerConfig config;
   CLI::App app{"primlabel-server: the gRPC point labeling service."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-server"));
   app.name("primlabel-server");
   std::string config_file;  // read before parsing, see with_config_file
   app.add_option("--config", config_file,

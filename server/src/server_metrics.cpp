@@ -2,7 +2,7 @@
 
 #include <prometheus/text_serializer.h>
 
-#include "build_version.hpp"
+#include "primlabel/build_version.hpp"
 #include "process_collector.hpp"
 
 namespace primlabel::server {

@@ -15,6 +15,7 @@
 #include "commands.hpp"
 #include "common/client_flags.hpp"
 #include "exit_codes.hpp"
+#include "primlabel/build_version.hpp"
 
 using namespace primlabel::client;
 using namespace primlabel::client::tools;
@@ -22,6 +23,7 @@ using namespace primlabel::client::tools;
 int main(int argc, char** argv) {
   CLI::App app{"primlabel: label point clouds with a primlabel server, list its models, check it.",
                "primlabel"};
+  app.set_version_flag("--version", primlabel::version_line("primlabel"));
   app.footer(kExitCodesHelp);
   app.require_subcommand(1);
   ConnectionFlags connection;
@@ -63,6 +65,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);

@@ -11,6 +11,7 @@
 
 #include "common/client_flags.hpp"
 #include "load_runner.hpp"
+#include "primlabel/build_version.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "primlabel/synth/generate.hpp"
 #include "report.hpp"
@@ -45,6 +46,7 @@ PointCloud first_points(PointCloud cloud, std::size_t n) {
 
 int main(int argc, char** argv) {
   CLI::App app{"primlabel-loadgen: load a primlabel server and measure it.", "primlabel-loadgen"};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-loadgen"));
   app.footer(kFooter);
   tools::ConnectionFlags connection;
   connection.retries = 1;  // measure the server, not the client's retries
@@ -93,6 +95,8 @@ int main(int argc, char** argv) {
       throw CLI::ValidationError("a step needs --duration or --requests");
     if (open_loop && spec.rate <= 0) throw CLI::ValidationError("--rate must be positive");
   } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "primlabel-loadgen: %s (see --help)\n", e.what());

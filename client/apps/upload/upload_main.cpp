@@ -15,6 +15,7 @@
 #include "common/client_flags.hpp"
 #include "directory_watch.hpp"
 #include "framing.hpp"
+#include "primlabel/build_version.hpp"
 #include "uploader.hpp"
 
 using namespace primlabel::client;
@@ -180,6 +181,7 @@ std::string summary_line(const UploadCounters& c, std::size_t left) {
 int main(int argc, char** argv) {
   CLI::App app{"primlabel-upload: upload scans to a primlabel server through a durable spool.",
                "primlabel-upload"};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-upload"));
   app.footer(kFooter);
   tools::ConnectionFlags connection;
   connection.retries = 2;  // the uploader's own backoff takes over after these
@@ -225,6 +227,8 @@ int main(int argc, char** argv) {
     if (!watch_dir.empty() && from_stdin)
       throw CLI::ValidationError("--watch and --stdin exclude each other");
   } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "primlabel-upload: %s (see --help)\n", e.what());
