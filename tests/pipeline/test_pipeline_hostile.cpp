@@ -14,6 +14,7 @@
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/pipeline/duplicates.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "proc_status.hpp"
 #include "random_label_model.hpp"
 
 namespace primlabel {
@@ -22,20 +23,7 @@ namespace {
 using pipeline::LabelingOptions;
 using pipeline::LabelingResult;
 
-// Peak resident set of this process so far (VmHWM), in bytes.
-std::size_t peak_rss_bytes() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmHWM:") {
-      std::size_t kb = 0;
-      status >> kb;
-      return kb * 1024;
-    }
-    status.ignore(1 << 12, '\n');
-  }
-  return 0;
-}
+std::size_t peak_rss_bytes() { return std::size_t(testing::proc_status("VmHWM")) * 1024; }
 
 PointCloud with_points(PointCloud cloud, const std::vector<Vec3f>& extra) {
   cloud.xyz.insert(cloud.xyz.end(), extra.begin(), extra.end());

@@ -8,6 +8,7 @@
 #include <random>
 #include <thread>
 
+#include "proc_status.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {
@@ -17,12 +18,7 @@ using testing::random_label_model;
 using testing::table_with_box_cloud;
 
 // VmHWM of this process (the server runs in it), in MB.
-double peak_rss_mb() {
-  std::ifstream in("/proc/self/status");
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
-  return -1;
-}
+double peak_rss_mb() { return double(testing::proc_status("VmHWM")) / 1024.0; }
 
 PointCloud cloud_of(std::vector<Vec3f> points) {
   PointCloud cloud;

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <thread>
 
+#include "proc_status.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {
@@ -18,14 +19,7 @@ using testing::random_label_model;
 using testing::table_with_box_cloud;
 using RawStream = grpc::ClientReaderWriter<v1::LabelRequest, v1::LabelResponse>;
 
-// A field of /proc/self/status ("Threads", "VmHWM" in kB); the server runs in this process.
-long process_status(const std::string& field) {
-  std::ifstream in("/proc/self/status");
-  std::string line;
-  while (std::getline(in, line))
-    if (line.rfind(field + ":", 0) == 0) return std::stol(line.substr(field.size() + 1));
-  return -1;
-}
+long process_status(const std::string& field) { return testing::proc_status(field); }
 
 double metric(TestServer& server, const std::string& name, const scrape::Labels& labels = {}) {
   return scrape::sum_samples(scrape_metrics(server.server->metrics_port()), name, labels);

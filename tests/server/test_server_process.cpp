@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "metrics_endpoint.hpp"
+#include "proc_status.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {
@@ -308,12 +309,8 @@ TEST_F(ServerBinary, ASecondServerOnAPortInUseExitsNamingTheAddress) {
   EXPECT_EQ(first.exit_code(30000), 0) << first.log();
 }
 
-// A field of /proc/<pid>/status in kB ("VmRSS", "VmHWM").
 long status_kb(pid_t pid, const std::string& field) {
-  std::ifstream in("/proc/" + std::to_string(pid) + "/status");
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind(field + ":", 0) == 0) return std::stol(line.substr(field.size() + 1));
-  return -1;
+  return testing::proc_status(field, std::to_string(pid));
 }
 
 TEST_F(ServerBinary, MemoryGoesBackToTheSystemAfterALargeRequest) {
