@@ -20,11 +20,11 @@
 #include <utility>
 #include <vector>
 
-#include "primlabel/core/cloud_io.hpp"
-#include "primlabel/core/features.hpp"
-#include "primlabel/core/neighbor_search.hpp"
-#include "primlabel/core/normals.hpp"
-#include "primlabel/core/point_cloud.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/features.hpp"
+#include "primlabel/geometry/neighbor_search.hpp"
+#include "primlabel/geometry/normals.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/tabletop/voxel_grid.hpp"
 
 #ifdef PRIMLABEL_HAVE_PCL

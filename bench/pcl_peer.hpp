@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "primlabel/core/neighbor_search.hpp"
-#include "primlabel/core/point_cloud.hpp"
+#include "primlabel/geometry/neighbor_search.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
 
 namespace primlabel::bench {
 

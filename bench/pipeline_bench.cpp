@@ -26,6 +26,7 @@
 
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
+#include "primlabel/synth/generate.hpp"
 
 namespace {
 
@@ -54,7 +55,7 @@ LabelModel quick_model(synth::SensorKind sensor) {
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
   std::vector<pipeline::SceneData> train;
   train.push_back(
-      pipeline::prepare_scene(pipeline::synthetic_scene(synth::SceneSet::kTrain, 0, sensor),
+      pipeline::prepare_scene(synth::synthetic_scene(synth::SceneSet::kTrain, 0, sensor),
                               "train", features, graph, every_class, 0));
   const auto class_ids = pipeline::classes_present(train);
   pipeline::assign_labels(train.front(), class_ids);
@@ -150,7 +151,7 @@ std::vector<double> stop_latencies(const LabelModel& model, const PointCloud& in
 
 int run_stop_latency(const Arguments& args) {
   const PointCloud scene =
-      pipeline::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400);
+      synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400);
   const LabelModel model =
       args.model.empty() ? quick_model(synth::SensorKind::kLms400) : load_model(args.model);
   std::mt19937 rng(3);
@@ -198,7 +199,7 @@ int run(const Arguments& args) {
               "points", "labeled", "features s", "infer s", "total s", "points/s");
   for (const std::string& name : args.sensors) {
     const synth::SensorKind sensor = *synth::sensor_from_name(name);
-    const PointCloud scene = pipeline::synthetic_scene(synth::SceneSet::kTest, 0, sensor);
+    const PointCloud scene = synth::synthetic_scene(synth::SceneSet::kTest, 0, sensor);
     const LabelModel model = given ? *given : quick_model(sensor);
     const std::string model_name =
         given ? "file" : std::string(model.kind == ModelKind::kCrf ? "crf" : "node") + "-quick";

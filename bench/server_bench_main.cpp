@@ -24,6 +24,7 @@
 #include "logging.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
+#include "primlabel/synth/generate.hpp"
 #include "primlabel/scrape/exposition_parser.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "primlabel/wire/packing.hpp"
@@ -55,7 +56,7 @@ LabelModel bench_model() {
 
 PointCloud table_scene(std::size_t target) {
   const PointCloud scene =
-      pipeline::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400);
+      synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400);
   const std::size_t stride = std::max<std::size_t>(1, scene.size() / target);
   PointCloud out;
   out.viewpoint = scene.viewpoint;
@@ -221,7 +222,7 @@ int main(int argc, char** argv) {
   PointCloud kinect;
   if (!cancel_only) {
     table = compare("table", model, table_scene(22000), *stub, reps_table, threads);
-    kinect = pipeline::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kKinect);
+    kinect = synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kKinect);
     frame = compare("kinect", model, kinect, *stub, reps_kinect, threads);
   }
 

@@ -2,7 +2,7 @@
 # SACSegmentation + ConvexHull + ExtractPolygonalPrismData + EuclideanClusterExtraction.
 # Included by bench/CMakeLists.txt (include(${CMAKE_CURRENT_SOURCE_DIR}/tabletop.cmake)).
 add_executable(primlabel-bench-tabletop ${CMAKE_CURRENT_LIST_DIR}/tabletop_bench_main.cpp)
-target_link_libraries(primlabel-bench-tabletop PRIVATE primlabel::core CLI11::CLI11)
+target_link_libraries(primlabel-bench-tabletop PRIVATE primlabel::research CLI11::CLI11)
 
 if(PRIMLABEL_WITH_PCL)
   # As in bench/CMakeLists.txt: Debian 12's VTK config names MPI::MPI_C without finding MPI.
@@ -23,7 +23,7 @@ if(PCL_FOUND AND PCL_SEGMENTATION_FOUND AND PCL_SURFACE_FOUND)
   target_include_directories(primlabel_tabletop_pcl_peer PRIVATE ${PCL_INCLUDE_DIRS})
   target_compile_definitions(primlabel_tabletop_pcl_peer PRIVATE ${PCL_DEFINITIONS})
   target_link_libraries(primlabel_tabletop_pcl_peer PRIVATE ${PRIMLABEL_TABLETOP_PCL_LIBS}
-                        primlabel::core)
+                        primlabel::research)
   target_link_libraries(primlabel-bench-tabletop PRIVATE primlabel_tabletop_pcl_peer)
   target_compile_definitions(primlabel-bench-tabletop PRIVATE PRIMLABEL_HAVE_PCL=1)
 else()

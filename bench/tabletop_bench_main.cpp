@@ -12,7 +12,7 @@
 #include <limits>
 #include <sstream>
 
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/tabletop/segmentation_eval.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
 #ifdef PRIMLABEL_HAVE_PCL

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "allocation_guard.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "test_util.hpp"
 
 namespace primlabel::test {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "primlabel/core/point_cloud.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/model/label_model.hpp"
 
 namespace primlabel::testing {

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "primlabel/pipeline/training.hpp"
+#include "primlabel/synth/generate.hpp"
 
 namespace primlabel::testing {
 
@@ -16,7 +17,7 @@ inline LabelModel train_small_svm_model() {
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
   std::vector<pipeline::SceneData> train;
   train.push_back(pipeline::prepare_scene(
-      pipeline::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
+      synth::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
       features, graph, every_class, 2));
   const auto class_ids = pipeline::classes_present(train);
   pipeline::assign_labels(train.front(), class_ids);

@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "primlabel/core/cloud_io.hpp"
-#include "primlabel/core/features.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/features.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <numeric>
 
-#include "primlabel/core/cloud_io.hpp"
-#include "primlabel/core/features.hpp"
-#include "primlabel/core/normals.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/features.hpp"
+#include "primlabel/geometry/normals.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

@@ -4,11 +4,11 @@
 #include <limits>
 #include <stop_token>
 
-#include "primlabel/core/cancellation.hpp"
-#include "primlabel/core/neighbor_search.hpp"
+#include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/geometry/neighbor_search.hpp"
 #include "test_util.hpp"
 
-// As core/src/neighbor_search.cpp compiles it (ties lowest index first).
+// As core/geometry/src/search/neighbor_search.cpp compiles it (ties lowest index first).
 #define NANOFLANN_FIRST_MATCH
 #include <nanoflann.hpp>
 

@@ -3,8 +3,8 @@
 #include <cstring>
 #include <filesystem>
 
-#include "primlabel/core/cloud_io.hpp"
-#include "primlabel/core/normals.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/normals.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

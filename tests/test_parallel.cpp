@@ -6,9 +6,9 @@
 #include <atomic>
 #include <stdexcept>
 
-#include "parallel.hpp"
-#include "primlabel/core/features.hpp"
-#include "primlabel/core/normals.hpp"
+#include "primlabel/geometry/parallel.hpp"
+#include "primlabel/geometry/features.hpp"
+#include "primlabel/geometry/normals.hpp"
 
 namespace primlabel {
 namespace {

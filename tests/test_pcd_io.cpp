@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "cloud_io_test_util.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

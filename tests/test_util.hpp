@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "primlabel/core/point_cloud.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
 
 namespace primlabel::test {
 

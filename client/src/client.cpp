@@ -13,7 +13,7 @@
 #include "health_wire.hpp"
 #include "label_assembler.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
-#include "wire.hpp"
+#include "primlabel/wire/packing.hpp"
 
 namespace primlabel::client {
 

@@ -3,7 +3,7 @@
 #include <limits>
 #include <string>
 
-#include "wire.hpp"
+#include "primlabel/wire/packing.hpp"
 
 namespace primlabel::client {
 
@@ -34,7 +34,7 @@ void LabelAssembler::add(const v1::LabelChunk& chunk) {
   if (first > points_ || count > points_ - first)
     throw ProtocolError(at(first) + ": " + std::to_string(count) + " points run past the " +
                         std::to_string(points_) + " points sent");
-  if (chunk.labels().size() != wire::kLabelBytes * count)
+  if (chunk.labels().size() != wire::kLabelBytesPerPoint * count)
     throw ProtocolError(at(first) + ": " + std::to_string(chunk.labels().size()) +
                         " bytes of labels for " + std::to_string(count) + " points");
   for (std::uint64_t i = first; i < first + count; ++i)

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <map>
 
-#include "primlabel/core/taxonomy.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/wire/packing.hpp"
 
 namespace primlabel::server {

@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <optional>
 
-#include "primlabel/core/point_cloud.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/v1/labeling.pb.h"
 #include "service_error.hpp"
 

@@ -19,7 +19,7 @@
 
 #include "primlabel/client/client.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
-#include "wire.hpp"
+#include "primlabel/wire/packing.hpp"
 
 namespace primlabel::test {
 
@@ -82,7 +82,7 @@ class FakeLabeler final : public v1::Labeler::Service {
       } else if (request.has_chunk()) {
         if (!have_header) return {grpc::StatusCode::INVALID_ARGUMENT, "chunk before header"};
         ++chunks_received;
-        const auto xyz = client::wire::unpack_vec3(request.chunk().xyz());
+        const auto xyz = wire::unpack_vec3<Vec3f>(request.chunk().xyz());
         points.insert(points.end(), xyz.begin(), xyz.end());
       } else {
         break;  // EndOfScan
@@ -104,7 +104,7 @@ class FakeLabeler final : public v1::Labeler::Service {
                            v1::LabelCloudResponse* response) {
     ++label_calls;
     if (auto status = admit(context); !status.ok()) return status;
-    const auto points = client::wire::unpack_vec3(request->points().xyz());
+    const auto points = wire::unpack_vec3<Vec3f>(request->points().xyz());
     v1::ScanHeader header = request->header();
     header.mutable_options()->set_response_chunk_points(0xFFFFFFFFu);  // one chunk
     std::vector<v1::LabelResponse> responses;
@@ -192,11 +192,11 @@ class FakeLabeler final : public v1::Labeler::Service {
         for (int k = 0; k < kClasses; ++k)
           probabilities.push_back(labels[i] % kClasses == static_cast<std::uint32_t>(k));
       }
-      c.set_labels(client::wire::pack_u32(labels.data(), count));
+      c.set_labels(wire::pack_u32(labels.data(), count));
       if (header.options().return_descriptors())
-        c.set_descriptors(client::wire::pack_f32(descriptors.data(), descriptors.size()));
+        c.set_descriptors(wire::pack_f32(descriptors.data(), descriptors.size()));
       if (header.options().return_probabilities())
-        c.set_probabilities(client::wire::pack_f32(probabilities.data(), probabilities.size()));
+        c.set_probabilities(wire::pack_f32(probabilities.data(), probabilities.size()));
     }
     summary.set_scan_id(header.scan_id());
     summary.set_model("fake");

@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "fake_labeler.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

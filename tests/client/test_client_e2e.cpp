@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "primlabel/client/client.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "process.hpp"
 #include "random_label_model.hpp"

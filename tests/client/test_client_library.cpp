@@ -12,7 +12,7 @@
 #include "label_assembler.hpp"
 #include "primlabel/client/backoff.hpp"
 #include "primlabel/client/client.hpp"
-#include "wire.hpp"
+#include "primlabel/wire/packing.hpp"
 
 namespace primlabel {
 namespace {
@@ -51,34 +51,34 @@ ClientOptions fast_options(const std::string& address) {
 
 TEST(ClientWire, PacksLittleEndianFloatsPointMajor) {
   const std::vector<Vec3f> points{{1.0f, -2.0f, 0.5f}, {3.0f, 4.0f, 5.0f}};
-  const std::string bytes = client::wire::pack_vec3(points, 0, 2);
+  const std::string bytes = wire::pack_vec3(points, 0, 2);
   ASSERT_EQ(bytes.size(), 24u);
   // 1.0f = 0x3F800000, least significant byte first.
   EXPECT_EQ(bytes.substr(0, 4), std::string("\x00\x00\x80\x3F", 4));
   EXPECT_EQ(bytes.substr(4, 4), std::string("\x00\x00\x00\xC0", 4));  // -2.0f
-  const auto back = client::wire::unpack_vec3(bytes);
+  const auto back = wire::unpack_vec3<Vec3f>(bytes);
   ASSERT_EQ(back.size(), 2u);
   EXPECT_EQ(back[0], points[0]);
   EXPECT_EQ(back[1], points[1]);
-  EXPECT_EQ(client::wire::unpack_vec3(client::wire::pack_vec3(points, 1, 1))[0], points[1]);
+  EXPECT_EQ(wire::unpack_vec3<Vec3f>(wire::pack_vec3(points, 1, 1))[0], points[1]);
 }
 
 TEST(ClientWire, RejectsTruncatedXyzAndRangesPastTheEnd) {
-  EXPECT_THROW(client::wire::unpack_vec3(std::string(13, '\0')), std::invalid_argument);
+  EXPECT_THROW(wire::unpack_vec3<Vec3f>(std::string(13, '\0')), std::invalid_argument);
   std::vector<Vec3f> one(1, Vec3f::Zero());
-  EXPECT_THROW(client::wire::pack_vec3(one, 1, 1), std::out_of_range);
+  EXPECT_THROW(wire::pack_vec3(one, 1, 1), std::out_of_range);
 }
 
 TEST(ClientWire, Uint32AndNanRoundTrip) {
   const std::vector<std::uint32_t> labels{0, 1, 0xDEADBEEF};
-  const std::string bytes = client::wire::pack_u32(labels.data(), labels.size());
+  const std::string bytes = wire::pack_u32(labels.data(), labels.size());
   EXPECT_EQ(bytes.substr(8, 4), std::string("\xEF\xBE\xAD\xDE", 4));
   std::vector<std::uint32_t> back(3);
-  client::wire::unpack_u32(bytes, back.data());
+  wire::unpack_u32(bytes, back.data());
   EXPECT_EQ(back, labels);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   float out = 0;
-  client::wire::unpack_f32(client::wire::pack_f32(&nan, 1), &out);
+  wire::unpack_f32(wire::pack_f32(&nan, 1), &out);
   EXPECT_TRUE(std::isnan(out));
 }
 
@@ -129,10 +129,10 @@ v1::LabelChunk chunk(std::uint64_t first, std::uint32_t count, int descriptor_di
   c.set_point_count(count);
   std::vector<std::uint32_t> labels(count);
   for (std::uint32_t i = 0; i < count; ++i) labels[i] = static_cast<std::uint32_t>(first + i);
-  c.set_labels(client::wire::pack_u32(labels.data(), count));
+  c.set_labels(wire::pack_u32(labels.data(), count));
   if (descriptor_dim > 0) {
     std::vector<float> d(count * descriptor_dim, 1.0f);
-    c.set_descriptors(client::wire::pack_f32(d.data(), d.size()));
+    c.set_descriptors(wire::pack_f32(d.data(), d.size()));
   }
   return c;
 }

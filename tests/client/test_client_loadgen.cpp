@@ -10,7 +10,7 @@
 #include "loadgen/load_runner.hpp"
 #include "loadgen/report.hpp"
 #include "loadgen/server_counters.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "fake_labeler.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "process.hpp"
 #include "small_filesystem.hpp"
 #include "test_util.hpp"

@@ -5,7 +5,7 @@
 #include <random>
 #include <stop_token>
 
-#include "primlabel/core/cancellation.hpp"
+#include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/crf/graph.hpp"
 
 namespace primlabel::crf {

@@ -1,12 +1,12 @@
-// White-box: the CRF score loops of core/src/crf/potentials.cpp honour a stop token and give the
+// White-box: the CRF score loops of core/crf/src/potentials.cpp honour a stop token and give the
 // same values with a token that never stops.
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <stop_token>
 
-#include "crf/potentials.hpp"
-#include "primlabel/core/cancellation.hpp"
+#include "potentials.hpp"
+#include "primlabel/geometry/cancellation.hpp"
 #include "synthetic.hpp"
 
 namespace primlabel::crf {

@@ -5,8 +5,8 @@
 #include <fstream>
 #include <stop_token>
 
-#include "primlabel/core/cancellation.hpp"
-#include "primlabel/crf/svm_baseline.hpp"
+#include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/model/svm_baseline.hpp"
 #include "synthetic.hpp"
 #include "test_util.hpp"
 

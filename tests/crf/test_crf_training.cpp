@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "brute_force.hpp"
-#include "crf/objectives.hpp"  // white-box: the objectives behind train_crf
+#include "learning/objectives.hpp"  // white-box: the objectives behind train_crf
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
 #include "synthetic.hpp"

@@ -2,7 +2,7 @@
 // What every cloud a reader returns must satisfy, whatever the file said: one entry per point in
 // every attribute, and a shape that covers the points. A violation traps, so libFuzzer keeps it.
 
-#include "primlabel/core/point_cloud.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
 
 namespace primlabel::fuzz {
 

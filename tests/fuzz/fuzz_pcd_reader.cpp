@@ -7,7 +7,7 @@
 
 #include "cloud_invariants.hpp"
 #include "fuzz_file_input.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::string path = primlabel::fuzz::input_file(".pcd");

@@ -6,8 +6,8 @@
 #include <exception>
 
 #include "primlabel/client/client.hpp"
-#include "primlabel/core/normals.hpp"
-#include "primlabel/core/point_cloud.hpp"
+#include "primlabel/geometry/normals.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
 
 int main() {
   primlabel::PointCloud cloud;

@@ -48,4 +48,26 @@ log "build the consumer"
 
 log "run the consumer"
 "$tmp/build/robot_app"
+
+# What the robot's build must find: gRPC, protobuf and geometry's own dependencies, nothing of
+# libsvm, libpng, zlib or prometheus-cpp (the server's and the rest of core's).
+targets=$(find "$prefix" -name 'primlabelTargets*.cmake' -exec cat {} +)
+for forbidden in svm png PNG ZLIB prometheus server; do
+  if grep -q -- "$forbidden" <<<"$targets"; then
+    log "FAIL: the installed targets name '$forbidden'"
+    exit 1
+  fi
+done
+for proto in labeling.proto model.proto; do
+  [[ -f $prefix/include/primlabel/v1/$proto ]] || { log "FAIL: $proto not installed"; exit 1; }
+done
+
+log "build the consumer again with pkg-config (primlabel-client.pc), without CMake"
+pc=$(find "$prefix" -name primlabel-client.pc)
+[[ -n $pc ]] || { log "FAIL: no primlabel-client.pc under $prefix"; exit 1; }
+export PKG_CONFIG_PATH=$(dirname "$pc")
+# shellcheck disable=SC2046
+${cxx:-c++} -std=c++20 -O1 -o "$tmp/robot_app_pc" "$here/main.cpp" \
+  $(pkg-config --cflags --libs primlabel-client)
+"$tmp/robot_app_pc"
 log "OK"

@@ -6,7 +6,7 @@
 
 #include <functional>
 
-#include "primlabel/core/taxonomy.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/v1/model.pb.h"
 #include "test_util.hpp"

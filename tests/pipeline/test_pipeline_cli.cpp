@@ -10,9 +10,10 @@
 #include <fstream>
 
 #include "png_decode.hpp"
-#include "primlabel/core/features.hpp"
+#include "primlabel/geometry/features.hpp"
 #include "primlabel/pipeline/training.hpp"
-#include "primlabel/synth/labeled_cloud.hpp"
+#include "primlabel/synth/generate.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

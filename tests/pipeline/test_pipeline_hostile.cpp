@@ -11,7 +11,7 @@
 #include <string>
 #include <thread>
 
-#include "primlabel/core/taxonomy.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/pipeline/duplicates.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "proc_status.hpp"

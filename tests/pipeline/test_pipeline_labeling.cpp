@@ -12,6 +12,7 @@
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
+#include "primlabel/synth/generate.hpp"
 
 namespace primlabel {
 namespace {
@@ -32,7 +33,7 @@ Trained train_on_two_scenes() {
   std::vector<SceneData> train;
   for (int i = 0; i < 2; ++i)
     train.push_back(pipeline::prepare_scene(
-        pipeline::synthetic_scene(synth::SceneSet::kTrain, i, synth::SensorKind::kLms400), "train",
+        synth::synthetic_scene(synth::SceneSet::kTrain, i, synth::SensorKind::kLms400), "train",
         features, graph, every_class, 2));
   const auto class_ids = pipeline::classes_present(train);
   for (SceneData& s : train) pipeline::assign_labels(s, class_ids);
@@ -41,7 +42,7 @@ Trained train_on_two_scenes() {
   options.iterations = 100;
   options.threads = 2;
   return {pipeline::train_label_model(train, {}, class_ids, features, graph, options).model,
-          pipeline::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400)};
+          synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400)};
 }
 
 double accuracy(const LabelModel& model, const PointCloud& truth,
@@ -70,7 +71,7 @@ LabelModel zero_model() {
 
 PointCloud small_scene() {
   PointCloud scene =
-      pipeline::synthetic_scene(synth::SceneSet::kTest, 1, synth::SensorKind::kLms400);
+      synth::synthetic_scene(synth::SceneSet::kTest, 1, synth::SensorKind::kLms400);
   return scene;
 }
 
@@ -135,10 +136,10 @@ TEST(PipelineLabeling, PiecewiseCrfTrainingKeepsTheCouplingThatValidatesBest) {
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
   std::vector<SceneData> train, validation;
   train.push_back(pipeline::prepare_scene(
-      pipeline::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
+      synth::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
       features, graph, every_class, 2));
   validation.push_back(pipeline::prepare_scene(
-      pipeline::synthetic_scene(synth::SceneSet::kVal, 0, synth::SensorKind::kLms400), "val",
+      synth::synthetic_scene(synth::SceneSet::kVal, 0, synth::SensorKind::kLms400), "val",
       features, graph, every_class, 2));
   const auto class_ids = pipeline::classes_present(train);
   pipeline::assign_labels(train[0], class_ids);

@@ -7,9 +7,9 @@
 #include <filesystem>
 
 #include "png_decode.hpp"
-#include "primlabel/core/cloud_io.hpp"
-#include "primlabel/core/features.hpp"
-#include "primlabel/pipeline/mosd_report.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/features.hpp"
+#include "primlabel/research/mosd_report.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -35,8 +35,8 @@ TEST(PipelineMosd, ReportCountsTablePointsAndDrawsTheScene) {
   test::TempDir dir;
   pipeline::LabelingOptions options;
   options.threads = 2;
-  const pipeline::MosdSceneReport scene =
-      pipeline::report_mosd_scene(zero_model(), path, dir.file("learn0.png"), options);
+  const research::MosdSceneReport scene =
+      research::report_mosd_scene(zero_model(), path, dir.file("learn0.png"), options);
   EXPECT_GT(scene.table_points, 100000u);  // learn0: 153,323 table points
   EXPECT_GT(scene.object_points, 10000u);
   EXPECT_LE(scene.table_points + scene.object_points, scene.points);
@@ -51,12 +51,12 @@ TEST(PipelineMosd, ReportCountsTablePointsAndDrawsTheScene) {
   EXPECT_EQ(png.height, 720);
   EXPECT_GT(png.distinct_colors(), 8u);
 
-  const pipeline::MosdReport report = pipeline::summarize_mosd({scene, scene});
+  const research::MosdReport report = research::summarize_mosd({scene, scene});
   EXPECT_EQ(report.table_points, 2 * scene.table_points);
   EXPECT_DOUBLE_EQ(report.plane_share(), share);
-  const std::string json = pipeline::mosd_report_json(report);
+  const std::string json = research::mosd_report_json(report);
   EXPECT_NE(json.find("\"plane_share\":"), std::string::npos) << json;
-  EXPECT_NE(pipeline::mosd_report_text(report).find("overall"), std::string::npos);
+  EXPECT_NE(research::mosd_report_text(report).find("overall"), std::string::npos);
 }
 
 TEST(PipelineMosd, SceneWithoutLabelsIsAClearError) {
@@ -64,7 +64,7 @@ TEST(PipelineMosd, SceneWithoutLabelsIsAClearError) {
   PointCloud cloud = test::plane_grid(0, 0, 0.1f, 0.01f);
   write_cloud(dir.file("plain.pcd"), cloud);
   try {
-    pipeline::report_mosd_scene(zero_model(), dir.file("plain.pcd"), "");
+    research::report_mosd_scene(zero_model(), dir.file("plain.pcd"), "");
     FAIL() << "accepted a cloud without labels";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("plain.pcd: no label field"), std::string::npos)

@@ -7,9 +7,9 @@
 #include <fstream>
 
 #include "png_decode.hpp"
-#include "primlabel/core/taxonomy.hpp"
-#include "primlabel/pipeline/confusion_plot.hpp"
-#include "primlabel/pipeline/fig4.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/research/confusion_plot.hpp"
+#include "primlabel/research/fig4.hpp"
 #include "primlabel/render/heatmap.hpp"
 #include "test_util.hpp"
 
@@ -33,7 +33,7 @@ std::size_t count_color(const test::Decoded& png, std::uint32_t rgb) {
 TEST(PipelinePlots, ConfusionPngShowsSharesCountsAndNames) {
   test::TempDir dir;
   const crf::ConfusionMatrix confusion = sample_confusion();
-  pipeline::write_confusion_png(dir.file("c.png"), confusion,
+  research::write_confusion_png(dir.file("c.png"), confusion,
                                 {"plane", "cylinder-convex", "edge-convex"}, "scene");
   const test::Decoded png = test::decode_png(dir.file("c.png"));
   ASSERT_GT(png.width, 0) << "does not decode";
@@ -53,20 +53,20 @@ TEST(PipelinePlots, ConfusionPngShowsSharesCountsAndNames) {
   // Predictions outside the classes add an "other" column.
   crf::ConfusionMatrix with_other = confusion;
   with_other.add(2, 0, 5);
-  pipeline::write_confusion_png(dir.file("o.png"), with_other, {}, "");
+  research::write_confusion_png(dir.file("o.png"), with_other, {}, "");
   EXPECT_GT(test::decode_png(dir.file("o.png")).width, png.width / 2);
-  EXPECT_THROW(pipeline::write_confusion_png("/nonexistent/dir/c.png", confusion, {}),
+  EXPECT_THROW(research::write_confusion_png("/nonexistent/dir/c.png", confusion, {}),
                std::runtime_error);
 }
 
 TEST(PipelinePlots, HikDistanceIsZeroForEqualAndOneForDisjointHistograms) {
   const std::vector<double> a{50, 50, 0, 0}, b{0, 0, 50, 50}, c{50, 0, 50, 0}, half{25, 25, 0, 0};
-  EXPECT_DOUBLE_EQ(pipeline::hik_distance(a, a), 0.0);
-  EXPECT_DOUBLE_EQ(pipeline::hik_distance(a, b), 1.0);
-  EXPECT_DOUBLE_EQ(pipeline::hik_distance(a, c), 0.5);
-  EXPECT_DOUBLE_EQ(pipeline::hik_distance(c, a), 0.5);
-  EXPECT_DOUBLE_EQ(pipeline::hik_distance(a, half), 0.0);  // normalised by the smaller mass
-  EXPECT_DOUBLE_EQ(pipeline::hik_distance(std::vector<double>(4, 0.0), std::vector<double>(4, 0.0)),
+  EXPECT_DOUBLE_EQ(research::hik_distance(a, a), 0.0);
+  EXPECT_DOUBLE_EQ(research::hik_distance(a, b), 1.0);
+  EXPECT_DOUBLE_EQ(research::hik_distance(a, c), 0.5);
+  EXPECT_DOUBLE_EQ(research::hik_distance(c, a), 0.5);
+  EXPECT_DOUBLE_EQ(research::hik_distance(a, half), 0.0);  // normalised by the smaller mass
+  EXPECT_DOUBLE_EQ(research::hik_distance(std::vector<double>(4, 0.0), std::vector<double>(4, 0.0)),
                    0.0);
 }
 
@@ -76,10 +76,10 @@ std::string read_text(const std::string& path) {
 }
 
 TEST(PipelinePlots, Fig4OnOneSyntheticSceneIsAProperDistanceMatrix) {
-  pipeline::Fig4Options options;
+  research::Fig4Options options;
   options.scenes = 1;
   options.threads = 2;
-  const pipeline::Fig4 fig4 = pipeline::run_fig4(options);
+  const research::Fig4 fig4 = research::run_fig4(options);
   const auto& ids = fig4.signatures.class_ids;
   const auto index_of = [&](PrimitiveClass c) {
     return Eigen::Index(std::find(ids.begin(), ids.end(), class_id(c)) - ids.begin());
@@ -105,7 +105,7 @@ TEST(PipelinePlots, Fig4OnOneSyntheticSceneIsAProperDistanceMatrix) {
 
   test::TempDir dir;
   const std::string out = dir.file("fig4");
-  pipeline::write_fig4(fig4, out);
+  research::write_fig4(fig4, out);
   const std::string signatures = read_text(out + "/fig4_signatures.csv");
   EXPECT_EQ(signatures.rfind("class,bin0,bin1,", 0), 0u);
   EXPECT_NE(signatures.find(",bin32\nplane,"), std::string::npos);

@@ -9,7 +9,7 @@
 #include <stop_token>
 #include <thread>
 
-#include "primlabel/core/normals.hpp"
+#include "primlabel/geometry/normals.hpp"
 #include "primlabel/pipeline/duplicates.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/tabletop/voxel_grid.hpp"

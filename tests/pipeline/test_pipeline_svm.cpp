@@ -9,6 +9,7 @@
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/svm_model.hpp"
 #include "primlabel/pipeline/training.hpp"
+#include "primlabel/synth/generate.hpp"
 #include "small_svm_model.hpp"
 #include "test_util.hpp"
 
@@ -18,7 +19,7 @@ namespace {
 // A strip of a held-out LMS400 scene (its first sweep lines): small enough to label quickly.
 PointCloud small_scene() {
   PointCloud scene =
-      pipeline::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400);
+      synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400);
   const std::size_t keep = 20000;
   scene.xyz.resize(keep);
   scene.labels.resize(keep);

@@ -4,8 +4,8 @@
 
 #include <functional>
 
-#include "primlabel/core/cloud_io.hpp"
-#include "primlabel/synth/labeled_cloud.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

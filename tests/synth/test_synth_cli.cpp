@@ -9,9 +9,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "primlabel/core/cloud_io.hpp"
-#include "primlabel/core/taxonomy.hpp"
-#include "primlabel/synth/labeled_cloud.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "primlabel/core/neighbor_search.hpp"
+#include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/synth/generate.hpp"
 #include "primlabel/synth/scanners.hpp"
 

@@ -4,7 +4,7 @@
 
 #include <set>
 
-#include "primlabel/core/taxonomy.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "../test_util.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <filesystem>
 
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/tabletop/segmentation_eval.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
 

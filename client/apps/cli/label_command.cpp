@@ -10,7 +10,7 @@
 #include "commands.hpp"
 #include "common/labeled_output.hpp"
 #include "exit_codes.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel::client::tools {
 

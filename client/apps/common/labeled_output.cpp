@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <map>
 
-#include "primlabel/core/taxonomy.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/render/colorize.hpp"
 #include "primlabel/render/render.hpp"
 

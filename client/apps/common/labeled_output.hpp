@@ -6,7 +6,7 @@
 #include <string>
 
 #include "primlabel/client/client.hpp"
-#include "primlabel/core/point_cloud.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
 
 namespace primlabel::client::tools {
 

@@ -12,7 +12,7 @@
 #include "common/client_flags.hpp"
 #include "load_runner.hpp"
 #include "primlabel/build_version.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/synth/generate.hpp"
 #include "report.hpp"
 

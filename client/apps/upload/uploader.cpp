@@ -4,7 +4,7 @@
 #include <future>
 
 #include "common/labeled_output.hpp"
-#include "primlabel/core/cloud_io.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel::client::upload {
 

@@ -1,0 +1,176 @@
+#include "primlabel/crf/inference.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "primlabel/geometry/parallel.hpp"
+#include "inference/loopy_bp.hpp"
+#include "inference/mean_field.hpp"
+#include "potentials.hpp"
+#include "primlabel/geometry/cancellation.hpp"
+
+namespace primlabel::crf {
+
+struct InferenceWorkspace::Buffers {
+  detail::ScratchBuffer<float> theta;       // node scores, num_nodes x kp
+  detail::ScratchBuffer<float> phi;         // node potentials (BP)
+  detail::ScratchBuffer<float> edge_terms;  // per undirected edge: psi - 1 (BP) or theta (MF)
+  detail::ScratchBuffer<std::uint32_t> edge_of, block_first_edge;
+  detail::FastBpBuffers bp;
+  detail::MeanFieldBuffers mf;
+
+  std::size_t bytes() const {
+    return theta.bytes() + phi.bytes() + edge_terms.bytes() + edge_of.bytes() +
+           block_first_edge.bytes() + bp.messages.bytes() + bp.next.bytes() + bp.beliefs.bytes() +
+           bp.moved.bytes() * 3 + mf.q.bytes() + mf.next.bytes() + mf.moved.bytes() * 3;
+  }
+};
+
+InferenceWorkspace::InferenceWorkspace() = default;
+InferenceWorkspace::~InferenceWorkspace() = default;
+InferenceWorkspace::InferenceWorkspace(InferenceWorkspace&&) noexcept = default;
+InferenceWorkspace& InferenceWorkspace::operator=(InferenceWorkspace&&) noexcept = default;
+std::size_t InferenceWorkspace::bytes() const { return buffers_ ? buffers_->bytes() : 0; }
+void InferenceWorkspace::release() { buffers_.reset(); }
+
+namespace {
+
+// Labels and marginals from per-node scores on the padded layout: `rows` holds log-scores
+// (softmax for the marginals) or probabilities (normalised again in double).
+void outputs_from_rows(const float* rows, bool log_scores, const CrfModel& model,
+                       const Graph& graph, const InferenceOptions& options, int threads,
+                       InferenceResult& result) {
+  const long long n = static_cast<long long>(graph.num_nodes());
+  const int k_count = model.num_classes();
+  const int kp = detail::padded_classes(k_count);
+  float* marginals = options.compute_marginals ? result.marginals.data() : nullptr;
+  primlabel::detail::ExceptionBarrier barrier;
+#pragma omp parallel num_threads(threads)
+  {
+    std::vector<double> p(k_count);
+#pragma omp for schedule(static)
+    for (long long i = 0; i < n; ++i)
+      barrier.run([&] {
+        if (!graph.active[i]) {
+          result.labels[i] = options.unknown_label;
+          if (marginals)
+            for (int k = 0; k < k_count; ++k)
+              marginals[std::size_t(k) * n + i] = std::numeric_limits<float>::quiet_NaN();
+          return;
+        }
+        const float* row = rows + std::size_t(i) * kp;
+        int best = 0;  // first maximum: ties go to the lower class index
+        for (int k = 1; k < k_count; ++k)
+          if (row[k] > row[best]) best = k;
+        result.labels[i] = model.class_ids[best];
+        if (!marginals) return;
+        double sum = 0.0;
+        for (int k = 0; k < k_count; ++k)
+          sum += (p[k] = log_scores ? std::exp(double(row[k]) - row[best]) : double(row[k]));
+        for (int k = 0; k < k_count; ++k)
+          marginals[std::size_t(k) * n + i] = static_cast<float>(p[k] / sum);
+      });
+  }
+  barrier.rethrow();
+}
+
+// phi_i(k) = exp(theta_i(k) - max_k theta_i(k)), pads 0.
+void node_potentials_padded(const float* theta, std::size_t n, int k_count, int threads,
+                            float* phi) {
+  const int kp = detail::padded_classes(k_count);
+  const long long count = static_cast<long long>(n);
+  primlabel::detail::ExceptionBarrier barrier;
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (long long i = 0; i < count; ++i)
+    barrier.run([&] {
+      const Eigen::Map<const Eigen::ArrayXf> t(theta + i * kp, k_count);
+      Eigen::Map<Eigen::ArrayXf> out(phi + i * kp, kp);
+      out.head(k_count) = (t - t.maxCoeff()).exp();
+      out.tail(kp - k_count).setZero();
+    });
+  barrier.rethrow();
+}
+
+}  // namespace
+
+InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
+                      const InferenceOptions& options) {
+  InferenceWorkspace workspace;
+  return infer(model, descriptors, graph, options, workspace);
+}
+
+InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
+                      const InferenceOptions& options, InferenceWorkspace& workspace) {
+  detail::check_shapes(model, descriptors, graph);
+  if (options.max_iterations < 0) throw std::invalid_argument("infer: max_iterations < 0");
+  if (!(options.damping >= 0.0f && options.damping < 1.0f))
+    throw std::invalid_argument("infer: damping must be in [0, 1)");
+  if (!workspace.buffers_) workspace.buffers_ = std::make_unique<InferenceWorkspace::Buffers>();
+  InferenceWorkspace::Buffers& ws = *workspace.buffers_;
+  const std::size_t n = graph.num_nodes();
+  const int k_count = model.num_classes();
+  const int kp = detail::padded_classes(k_count);
+  const int threads = detail::useful_threads(options.threads, n);
+  InferenceResult result;
+  result.labels.resize(n);
+  if (options.compute_marginals) result.marginals.resize(static_cast<Eigen::Index>(n), k_count);
+
+  throw_if_stopped(options.stop, "inference");
+  float* theta = ws.theta.resize(n * kp);
+  detail::node_scores_padded(model, descriptors, graph, threads, theta, options.stop);
+  if (!model.has_edge_terms() || graph.num_slots() == 0) {
+    // No coupling: the marginals are the per-node softmax and the MAP is the per-node argmax.
+    outputs_from_rows(theta, true, model, graph, options, threads, result);
+    result.converged = true;
+    return result;
+  }
+
+  const std::size_t edges =
+      detail::number_edges(graph, threads, ws.edge_of, ws.block_first_edge, options.stop);
+  float* edge_terms = ws.edge_terms.resize(edges * kp);
+  detail::BpSettings settings;
+  settings.max_product = options.max_product;
+  settings.max_iterations = options.max_iterations;
+  settings.damping = options.damping;
+  settings.tolerance = options.tolerance;
+  settings.threads = threads;
+  settings.stop = options.stop;
+  throw_if_stopped(options.stop, "inference");
+  detail::BpRun run;
+  if (options.method == InferenceMethod::kMeanField) {
+    detail::edge_terms_padded(model, descriptors, graph, ws.block_first_edge.data(), threads, false,
+                              edge_terms, options.stop);
+    detail::MeanFieldProblem problem;
+    problem.graph = &graph;
+    problem.classes = k_count;
+    problem.node_scores = theta;
+    problem.edge_scores = edge_terms;
+    problem.edge_of = ws.edge_of.data();
+    run = detail::run_mean_field(problem, settings, ws.mf);
+    throw_if_stopped(options.stop, "inference");
+    outputs_from_rows(ws.mf.q.data(), false, model, graph, options, threads, result);
+  } else {
+    detail::edge_terms_padded(model, descriptors, graph, ws.block_first_edge.data(), threads, true,
+                              edge_terms, options.stop);
+    float* phi = ws.phi.resize(n * kp);
+    node_potentials_padded(theta, n, k_count, threads, phi);
+    detail::FastBpProblem problem;
+    problem.graph = &graph;
+    problem.classes = k_count;
+    problem.phi = phi;
+    problem.psi_minus_one = edge_terms;
+    problem.edge_of = ws.edge_of.data();
+    run = detail::run_fast_bp(problem, settings, ws.bp);
+    throw_if_stopped(options.stop, "inference");
+    detail::fast_bp_outputs(problem, ws.bp, model.class_ids, options.unknown_label, threads,
+                            result.labels.data(),
+                            options.compute_marginals ? result.marginals.data() : nullptr);
+  }
+  result.iterations = run.iterations;
+  result.converged = run.converged;
+  result.final_change = run.final_change;
+  return result;
+}
+
+}  // namespace primlabel::crf

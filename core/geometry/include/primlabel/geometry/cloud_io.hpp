@@ -1,0 +1,41 @@
+#pragma once
+// Reading and writing point clouds: PCD v0.7 (ascii, binary, binary_compressed) and PLY (ascii,
+// binary_little_endian; binary_big_endian is read too). Errors are reported as IoError whose
+// message starts with the file path and says what is wrong with it. Writes are atomic (a
+// temporary file in the same directory renamed over the target).
+//
+// Field mapping (PCD field / PLY vertex property -> PointCloud):
+//   x y z -> xyz (required); normal_x normal_y normal_z (PLY: nx ny nz) -> normals;
+//   curvature -> curvature; label -> labels (must be integers in 0..2^32-1);
+//   PCD rgb/rgba (4 bytes, bit pattern kept) or PLY red green blue [alpha] uchar -> rgba;
+//   anything else -> a FloatField (PCD keeps COUNT; PLY name_0..name_k runs form one field).
+//   PCD "_" padding fields are skipped. PLY clouds are read as one row (height 1).
+
+#include <stdexcept>
+#include <string>
+
+#include "primlabel/geometry/point_cloud.hpp"
+
+namespace primlabel {
+
+class IoError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class PcdEncoding { kAscii, kBinary, kBinaryCompressed };
+enum class PlyEncoding { kAscii, kBinaryLittleEndian };
+
+PointCloud read_pcd(const std::string& path);
+void write_pcd(const std::string& path, const PointCloud& cloud,
+               PcdEncoding encoding = PcdEncoding::kBinaryCompressed);
+
+PointCloud read_ply(const std::string& path);
+void write_ply(const std::string& path, const PointCloud& cloud,
+               PlyEncoding encoding = PlyEncoding::kBinaryLittleEndian);
+
+// Dispatch on the extension (.pcd / .ply, case-insensitive); anything else is an IoError.
+PointCloud read_cloud(const std::string& path);
+void write_cloud(const std::string& path, const PointCloud& cloud);
+
+}  // namespace primlabel

@@ -1,0 +1,65 @@
+#pragma once
+// Point Feature Histograms (Rusu et al.): FPFH (33 bins) and PFH (125 bins), computed exactly as
+// PCL 1.13 computes them so descriptors are interchangeable with PCL's.
+//
+// Defined behaviour for bad input: a point with non-finite coordinates or normal gets an all-NaN
+// descriptor. A point with no usable neighbour but itself gets an all-zero descriptor, as in PCL
+// (every sub-histogram of a valid descriptor sums to 100, so it is easy to tell apart). Neighbours
+// with non-finite normals are left out of every histogram (PCL would bin their NaN angles into
+// bin 0).
+
+#include <cstddef>
+#include <stop_token>
+#include <vector>
+
+#include "primlabel/geometry/neighbor_search.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/geometry/progress.hpp"
+
+namespace primlabel {
+
+inline constexpr int kFpfhBinsPerFeature = 11;
+inline constexpr int kFpfhSize = 3 * kFpfhBinsPerFeature;  // 33
+inline constexpr int kPfhBinsPerFeature = 5;
+inline constexpr int kPfhSize = 125;  // 5^3
+
+enum class FpfhVariant {
+  kPcl,          // PCL: weighted sum of the neighbours' SPFHs only
+  kWithOwnSpfh,  // the paper's formula as Open3D implements it: PCL's result + the point's own SPFH
+};
+
+struct FeatureOptions {
+  Neighborhood neighborhood = Neighborhood::Knn(10);
+  FpfhVariant fpfh_variant = FpfhVariant::kPcl;
+  int threads = 0;  // 0 = OpenMP default
+  // FPFH keeps each point's neighbour list between its two passes up to this many bytes (4 per
+  // neighbour); points beyond it are searched twice. Results do not depend on it.
+  std::size_t neighbor_cache_bytes = std::size_t(1) << 30;
+  ProgressFn progress;
+  // Once stopped, the remaining blocks of points are skipped and the function throws Cancelled.
+  std::stop_token stop;
+};
+
+struct FeatureStats {
+  std::size_t computed = 0;  // points with a histogram from at least one neighbour
+  std::size_t isolated = 0;  // valid points with no neighbour: all-zero descriptor
+  std::size_t nan = 0;       // invalid points or normals: NaN descriptor
+};
+
+// Row-major size() x 33. Requires cloud.normals.
+std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
+                                FeatureStats* stats = nullptr,
+                                const NeighborSearch* search = nullptr);
+
+// Row-major size() x 125. Requires cloud.normals.
+std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& options,
+                               FeatureStats* stats = nullptr,
+                               const NeighborSearch* search = nullptr);
+
+// The four pair features of (p1, n1) and (p2, n2) as pcl::computePairFeatures defines them:
+// f1 = alpha (theta in the Darboux frame, atan2), f2 = phi, f3 = theta (cosines), f4 = distance.
+// Returns false (all zero) for coincident points or a degenerate frame.
+bool compute_pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2,
+                           float& f1, float& f2, float& f3, float& f4);
+
+}  // namespace primlabel

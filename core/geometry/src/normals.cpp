@@ -1,0 +1,113 @@
+#include "primlabel/geometry/normals.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <atomic>
+#include <limits>
+#include <stdexcept>
+
+#include "primlabel/geometry/parallel.hpp"
+#include "primlabel/geometry/cancellation.hpp"
+
+namespace primlabel {
+
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// Plane normal and surface variation of one neighbourhood. The covariance is accumulated in
+// double around the query point (shifting keeps the sums small and the result accurate).
+bool fit_normal(const std::vector<Vec3f>& xyz, const Vec3f& query, const NeighborList& neighbors,
+                Vec3f& normal, float& curvature) {
+  const std::size_t n = neighbors.size();
+  if (n < 3) return false;
+  double sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
+  for (std::uint32_t index : neighbors.indices) {
+    const Vec3f& p = xyz[index];
+    const double x = double(p.x()) - query.x(), y = double(p.y()) - query.y(),
+                 z = double(p.z()) - query.z();
+    sx += x, sy += y, sz += z;
+    sxx += x * x, sxy += x * y, sxz += x * z, syy += y * y, syz += y * z, szz += z * z;
+  }
+  const double inv_n = 1.0 / double(n);
+  const double mx = sx * inv_n, my = sy * inv_n, mz = sz * inv_n;
+  Eigen::Matrix3d cov;
+  cov(0, 0) = sxx * inv_n - mx * mx;
+  cov(0, 1) = sxy * inv_n - mx * my;
+  cov(0, 2) = sxz * inv_n - mx * mz;
+  cov(1, 1) = syy * inv_n - my * my;
+  cov(1, 2) = syz * inv_n - my * mz;
+  cov(2, 2) = szz * inv_n - mz * mz;
+  cov(1, 0) = cov(0, 1);
+  cov(2, 0) = cov(0, 2);
+  cov(2, 1) = cov(1, 2);
+
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(cov);
+  const Eigen::Vector3d lambda = solver.eigenvalues();  // ascending
+  const double trace = cov.trace();
+  if (!(trace > 0.0)) return false;  // all neighbours coincide: no plane
+  normal = solver.eigenvectors().col(0).cast<float>();
+  curvature = static_cast<float>(std::max(lambda(0), 0.0) / trace);
+  return is_finite(normal);
+}
+
+}  // namespace
+
+NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
+                             const NeighborSearch* search) {
+  if (!options.neighborhood.valid())
+    throw std::invalid_argument("normal estimation: invalid neighbourhood " +
+                                options.neighborhood.describe());
+  std::unique_ptr<NeighborSearch> own_search;
+  if (!search) {
+    own_search = std::make_unique<NeighborSearch>(cloud.xyz, options.stop);
+    search = own_search.get();
+  }
+  const Vec3f viewpoint = options.viewpoint.value_or(cloud.viewpoint.origin);
+  const std::size_t n = cloud.size();
+  detail::assign_checked(cloud.normals, n, Vec3f(Vec3f::Constant(kNaN)), options.stop,
+                         "normal estimation");
+  detail::assign_checked(cloud.curvature, n, kNaN, options.stop, "normal estimation");
+
+  std::atomic<std::size_t> estimated{0}, too_few{0}, invalid_input{0};
+  detail::ProgressCounter progress(options.progress, n);
+  const int threads = detail::resolve_threads(options.threads);
+  constexpr std::size_t kBlock = 256;
+  const auto blocks = static_cast<std::ptrdiff_t>((n + kBlock - 1) / kBlock);
+  const auto make_scratch = [] { return NeighborList(); };
+  detail::for_each_block(
+      threads, blocks, options.stop, make_scratch,
+      [&](NeighborList& neighbors, std::ptrdiff_t block) {
+        std::size_t block_estimated = 0, block_too_few = 0, block_invalid = 0;
+        const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+        for (std::size_t i = first; i < last; ++i) {
+          // Checked per point: a stop is then honoured within one (capped) neighbourhood's time.
+          if (options.stop.stop_requested()) return;
+          const Vec3f& p = cloud.xyz[i];
+          if (!is_finite(p)) {
+            ++block_invalid;
+            continue;
+          }
+          search->find(p, options.neighborhood, neighbors, /*sorted=*/false);
+          Vec3f normal;
+          float curvature;
+          if (fit_normal(cloud.xyz, p, neighbors, normal, curvature)) {
+            // Face the sensor, as PCL's flipNormalTowardsViewpoint does.
+            if ((viewpoint - p).dot(normal) < 0.0f) normal = -normal;
+            cloud.normals[i] = normal;
+            cloud.curvature[i] = curvature;
+            ++block_estimated;
+          } else {
+            ++block_too_few;
+          }
+        }
+        estimated += block_estimated, too_few += block_too_few, invalid_input += block_invalid;
+        progress.add(last - first);
+      });
+  throw_if_stopped(options.stop, "normal estimation");
+  progress.finish();
+  return NormalStats{estimated.load(), too_few.load(), invalid_input.load()};
+}
+
+}  // namespace primlabel

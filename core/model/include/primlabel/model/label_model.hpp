@@ -1,0 +1,100 @@
+#pragma once
+// A trained labeling model as the tools and the service use it, and its file. Everything needed to
+// label a cloud travels in the file: class list, how descriptors are computed, the CRF graph, the
+// weights, inference settings, and where the model came from and how well it did.
+//
+// File layout: the 16-byte magic "PRIMLABEL-MODEL\n", then a primlabel.v1.ModelEnvelope
+// (api/primlabel/v1/model.proto) holding the format version and a CRC-32 of the serialised
+// primlabel.v1.Model. A file that is not a model, truncated, corrupt, from a newer format or
+// inconsistent with itself is rejected with a ModelError naming the file and the reason.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "primlabel/geometry/features.hpp"
+#include "primlabel/crf/graph.hpp"
+#include "primlabel/crf/inference.hpp"
+#include "primlabel/crf/model.hpp"
+
+namespace primlabel {
+
+inline constexpr std::uint32_t kModelFormatVersion = 1;
+
+class ModelError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class ModelKind { kCrf, kNodeOnly, kSvm };
+enum class DescriptorKind { kFpfh, kPfh };
+
+// How a cloud is described before labeling; the labels are only meaningful for the same settings.
+struct FeatureSettings {
+  DescriptorKind descriptor = DescriptorKind::kFpfh;
+  FpfhVariant fpfh_variant = FpfhVariant::kPcl;
+  Neighborhood normals = Neighborhood::Radius(0.01f);
+  Neighborhood features = Neighborhood::Radius(0.025f);
+  float voxel_size = 0.0f;         // downsampling before features; 0 = none
+  bool radii_overridable = false;  // whether a request may change the radii
+
+  int descriptor_dim() const { return descriptor == DescriptorKind::kFpfh ? kFpfhSize : kPfhSize; }
+};
+
+struct ClassScore {
+  double precision = 0, recall = 0, f1 = 0;
+  std::uint64_t support = 0;
+};
+
+struct TrainingSummary {
+  std::vector<std::string> sources;
+  std::uint64_t scenes = 0, points = 0;
+  std::vector<std::uint64_t> class_points;  // per model class
+  std::string objective;
+  double l2 = 0;
+  std::uint32_t iterations = 0;
+  double seconds = 0;
+};
+
+struct EvaluationSummary {
+  std::uint64_t points = 0;
+  double accuracy = 0;
+  std::vector<ClassScore> per_class;  // per model class
+};
+
+struct LabelModel {
+  std::string name;
+  std::string version;
+  ModelKind kind = ModelKind::kCrf;
+  FeatureSettings features;
+  crf::GraphOptions graph;
+  crf::CrfModel weights;  // kCrf, kNodeOnly (class_ids are the model's classes)
+  // kSvm: libsvm's text model (crf::SvmClassifier::to_libsvm_text; its labels index
+  // svm_class_ids), the classes, and weights.feature_scale as the SVM's feature scale.
+  std::string svm_model;
+  std::vector<std::uint32_t> svm_class_ids;
+  crf::InferenceOptions inference;
+  TrainingSummary training;
+  EvaluationSummary validation;
+  std::int64_t created_unix_ms = 0;
+  std::string created_by;
+
+  // Taxonomy ids of the classes this model predicts, in weight-row order.
+  const std::vector<std::uint32_t>& class_ids() const {
+    return kind == ModelKind::kSvm ? svm_class_ids : weights.class_ids;
+  }
+  // Throws ModelError (prefixed with `source`) when the parts do not fit together (for kSvm: when
+  // the libsvm text does not parse or does not fit the classes and descriptor).
+  void validate(const std::string& source = "model") const;
+};
+
+// Serialised file bytes, and back. `source` names the origin in error messages.
+std::string serialize_model(const LabelModel& model);
+LabelModel parse_model(const std::string& bytes, const std::string& source);
+
+// Writes atomically (temporary file + rename); reads with the checks above.
+void save_model(const std::string& path, const LabelModel& model);
+LabelModel load_model(const std::string& path);
+
+}  // namespace primlabel

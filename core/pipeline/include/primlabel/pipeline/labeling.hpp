@@ -1,0 +1,110 @@
+#pragma once
+// The glue from a point cloud to per-point primitive labels: normals and descriptors with a
+// model's feature settings, the CRF's neighbourhood graph, training scenes from labeled clouds,
+// and labeling a cloud with a trained LabelModel.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <stop_token>
+#include <vector>
+
+#include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/geometry/neighbor_search.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/crf/graph.hpp"
+#include "primlabel/crf/training.hpp"
+#include "primlabel/model/label_model.hpp"
+
+namespace primlabel::pipeline {
+
+// Normals (written into the cloud) and descriptors of every point, plus the neighbour index that
+// computed them so the graph can reuse it. `search` indexes cloud.xyz: keep the cloud alive and
+// unmoved while it is used.
+struct DescribedCloud {
+  std::vector<float> descriptors;  // row-major cloud.size() x descriptor_dim; NaN rows = invalid
+  int descriptor_dim = 0;
+  std::unique_ptr<NeighborSearch> search;
+  double normal_seconds = 0, feature_seconds = 0;
+};
+
+// Thrown by describe_cloud and label_cloud when their stop token is requested.
+using Cancelled = primlabel::Cancelled;
+
+// A radius neighbourhood without a cap (max_neighbors 0) gets this one wherever the pipeline
+// describes a cloud or builds its graph, for training and labeling alike: the nearest 1024 within
+// the radius. Each point then costs a bounded amount whatever the input (points packed into a
+// millimetre cost O(n * 1024), not O(n^2)). The default LMS400 scenes have at most 628 points
+// within the 25 mm feature radius (111 within 10 mm), so their features are unchanged.
+inline constexpr int kDefaultMaxNeighbors = 1024;
+// `hood` with kDefaultMaxNeighbors when it is a radius neighbourhood without a cap; a model's own
+// cap and k-nearest neighbourhoods are kept.
+Neighborhood capped(const Neighborhood& hood);
+
+struct DescribeOptions {
+  int threads = 0;  // 0 = OpenMP default
+  // Keep cloud.normals (one per point, e.g. from the sensor) instead of estimating them.
+  bool use_cloud_normals = false;
+  std::stop_token stop;  // checked per point and inside the index builds; throws Cancelled
+};
+
+// Throws std::invalid_argument for settings describe_cloud cannot honour (voxel downsampling:
+// label_cloud does it) or a missing normal per point with use_cloud_normals.
+DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings,
+                              const DescribeOptions& options);
+DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings, int threads = 0);
+
+crf::Graph build_scene_graph(const PointCloud& cloud, const DescribedCloud& described,
+                             const crf::GraphOptions& options);
+
+// A training / validation scene: labels become class indices into `class_ids`; taxonomy ids that
+// are not one of the model's classes (kUnknown included) become kIgnoreLabel.
+crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& described,
+                                   crf::Graph graph, const std::vector<std::uint32_t>& class_ids);
+
+struct LabelingOptions {
+  int threads = 0;  // 0 = OpenMP default; the labels do not depend on it
+  bool want_probabilities = false;
+  bool want_descriptors = false;  // LabelingResult.descriptors
+  bool tabletop_only = false;     // label only the table and the objects on it; the rest is unknown
+  // Keep the cloud's own normals (cloud.normals, one per point) instead of estimating them.
+  bool use_cloud_normals = false;
+  // > 0: downsample to voxels of this edge before describing (replaces the model's voxel_size);
+  // every input point gets its voxel's label, probabilities, descriptor and normal.
+  float voxel_size = 0.0f;
+  // > 0: replace the model's normal / feature radius. Only for models whose FeatureSettings
+  // allow it (radii_overridable), else label_cloud throws std::invalid_argument.
+  float normal_radius = 0.0f;
+  float feature_radius = 0.0f;
+  // Checked between stages and per point inside them (and in the table-top stage, the voxel
+  // filter and the index builds); label_cloud then throws Cancelled, within milliseconds.
+  std::stop_token stop;
+};
+
+struct LabelingResult {
+  std::vector<std::uint32_t> labels;  // taxonomy class id per point; 0 (unknown) when unlabeled
+  Eigen::MatrixXf probabilities;      // points x K (model class order) when asked; NaN rows
+  std::vector<std::uint32_t> class_ids;
+  // points x descriptor_dim, row-major, when asked; NaN rows = the point had no descriptor.
+  std::vector<float> descriptors;
+  int descriptor_dim = 0;
+  std::size_t labeled_points = 0;    // input points that got a descriptor (through their voxel)
+  std::size_t described_points = 0;  // points described: voxels when downsampling
+  double prefilter_seconds = 0;      // table-top segmentation and voxel downsampling
+  double normal_seconds = 0;         // normal estimation (0 with the cloud's own normals)
+  double descriptor_seconds = 0;     // FPFH / PFH
+  double feature_seconds = 0;        // normals + descriptors
+  double inference_seconds = 0;      // graph + inference
+};
+
+// Labels every point with the model's own feature, graph and inference settings (and the
+// overrides in `options`). Points with non-finite coordinates or no descriptor get class 0.
+// Exact duplicates are described once (duplicates.hpp): every copy gets the labels,
+// probabilities, descriptor and normal of its lowest-index copy.
+// Throws ModelError when an SVM model's libsvm text does not load, std::invalid_argument for
+// overrides the model does not allow or missing normals, and Cancelled when options.stop is
+// requested.
+LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
+                           const LabelingOptions& options = {});
+
+}  // namespace primlabel::pipeline

@@ -1,0 +1,93 @@
+// Normals and descriptors with a model's FeatureSettings; the neighbour index is built once and
+// shared by normals, descriptors and the graph.
+
+#include <chrono>
+#include <stdexcept>
+
+#include "primlabel/geometry/features.hpp"
+#include "primlabel/geometry/normals.hpp"
+#include "primlabel/pipeline/labeling.hpp"
+
+namespace primlabel::pipeline {
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+}  // namespace
+
+Neighborhood capped(const Neighborhood& hood) {
+  Neighborhood out = hood;
+  if (out.radius > 0.0f && out.max_neighbors == 0) out.max_neighbors = kDefaultMaxNeighbors;
+  return out;
+}
+
+DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings, int threads) {
+  DescribeOptions options;
+  options.threads = threads;
+  return describe_cloud(cloud, settings, options);
+}
+
+DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings,
+                              const DescribeOptions& options) {
+  if (settings.voxel_size > 0.0f)
+    throw std::invalid_argument("describe_cloud does not downsample: label_cloud does");
+  if (!settings.normals.valid() || !settings.features.valid())
+    throw std::invalid_argument("invalid normal or feature neighbourhood");
+  if (options.use_cloud_normals && cloud.normals.size() != cloud.size())
+    throw std::invalid_argument("the cloud has no normal per point to keep");
+  throw_if_stopped(options.stop, "describing the cloud");
+  DescribedCloud out;
+  // The index build checks the token itself (a 5M-point k-d tree takes about a second).
+  out.search = std::make_unique<NeighborSearch>(cloud.xyz, options.stop);
+
+  if (!options.use_cloud_normals) {
+    const auto start = std::chrono::steady_clock::now();
+    NormalOptions normal_options;
+    normal_options.neighborhood = capped(settings.normals);
+    normal_options.threads = options.threads;
+    normal_options.stop = options.stop;
+    estimate_normals(cloud, normal_options, out.search.get());
+    out.normal_seconds = seconds_since(start);
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  FeatureOptions feature_options;
+  feature_options.neighborhood = capped(settings.features);
+  feature_options.fpfh_variant = settings.fpfh_variant;
+  feature_options.threads = options.threads;
+  feature_options.stop = options.stop;
+  const bool fpfh = settings.descriptor == DescriptorKind::kFpfh;
+  out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, nullptr, out.search.get())
+                         : compute_pfh(cloud, feature_options, nullptr, out.search.get());
+  out.descriptor_dim = settings.descriptor_dim();
+  out.feature_seconds = seconds_since(start);
+  return out;
+}
+
+crf::Graph build_scene_graph(const PointCloud& cloud, const DescribedCloud& described,
+                             const crf::GraphOptions& options) {
+  crf::GraphOptions bounded = options;
+  bounded.neighborhood = capped(options.neighborhood);
+  return crf::build_graph(cloud.xyz, described.descriptors, described.descriptor_dim, bounded,
+                          described.search.get());
+}
+
+crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& described,
+                                   crf::Graph graph, const std::vector<std::uint32_t>& class_ids) {
+  if (cloud.labels.size() != cloud.size())
+    throw std::invalid_argument("the cloud has no label per point");
+  crf::LabeledGraph scene;
+  scene.descriptor_dim = described.descriptor_dim;
+  scene.descriptors = std::move(described.descriptors);
+  scene.graph = std::move(graph);
+  scene.labels.assign(cloud.size(), crf::kIgnoreLabel);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (!scene.graph.active[i]) continue;  // no descriptor: nothing to learn from
+    for (std::size_t k = 0; k < class_ids.size(); ++k)
+      if (class_ids[k] == cloud.labels[i]) scene.labels[i] = static_cast<int>(k);
+  }
+  return scene;
+}
+
+}  // namespace primlabel::pipeline

@@ -1,0 +1,276 @@
+// Labeling a cloud with a trained model: optionally downsample to voxels, optionally restrict to
+// the table-top, describe with the model's settings (or allowed overrides), build its graph,
+// infer (CRF or node-only) or classify point by point (SVM), and carry the results back to every
+// input point.
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/crf/inference.hpp"
+#include "primlabel/pipeline/duplicates.hpp"
+#include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/pipeline/svm_model.hpp"
+#include "primlabel/tabletop/tabletop.hpp"
+#include "primlabel/tabletop/voxel_grid.hpp"
+
+namespace primlabel::pipeline {
+
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The model's feature settings with the request's radius overrides applied (a radius keeps the
+// model's neighbour cap when the model already used a radius).
+FeatureSettings effective_features(const LabelModel& model, const LabelingOptions& options) {
+  FeatureSettings settings = model.features;
+  settings.voxel_size = 0.0f;  // label_cloud downsamples itself
+  const bool overrides = options.normal_radius > 0.0f || options.feature_radius > 0.0f;
+  if (overrides && !model.features.radii_overridable)
+    throw std::invalid_argument("model '" + model.name + "' does not allow radius overrides");
+  auto override_radius = [](Neighborhood& neighborhood, float radius) {
+    if (!(radius > 0.0f)) return;
+    const int cap = neighborhood.radius > 0.0f ? neighborhood.max_neighbors : 0;
+    neighborhood = Neighborhood{radius, 0, cap};
+  };
+  override_radius(settings.normals, options.normal_radius);
+  override_radius(settings.features, options.feature_radius);
+  return settings;
+}
+
+// Every point of `cloud` described and labeled (no duplicates expected, see label_all_points).
+LabelingResult label_distinct_points(const LabelModel& model, const FeatureSettings& features,
+                                     PointCloud& cloud, const LabelingOptions& options) {
+  LabelingResult result;
+  result.class_ids = model.class_ids();
+  DescribeOptions describe_options;
+  describe_options.threads = options.threads;
+  describe_options.use_cloud_normals = options.use_cloud_normals;
+  describe_options.stop = options.stop;
+  DescribedCloud described = describe_cloud(cloud, features, describe_options);
+  result.normal_seconds = described.normal_seconds;
+  result.descriptor_seconds = described.feature_seconds;
+  result.feature_seconds = described.normal_seconds + described.feature_seconds;
+  result.described_points = cloud.size();
+  throw_if_stopped(options.stop, "labeling");
+  if (model.kind == ModelKind::kSvm) {  // point by point: no graph
+    classify_with_svm(model, std::move(described), options, result);
+    return result;
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  crf::GraphOptions graph_options = model.graph;
+  graph_options.threads = options.threads;
+  graph_options.stop = options.stop;
+  // A node-only model ignores edges, so its graph needs none (only the active mask).
+  if (model.kind == ModelKind::kNodeOnly) graph_options.neighborhood = Neighborhood::Knn(1);
+  const crf::Graph graph = build_scene_graph(cloud, described, graph_options);
+  throw_if_stopped(options.stop, "labeling");
+  crf::InferenceOptions inference = model.inference;
+  inference.threads = options.threads;
+  inference.unknown_label = class_id(PrimitiveClass::kUnknown);
+  inference.compute_marginals = options.want_probabilities;
+  inference.stop = options.stop;
+  crf::InferenceResult inferred = infer(model.weights, described.descriptors, graph, inference);
+  result.inference_seconds = seconds_since(start);
+
+  result.labels = std::move(inferred.labels);
+  if (options.want_probabilities) result.probabilities = std::move(inferred.marginals);
+  if (options.want_descriptors) {
+    result.descriptors = std::move(described.descriptors);
+    result.descriptor_dim = described.descriptor_dim;
+  }
+  result.labeled_points = graph.num_active();
+  return result;
+}
+
+// An empty result for `points` points: every label unknown, NaN rows where asked.
+LabelingResult unknown_result(std::size_t points, const LabelingResult& like,
+                              const LabelingOptions& options) {
+  LabelingResult result;
+  result.class_ids = like.class_ids;
+  result.labeled_points = like.labeled_points;
+  result.described_points = like.described_points;
+  result.prefilter_seconds = like.prefilter_seconds;
+  result.normal_seconds = like.normal_seconds;
+  result.descriptor_seconds = like.descriptor_seconds;
+  result.feature_seconds = like.feature_seconds;
+  result.inference_seconds = like.inference_seconds;
+  result.labels.assign(points, class_id(PrimitiveClass::kUnknown));
+  if (options.want_probabilities)
+    result.probabilities =
+        Eigen::MatrixXf::Constant(Eigen::Index(points), Eigen::Index(like.class_ids.size()), kNaN);
+  if (options.want_descriptors) {
+    result.descriptor_dim = like.descriptor_dim;
+    result.descriptors.assign(points * std::size_t(like.descriptor_dim), kNaN);
+  }
+  return result;
+}
+
+// Copies the results of part point `from` to point `to` of the whole.
+void copy_point(const LabelingResult& part, std::size_t from, LabelingResult& whole,
+                std::size_t to) {
+  whole.labels[to] = part.labels[from];
+  if (part.probabilities.size() > 0)
+    whole.probabilities.row(Eigen::Index(to)) = part.probabilities.row(Eigen::Index(from));
+  if (!part.descriptors.empty()) {
+    const std::size_t d = std::size_t(part.descriptor_dim);
+    std::copy_n(part.descriptors.begin() + from * d, d, whole.descriptors.begin() + to * d);
+  }
+}
+
+// The results of `part` (a cloud of distinct points or voxels) carried to every point of the
+// whole cloud through `slot_of` (kNoVoxel: the point was not described and stays unknown),
+// normals and curvature included unless the cloud's own normals were used.
+LabelingResult fan_out(const LabelingResult& partial, const PointCloud& part,
+                       const std::vector<std::uint32_t>& slot_of, PointCloud& cloud,
+                       const LabelingOptions& options) {
+  LabelingResult result = unknown_result(cloud.size(), partial, options);
+  result.labeled_points = 0;
+  if (!options.use_cloud_normals) {
+    cloud.normals.assign(cloud.size(), Vec3f::Constant(kNaN));
+    cloud.curvature.assign(cloud.size(), kNaN);
+  }
+  const std::uint32_t unknown = class_id(PrimitiveClass::kUnknown);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const std::uint32_t j = slot_of[i];
+    if (j == tabletop::kNoVoxel) continue;
+    copy_point(partial, j, result, i);
+    if (partial.labels[j] != unknown) ++result.labeled_points;
+    if (!options.use_cloud_normals) {
+      cloud.normals[i] = part.normals[j];
+      cloud.curvature[i] = part.curvature[j];
+    }
+  }
+  return result;
+}
+
+// Exact duplicates are described once, at their lowest index, and every copy gets that copy's
+// results (as voxels fan out to their members below).
+LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& features,
+                                PointCloud& cloud, const LabelingOptions& options) {
+  const DuplicateMap duplicates = find_duplicates(cloud.xyz, options.stop);
+  if (!duplicates.any()) return label_distinct_points(model, features, cloud, options);
+  const std::vector<std::uint32_t>& keep = duplicates.representatives;
+  PointCloud distinct;
+  distinct.resize_unorganized(keep.size());
+  distinct.viewpoint = cloud.viewpoint;
+  for (std::size_t j = 0; j < keep.size(); ++j) distinct.xyz[j] = cloud.xyz[keep[j]];
+  if (options.use_cloud_normals) {
+    distinct.normals.resize(keep.size());
+    for (std::size_t j = 0; j < keep.size(); ++j) distinct.normals[j] = cloud.normals[keep[j]];
+  }
+  const LabelingResult partial = label_distinct_points(model, features, distinct, options);
+  return fan_out(partial, distinct, duplicates.slot_of, cloud, options);
+}
+
+// Table-top only: label the sub-cloud of table and object points, scatter back.
+LabelingResult label_tabletop(const LabelModel& model, const FeatureSettings& features,
+                              PointCloud& cloud, const LabelingOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  tabletop::TabletopOptions tabletop_options;
+  tabletop_options.threads = options.threads;
+  tabletop_options.stop = options.stop;
+  const tabletop::TabletopResult segmented = tabletop::segment_tabletop(cloud, tabletop_options);
+  const std::vector<std::uint8_t> mask = tabletop::tabletop_mask(segmented, cloud.size());
+  PointCloud sub;
+  std::vector<std::size_t> source_index;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (mask[i]) source_index.push_back(i);
+  sub.resize_unorganized(source_index.size());
+  sub.viewpoint = cloud.viewpoint;
+  for (std::size_t j = 0; j < source_index.size(); ++j) sub.xyz[j] = cloud.xyz[source_index[j]];
+  if (options.use_cloud_normals) {
+    sub.normals.resize(source_index.size());
+    for (std::size_t j = 0; j < source_index.size(); ++j)
+      sub.normals[j] = cloud.normals[source_index[j]];
+  }
+  const double prefilter_seconds = seconds_since(start);
+  throw_if_stopped(options.stop, "labeling");
+
+  const LabelingResult partial = label_all_points(model, features, sub, options);
+  LabelingResult result = unknown_result(cloud.size(), partial, options);
+  result.prefilter_seconds = prefilter_seconds;
+  if (!options.use_cloud_normals) {
+    cloud.normals.assign(cloud.size(), Vec3f::Constant(kNaN));
+    cloud.curvature.assign(cloud.size(), kNaN);
+  }
+  for (std::size_t j = 0; j < source_index.size(); ++j) {
+    const std::size_t i = source_index[j];
+    copy_point(partial, j, result, i);
+    if (!options.use_cloud_normals) {
+      cloud.normals[i] = sub.normals[j];
+      cloud.curvature[i] = sub.curvature[j];
+    }
+  }
+  return result;
+}
+
+LabelingResult label_points(const LabelModel& model, const FeatureSettings& features,
+                            PointCloud& cloud, const LabelingOptions& options) {
+  return options.tabletop_only ? label_tabletop(model, features, cloud, options)
+                               : label_all_points(model, features, cloud, options);
+}
+
+// Voxel centroids, with the mean of the members' normals (normalised) when the cloud's own
+// normals are used.
+PointCloud voxel_cloud(const PointCloud& cloud, const tabletop::VoxelGrid& grid,
+                       bool with_normals) {
+  PointCloud voxels;
+  voxels.resize_unorganized(grid.centroids.size());
+  voxels.xyz = grid.centroids;
+  voxels.viewpoint = cloud.viewpoint;
+  if (!with_normals) return voxels;
+  voxels.normals.assign(grid.centroids.size(), Vec3f::Constant(kNaN));
+  for (std::size_t v = 0; v < grid.centroids.size(); ++v) {
+    Vec3f sum = Vec3f::Zero();
+    for (std::uint32_t m = grid.member_offsets[v]; m < grid.member_offsets[v + 1]; ++m) {
+      const Vec3f& n = cloud.normals[grid.members[m]];
+      if (is_finite(n)) sum += n;
+    }
+    if (sum.norm() > 0.0f) voxels.normals[v] = sum.normalized();
+  }
+  return voxels;
+}
+
+LabelingResult label_voxels(const LabelModel& model, const FeatureSettings& features,
+                            PointCloud& cloud, float voxel_size, const LabelingOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const tabletop::VoxelGrid grid = tabletop::voxel_downsample(
+      cloud.xyz, tabletop::finite_indices(cloud.xyz), voxel_size, options.stop);
+  PointCloud voxels = voxel_cloud(cloud, grid, options.use_cloud_normals);
+  const double voxel_seconds = seconds_since(start);
+  throw_if_stopped(options.stop, "labeling");
+
+  const LabelingResult partial = label_points(model, features, voxels, options);
+  LabelingResult result = fan_out(partial, voxels, grid.voxel_of_point, cloud, options);
+  result.prefilter_seconds = partial.prefilter_seconds + voxel_seconds;
+  return result;
+}
+
+}  // namespace
+
+LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
+                           const LabelingOptions& options) {
+  if (options.use_cloud_normals && cloud.normals.size() != cloud.size())
+    throw std::invalid_argument("use_cloud_normals: the cloud has " +
+                                std::to_string(cloud.normals.size()) + " normals for " +
+                                std::to_string(cloud.size()) + " points");
+  if (!(options.voxel_size >= 0.0f) || !std::isfinite(options.voxel_size))
+    throw std::invalid_argument("voxel size must be finite and >= 0");
+  const FeatureSettings features = effective_features(model, options);
+  const float voxel_size =
+      options.voxel_size > 0.0f ? options.voxel_size : model.features.voxel_size;
+  throw_if_stopped(options.stop, "labeling");
+  if (voxel_size > 0.0f) return label_voxels(model, features, cloud, voxel_size, options);
+  return label_points(model, features, cloud, options);
+}
+
+}  // namespace primlabel::pipeline

@@ -1,0 +1,41 @@
+#pragma once
+// Pictures of point clouds for people: a PNG of the points coloured per point (by label, by
+// segment, ...), seen from above, obliquely or from the sensor, with an optional legend.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "primlabel/geometry/point_cloud.hpp"
+
+namespace primlabel {
+
+enum class RenderView {
+  kTop,      // looking down the up axis
+  kOblique,  // from above and to the side, the usual "table scene" picture
+  kSensor,   // from the cloud's viewpoint, as the sensor saw it
+};
+
+struct LegendEntry {
+  std::string name;
+  std::uint32_t rgb;  // 0xRRGGBB
+};
+
+struct RenderOptions {
+  int width = 1024;
+  int height = 768;
+  RenderView view = RenderView::kOblique;
+  Vec3f up = Vec3f(0, 0, 1);  // world up, for kTop and kOblique
+  int point_radius_px = 1;    // splat size; 0 = single pixels
+  std::uint32_t background = 0xFFFFFF;
+  std::string title;                // drawn top-left when not empty
+  std::vector<LegendEntry> legend;  // drawn bottom-left when not empty
+};
+
+// Renders the finite points of `cloud` with colours `point_rgb` (0xRRGGBB, one per point) to a
+// PNG at `path`, nearer points drawn over farther ones. Throws std::runtime_error naming the path
+// when the file cannot be written, std::invalid_argument when the colours do not match the cloud.
+void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point_rgb,
+                const RenderOptions& options, const std::string& path);
+
+}  // namespace primlabel

@@ -1,0 +1,82 @@
+// The Kinect-like structured-light depth camera.
+
+#include <cmath>
+#include <vector>
+
+#include "primlabel/geometry/parallel.hpp"
+#include "primlabel/synth/random.hpp"
+#include "primlabel/synth/scanners.hpp"
+#include "scan_common.hpp"
+
+namespace primlabel::synth {
+namespace {
+
+constexpr std::uint64_t kKinectStream = 201;
+constexpr double kDeg = M_PI / 180.0;
+
+}  // namespace
+
+KinectOptions kinect_for_scene(const Scene& scene, std::uint64_t seed) {
+  Rng rng(mix_seed(seed, kKinectStream - 1));
+  KinectOptions options;
+  const double front = -0.5 * scene.table_size.y();
+  options.position =
+      Vec3d(rng.uniform(-0.08, 0.08), front - rng.uniform(0.4, 0.5), rng.uniform(0.65, 0.8));
+  options.target = Vec3d(rng.uniform(-0.05, 0.05), rng.uniform(0.0, 0.08), 0.0);
+  return options;
+}
+
+PointCloud scan_kinect(const Scene& scene, const KinectOptions& options, double label_radius,
+                       std::uint64_t seed) {
+  const Eigen::Matrix3d rotation = detail::camera_rotation(options.target - options.position);
+  const double focal = options.focal_px * options.width / 640.0;
+  const double cx = 0.5 * (options.width - 1), cy = 0.5 * (options.height - 1);
+  // Depth from disparity: z = focal * baseline / d, d quantised to 1/subpixel pixel.
+  const double focal_baseline = focal * options.baseline;
+  const Vec3d projector = options.position + options.baseline * rotation.col(0);
+  const double min_cos_incidence = std::cos(options.max_incidence_deg * kDeg);
+  const std::size_t pixels = std::size_t(options.width) * options.height;
+
+  std::vector<detail::Return> returns(pixels);
+  primlabel::detail::ExceptionBarrier barrier;
+#pragma omp parallel for schedule(dynamic, 8)
+  for (int v = 0; v < options.height; ++v)
+    barrier.run([&] {
+      for (int u = 0; u < options.width; ++u) {
+        const std::size_t pixel = std::size_t(v) * options.width + u;
+        const Vec3d camera_ray((u - cx) / focal, (v - cy) / focal, 1.0);  // z = 1: depth units
+        const Ray ray{options.position, (rotation * camera_ray).normalized()};
+        Rng rng(mix_seed(seed, kKinectStream, pixel));
+        const double lost = rng.uniform();
+        const double noise = rng.normal();
+
+        const auto hit = scene.cast(ray, 1e-6, options.max_range * 2.0);
+        if (!hit || lost < options.dropout) continue;
+        if (-ray.dir.dot(hit->normal) < min_cos_incidence) continue;
+        const Vec3d point = ray.at(hit->t);
+        const double depth = hit->t / camera_ray.norm();
+        if (depth < options.min_range || depth > options.max_range) continue;
+        if (options.projector_shadow && scene.occluded(projector, point)) continue;
+
+        double measured = depth + options.depth_noise * depth * depth * noise;
+        if (options.quantize) {
+          const double disparity = focal_baseline / measured;
+          measured = focal_baseline / (std::round(disparity * options.subpixel) / options.subpixel);
+        }
+        const Vec3d measured_point = options.position + rotation * (camera_ray * measured);
+        returns[pixel] = detail::make_return(scene, *hit, point, measured_point, label_radius);
+      }
+    });
+  barrier.rethrow();
+
+  PointCloud cloud;
+  detail::label_unseen_creases_as_surface(returns, label_radius);
+  detail::store_returns(returns, cloud);
+  cloud.width = static_cast<std::uint32_t>(options.width);
+  cloud.height = static_cast<std::uint32_t>(options.height);
+  cloud.viewpoint.origin = options.position.cast<float>();
+  cloud.viewpoint.orientation = Eigen::Quaternionf(rotation.cast<float>());
+  return cloud;
+}
+
+}  // namespace primlabel::synth

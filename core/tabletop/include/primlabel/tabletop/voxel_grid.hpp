@@ -1,0 +1,38 @@
+#pragma once
+// Removal of invalid points and optional voxel-grid downsampling (one centroid per occupied
+// voxel, as PCL's VoxelGrid), keeping the map from every input point to its voxel so results on
+// the downsampled points can be carried back to the input.
+
+#include <cstdint>
+#include <limits>
+#include <stop_token>
+#include <vector>
+
+#include "primlabel/geometry/point_cloud.hpp"
+
+namespace primlabel::tabletop {
+
+inline constexpr std::uint32_t kNoVoxel = std::numeric_limits<std::uint32_t>::max();
+
+// Indices of the points with finite coordinates, ascending.
+std::vector<std::uint32_t> finite_indices(const std::vector<Vec3f>& points);
+
+struct VoxelGrid {
+  std::vector<Vec3f> centroids;               // one per occupied voxel
+  std::vector<std::uint32_t> voxel_of_point;  // per input point; kNoVoxel when not in `indices`
+  std::vector<std::uint32_t> member_offsets;  // voxel v holds members[offsets[v] .. offsets[v+1])
+  std::vector<std::uint32_t> members;         // input indices, ascending within each voxel
+};
+
+// Centroid per voxel of edge `leaf` over points[indices] (which must be finite). Voxels are
+// ordered by their integer coordinates (z, then y, then x), so the output does not depend on the
+// order of `indices`. Throws std::invalid_argument when leaf <= 0 or the extent overflows the
+// 21-bit voxel coordinates.
+// Throws std::invalid_argument when the extent needs more than 2^21 voxels per axis (e.g. one far
+// point), and Cancelled when `stop` is requested (checked every 64k points and between the sort's
+// runs and merges).
+VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
+                           const std::vector<std::uint32_t>& indices, float leaf,
+                           const std::stop_token& stop = {});
+
+}  // namespace primlabel::tabletop

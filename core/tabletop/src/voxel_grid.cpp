@@ -1,0 +1,105 @@
+#include "primlabel/tabletop/voxel_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "primlabel/geometry/cancellation.hpp"
+
+namespace primlabel::tabletop {
+
+std::vector<std::uint32_t> finite_indices(const std::vector<Vec3f>& points) {
+  std::vector<std::uint32_t> out;
+  out.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (is_finite(points[i])) out.push_back(static_cast<std::uint32_t>(i));
+  return out;
+}
+
+namespace {
+
+constexpr std::size_t kCheckEvery = std::size_t(1) << 16;
+constexpr const char* kWhat = "voxel downsampling";
+
+// std::sort in runs of 1M elements, then pairwise merges, with a stop check between any two:
+// one std::sort of 10M pairs is about a second nobody could interrupt. Same order as std::sort
+// (the keys are unique pairs).
+template <typename T>
+void sort_checked(std::vector<T>& v, const std::stop_token& stop) {
+  constexpr std::size_t kRun = std::size_t(1) << 20;
+  for (std::size_t first = 0; first < v.size(); first += kRun) {
+    throw_if_stopped(stop, kWhat);
+    std::sort(v.begin() + first, v.begin() + std::min(v.size(), first + kRun));
+  }
+  for (std::size_t width = kRun; width < v.size(); width *= 2)
+    for (std::size_t first = 0; first + width < v.size(); first += 2 * width) {
+      throw_if_stopped(stop, kWhat);
+      std::inplace_merge(v.begin() + first, v.begin() + first + width,
+                         v.begin() + std::min(v.size(), first + 2 * width));
+    }
+}
+
+}  // namespace
+
+VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
+                           const std::vector<std::uint32_t>& indices, float leaf,
+                           const std::stop_token& stop) {
+  if (!(leaf > 0.0f) || !std::isfinite(leaf))
+    throw std::invalid_argument("voxel leaf must be positive, got " + std::to_string(leaf));
+  VoxelGrid grid;
+  grid.voxel_of_point.assign(points.size(), kNoVoxel);
+  grid.member_offsets.push_back(0);
+  if (indices.empty()) return grid;
+
+  Vec3f lo = points[indices[0]];
+  Vec3f hi = lo;
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    if (k % kCheckEvery == 0) throw_if_stopped(stop, kWhat);
+    lo = lo.cwiseMin(points[indices[k]]);
+    hi = hi.cwiseMax(points[indices[k]]);
+  }
+  const double inv = 1.0 / leaf;
+  constexpr double kMaxCells = double(1 << 21);
+  // The extent in double: in float it overflows to infinity for points near +-FLT_MAX.
+  const double extent = (hi.cast<double>() - lo.cast<double>()).maxCoeff();
+  if (!(extent * inv < kMaxCells - 1))
+    throw std::invalid_argument("voxel leaf " + std::to_string(leaf) +
+                                " is too small for the cloud's extent (" + std::to_string(extent) +
+                                " m: a point far from the others?)");
+
+  // Sorting (key, index) pairs makes the voxel order and member order independent of the input.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
+  keyed.reserve(indices.size());
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    if (k % kCheckEvery == 0) throw_if_stopped(stop, kWhat);
+    const std::uint32_t i = indices[k];
+    const Vec3f& p = points[i];
+    const auto cell = [&](int axis) {
+      return static_cast<std::uint64_t>(std::floor((double(p[axis]) - lo[axis]) * inv));
+    };
+    keyed.emplace_back((cell(2) << 42) | (cell(1) << 21) | cell(0), i);
+  }
+  sort_checked(keyed, stop);
+
+  grid.members.reserve(keyed.size());
+  for (std::size_t begin = 0; begin < keyed.size();) {
+    throw_if_stopped(stop, kWhat);  // every voxel: cheap next to its members
+    std::size_t end = begin;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    const auto voxel = static_cast<std::uint32_t>(grid.centroids.size());
+    while (end < keyed.size() && keyed[end].first == keyed[begin].first) {
+      const std::uint32_t i = keyed[end].second;
+      sum += points[i].cast<double>();
+      grid.members.push_back(i);
+      grid.voxel_of_point[i] = voxel;
+      ++end;
+    }
+    grid.centroids.push_back((sum / double(end - begin)).cast<float>());
+    grid.member_offsets.push_back(static_cast<std::uint32_t>(grid.members.size()));
+    begin = end;
+  }
+  return grid;
+}
+
+}  // namespace primlabel::tabletop

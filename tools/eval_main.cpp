@@ -1,0 +1,325 @@
+// primlabel-eval: labels clouds with a trained model and scores them against their ground truth,
+// or re-measures the paper's Table I and Fig. 4.
+//
+//   primlabel-eval --model table.plm scene.pcd [--json] [--out labeled.pcd]
+//   primlabel-eval --model table.plm --no-truth mosd_scene.pcd     # predicted label histogram
+//   primlabel-eval --model table.plm --confusion-png confusion.png a.pcd b.pcd   # over all files
+//   primlabel-eval --table1 [--json]
+//   primlabel-eval --fig4 out/ [--fig4-scenes 3]                    # the paper's Fig. 4
+//   primlabel-eval --model kinect.plm --mosd-report out/ ../shared/data/mosd/*.pcd
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "cli_common.hpp"
+#include "node_basis.hpp"
+#include "primlabel/build_version.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/crf/metrics.hpp"
+#include "primlabel/research/confusion_plot.hpp"
+#include "primlabel/research/fig4.hpp"
+#include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/research/mosd_report.hpp"
+#include "primlabel/research/table1.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
+
+namespace {
+
+using namespace primlabel;
+
+struct Arguments {
+  std::string model, classes, out, confusion_png, fig4_dir, mosd_dir;
+  std::vector<std::string> files;
+  bool json = false, no_truth = false, tabletop_only = false, quiet = false;
+  bool table1 = false, no_pfh = false, no_svm = false;
+  std::string node_basis = "tent";
+  std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
+  int table1_train = 8, table1_test = 4, pfh_max_neighbors = 40, threads = 0, fig4_scenes = 3;
+};
+
+std::string class_name(std::uint32_t id) {
+  const auto c = class_from_id(id);
+  return c ? std::string(name(*c)) : std::to_string(id);
+}
+
+// JSON numbers cannot be NaN.
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.6f", v);
+  return buffer;
+}
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) >= 0x20) out += c;
+  }
+  return out + "\"";
+}
+
+void print_scores(const std::string& path, const crf::ConfusionMatrix& confusion, bool json) {
+  std::vector<std::string> names;
+  for (std::uint32_t id : confusion.class_ids()) names.push_back(class_name(id));
+  if (!json) {
+    std::printf("%s: %llu points scored, accuracy %.2f%%\n%s\n", path.c_str(),
+                static_cast<unsigned long long>(confusion.total()), 100 * confusion.accuracy(),
+                confusion.to_text(names).c_str());
+    return;
+  }
+  std::string line = "{\"file\":" + json_string(path) +
+                     ",\"points\":" + std::to_string(confusion.total()) +
+                     ",\"accuracy\":" + json_number(confusion.accuracy()) +
+                     ",\"macro_f1\":" + json_number(confusion.macro_f1()) + ",\"classes\":{";
+  for (int k = 0; k < confusion.num_classes(); ++k) {
+    const crf::ClassScores s = confusion.scores(k);
+    line += (k ? "," : "") + json_string(names[k]) + ":{\"precision\":" + json_number(s.precision) +
+            ",\"recall\":" + json_number(s.recall) + ",\"f1\":" + json_number(s.f1) +
+            ",\"support\":" + std::to_string(s.support) + "}";
+  }
+  line += "},\"confusion\":[";
+  for (int t = 0; t < confusion.num_classes(); ++t) {
+    line += t ? ",[" : "[";
+    for (int p = 0; p <= confusion.num_classes(); ++p)
+      line += (p ? "," : "") + std::to_string(confusion.count(t, p));
+    line += "]";
+  }
+  std::printf("%s]}\n", line.c_str());
+}
+
+void print_histogram(const std::string& path, const std::vector<std::uint32_t>& labels, bool json) {
+  std::vector<std::uint64_t> counts(kPrimitiveClassCount, 0);
+  for (std::uint32_t id : labels)
+    if (id < kPrimitiveClassCount) ++counts[id];
+  if (json) {
+    std::string line = "{\"file\":" + json_string(path) +
+                       ",\"points\":" + std::to_string(labels.size()) + ",\"histogram\":{";
+    for (std::uint32_t id = 0; id < kPrimitiveClassCount; ++id)
+      line += (id ? "," : "") + json_string(class_name(id)) + ":" + std::to_string(counts[id]);
+    std::printf("%s}}\n", line.c_str());
+    return;
+  }
+  std::printf("%s: %zu points, predicted labels:\n", path.c_str(), labels.size());
+  for (std::uint32_t id = 0; id < kPrimitiveClassCount; ++id)
+    if (counts[id])
+      std::printf("  %-18s %10llu  %6.2f%%\n", class_name(id).c_str(),
+                  static_cast<unsigned long long>(counts[id]),
+                  100.0 * double(counts[id]) / double(std::max<std::size_t>(labels.size(), 1)));
+}
+
+int evaluate_files(const Arguments& args) {
+  const LabelModel model = load_model(args.model);
+  const ClassMap map = args.classes.empty() ? ClassMap{} : read_class_map(args.classes);
+  crf::ConfusionMatrix overall(model.class_ids());  // every scored file, for the PNG
+  for (const std::string& path : args.files) {
+    PointCloud cloud = read_cloud(path);
+    const bool scored = !args.no_truth && cloud.has_labels();
+    if (scored)  // the labels as taxonomy ids (through the file's or the given class map)
+      cloud = args.classes.empty() ? load_labeled_cloud(path) : load_labeled_cloud(path, map);
+    pipeline::LabelingOptions options;
+    options.threads = args.threads;
+    options.tabletop_only = args.tabletop_only;
+    const pipeline::LabelingResult result = pipeline::label_cloud(model, cloud, options);
+    if (!args.quiet)
+      std::fprintf(stderr, "%s: %zu points, features %.2f s, inference %.2f s\n", path.c_str(),
+                   cloud.size(), result.feature_seconds, result.inference_seconds);
+    if (scored) {
+      crf::ConfusionMatrix confusion(model.class_ids());
+      confusion.add(cloud.labels, result.labels, class_id(PrimitiveClass::kUnknown));
+      print_scores(path, confusion, args.json);
+      overall.add(confusion);
+    } else {
+      print_histogram(path, result.labels, args.json);
+    }
+    if (!args.out.empty()) {
+      cloud.labels = result.labels;
+      write_tagged_cloud(args.out, cloud, {{"classes", class_map_tag(ClassMap::taxonomy())}});
+    }
+  }
+  if (!args.confusion_png.empty()) {
+    if (overall.total() == 0)
+      throw std::runtime_error("--confusion-png: no file had ground-truth primitive labels");
+    std::vector<std::string> names;
+    for (std::uint32_t id : overall.class_ids()) names.push_back(class_name(id));
+    research::write_confusion_png(
+        args.confusion_png, overall, names,
+        args.files.size() == 1 ? args.files.front() : std::to_string(args.files.size()) + " files");
+  }
+  return cli::kExitOk;
+}
+
+int table1(const Arguments& args) {
+  research::Table1Options options;
+  options.train_scenes = args.table1_train;
+  options.test_scenes = args.table1_test;
+  options.with_pfh = !args.no_pfh;
+  options.with_svm = !args.no_svm;
+  options.pfh_max_neighbors = args.pfh_max_neighbors;
+  options.node_knots = args.node_knots;
+  options.threads = args.threads;
+  if (!args.quiet)
+    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  const auto rows = research::run_table1(options);
+  std::fputs((args.json ? research::table1_json(rows) : research::table1_text(rows)).c_str(),
+             stdout);
+  return cli::kExitOk;
+}
+
+int mosd_report(const Arguments& args) {
+  const LabelModel model = load_model(args.model);
+  std::error_code ec;
+  std::filesystem::create_directories(args.mosd_dir, ec);
+  if (ec) throw std::runtime_error(args.mosd_dir + ": cannot be created (" + ec.message() + ")");
+  pipeline::LabelingOptions options;
+  options.threads = args.threads;
+  options.tabletop_only = args.tabletop_only;
+  std::vector<research::MosdSceneReport> scenes;
+  for (const std::string& path : args.files) {
+    const std::string png = (std::filesystem::path(args.mosd_dir) /
+                             (std::filesystem::path(path).stem().string() + "_labels.png"))
+                                .string();
+    scenes.push_back(research::report_mosd_scene(model, path, png, options));
+    if (!args.quiet)
+      std::fprintf(stderr, "%s: %.2f%% of %llu table points plane, wrote %s\n", path.c_str(),
+                   100.0 * scenes.back().plane_share(),
+                   static_cast<unsigned long long>(scenes.back().table_points), png.c_str());
+  }
+  const research::MosdReport report = research::summarize_mosd(std::move(scenes));
+  const std::string json = research::mosd_report_json(report);
+  const std::string json_path =
+      (std::filesystem::path(args.mosd_dir) / "mosd_report.json").string();
+  std::ofstream(json_path) << json;
+  std::fputs((args.json ? json : research::mosd_report_text(report)).c_str(), stdout);
+  return cli::kExitOk;
+}
+
+int fig4(const Arguments& args) {
+  research::Fig4Options options;
+  options.scenes = args.fig4_scenes;
+  options.threads = args.threads;
+  if (!args.quiet)
+    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  const research::Fig4 result = research::run_fig4(options);
+  research::write_fig4(result, args.fig4_dir);
+  if (!args.json) {
+    std::printf("%s", research::hik_text(result).c_str());
+    return cli::kExitOk;
+  }
+  const research::ClassSignatures& s = result.signatures;
+  std::string line = "{\"classes\":[";
+  for (std::size_t k = 0; k < s.class_ids.size(); ++k)
+    line += (k ? "," : "") + json_string(class_name(s.class_ids[k]));
+  line += "],\"points\":[";
+  for (std::size_t k = 0; k < s.points.size(); ++k)
+    line += (k ? "," : "") + std::to_string(s.points[k]);
+  line += "],\"hik\":[";
+  for (Eigen::Index r = 0; r < result.hik.rows(); ++r) {
+    line += r ? ",[" : "[";
+    for (Eigen::Index c = 0; c < result.hik.cols(); ++c)
+      line += (c ? "," : "") + json_number(result.hik(r, c));
+    line += "]";
+  }
+  std::printf("%s]}\n", line.c_str());
+  return cli::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Label clouds with a trained model and score them, or re-measure Table I."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-eval"));
+  app.name("primlabel-eval");
+  Arguments args;
+  auto* files = app.add_option("files", args.files, "clouds to label (.pcd or .ply)");
+  auto* model = app.add_option("--model", args.model, "model file (primlabel-train -o)");
+  app.add_flag("--json", args.json, "one JSON object per file (or per Table I row) on stdout");
+  auto* no_truth =
+      app.add_flag("--no-truth", args.no_truth,
+                   "the files' labels are no primitive classes (e.g. segment ids): print the "
+                   "predicted label histogram");
+  app.add_option("--classes", args.classes, "class map of the files' labels (id name per line)");
+  auto* out = app.add_option("--out", args.out, "write the predicted labels (one input file)");
+  auto* mosd =
+      app.add_option("--mosd-report", args.mosd_dir,
+                     "mOSD scenes (label 1-9 table): share of table points labeled plane, and a "
+                     "labeled PNG per scene, into DIR (with mosd_report.json)")
+          ->needs(model)
+          ->excludes(no_truth)
+          ->excludes(out);
+  app.add_option("--confusion-png", args.confusion_png,
+                 "confusion matrix over all scored files as PNG (rows true, columns predicted)")
+      ->excludes(no_truth)
+      ->excludes(mosd);
+  app.add_flag("--tabletop-only", args.tabletop_only, "label only the table and the objects on it");
+  auto* t1 = app.add_flag("--table1", args.table1,
+                          "re-measure the paper's Table I on synthetic LMS400 scenes");
+  app.add_option("--table1-train", args.table1_train, "Table I: training scenes (default 8)")
+      ->check(CLI::PositiveNumber)
+      ->needs(t1);
+  app.add_option("--table1-test", args.table1_test, "Table I: test scenes (default 4)")
+      ->check(CLI::PositiveNumber)
+      ->needs(t1);
+  app.add_flag("--no-pfh", args.no_pfh, "Table I: FPFH rows only")->needs(t1);
+  app.add_option("--node-basis", args.node_basis,
+                 "Table I: CRF / node-only node features, tent (default) or linear (as the paper)")
+      ->check(CLI::IsMember({"tent", "linear"}))
+      ->needs(t1);
+  app.add_option("--node-knots", args.node_knots, std::string("Table I: ") + cli::kNodeKnotsHelp)
+      ->delimiter(',')
+      ->needs(t1);
+  app.add_flag("--no-svm", args.no_svm, "Table I: no SVM rows")->needs(t1);
+  app.add_option("--pfh-max-neighbors", args.pfh_max_neighbors,
+                 "Table I: PFH uses the M nearest within the feature radius (default 40)")
+      ->check(CLI::PositiveNumber)
+      ->needs(t1);
+  auto* f4 = app.add_option("--fig4", args.fig4_dir,
+                            "write the paper's Fig. 4 (class-mean FPFH signatures, HIK distance "
+                            "matrix; CSV and PNG) from synthetic LMS400 training scenes to DIR");
+  app.add_option("--fig4-scenes", args.fig4_scenes, "Fig. 4: training scenes (default 3)")
+      ->check(CLI::PositiveNumber)
+      ->needs(f4);
+  app.add_option("--threads", args.threads, "worker threads (default: all cores)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
+  t1->excludes(model)->excludes(files)->excludes(f4);
+  f4->excludes(model)->excludes(files);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "primlabel-eval: usage error: %s (see --help)\n", e.what());
+    return cli::kExitUsage;
+  }
+  try {
+    args.node_knots = cli::node_knots(args.node_basis, args.node_knots);  // resolved once
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "primlabel-eval: usage error: %s\n", e.what());
+    return cli::kExitUsage;
+  }
+  const bool study = args.table1 || !args.fig4_dir.empty();
+  if (!study && (args.model.empty() || args.files.empty())) {
+    std::fprintf(stderr,
+                 "primlabel-eval: usage error: give --model and at least one file, or --table1 "
+                 "or --fig4 (see --help)\n");
+    return cli::kExitUsage;
+  }
+  if (!args.out.empty() && args.files.size() != 1) {
+    std::fprintf(stderr, "primlabel-eval: usage error: --out takes exactly one input file\n");
+    return cli::kExitUsage;
+  }
+  try {
+    if (args.table1) return table1(args);
+    if (!args.fig4_dir.empty()) return fig4(args);
+    if (!args.mosd_dir.empty()) return mosd_report(args);
+    return evaluate_files(args);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "primlabel-eval: error: %s\n", e.what());
+    return cli::kExitFailure;
+  }
+}

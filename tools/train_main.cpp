@@ -1,0 +1,253 @@
+// primlabel-train: trains a labeling model (CRF, node-only, SVM) from labeled synthetic scenes or
+// labeled PCD/PLY files and writes a model file.
+//
+//   primlabel-train --synth-train 4 --synth-val 1 --sensor lms400 -o table.plm --curve curve.csv
+//   primlabel-train --train a.pcd b.pcd --val c.pcd --classes map.txt --kind node -o m.plm
+//   primlabel-train --synth-train 3 --kind svm --svm-max-points 20000 -o svm.plm
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "cli_common.hpp"
+#include "node_basis.hpp"
+#include "primlabel/build_version.hpp"
+#include "primlabel/research/curve_plot.hpp"
+#include "primlabel/pipeline/training.hpp"
+#include "primlabel/synth/generate.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
+
+namespace {
+
+using namespace primlabel;
+
+struct Arguments {
+  int synth_train = 8, synth_val = 1, iterations = 200, graph_k = 8, threads = 0;
+  std::string sensor = "lms400", kind = "crf", objective = "piecewise", descriptor = "fpfh";
+  std::string fpfh_variant = "paper", node_basis = "tent";
+  double label_radius = synth::kDefaultLabelRadius, l2 = 1e-6, svm_c = 10.0, svm_gamma = 0.0;
+  std::size_t svm_max_points = 20000;
+  std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
+  float feature_radius = 0.025f, normal_radius = 0.01f;
+  std::vector<std::string> train_files, val_files;
+  std::string classes, output, curve_csv, curve_png, name;
+  bool quiet = false;
+};
+
+void say(const Arguments& args, const std::string& line) {
+  if (!args.quiet) std::fprintf(stderr, "%s\n", line.c_str());
+}
+
+std::vector<pipeline::SceneData> load_scenes(const Arguments& args, bool validation,
+                                             const FeatureSettings& features,
+                                             const crf::GraphOptions& graph) {
+  const std::vector<std::uint32_t> every_class = [] {
+    std::vector<std::uint32_t> ids;
+    for (PrimitiveClass c : all_classes()) ids.push_back(class_id(c));
+    return ids;
+  }();
+  std::vector<pipeline::SceneData> scenes;
+  auto add = [&](PointCloud cloud, const std::string& source) {
+    const auto start = std::chrono::steady_clock::now();
+    scenes.push_back(pipeline::prepare_scene(std::move(cloud), source, features, graph, every_class,
+                                             args.threads));
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    char line[512];
+    std::snprintf(line, sizeof line, "%s: %s, %zu points described in %.1f s",
+                  validation ? "validation" : "training", source.c_str(),
+                  scenes.back().truth.size(), s);
+    say(args, line);
+  };
+  const auto& files = validation ? args.val_files : args.train_files;
+  if (!args.train_files.empty()) {
+    const ClassMap map = args.classes.empty() ? ClassMap{} : read_class_map(args.classes);
+    for (const std::string& path : files)
+      add(args.classes.empty() ? load_labeled_cloud(path) : load_labeled_cloud(path, map), path);
+    return scenes;
+  }
+  const auto sensor = synth::sensor_from_name(args.sensor);
+  const auto set = validation ? synth::SceneSet::kVal : synth::SceneSet::kTrain;
+  const int count = validation ? args.synth_val : args.synth_train;
+  for (int i = 0; i < count; ++i)
+    add(synth::synthetic_scene(set, i, *sensor, args.label_radius),
+        "synth:" + args.sensor + ":" + std::string(synth::set_name(set)) + ":seed" +
+            std::to_string(synth::set_seed(set, i)));
+  return scenes;
+}
+
+int run(const Arguments& args) {
+  FeatureSettings features;
+  features.descriptor = args.descriptor == "pfh" ? DescriptorKind::kPfh : DescriptorKind::kFpfh;
+  features.fpfh_variant =
+      args.fpfh_variant == "paper" ? FpfhVariant::kWithOwnSpfh : FpfhVariant::kPcl;
+  features.normals = Neighborhood::Radius(args.normal_radius);
+  features.features = Neighborhood::Radius(args.feature_radius);
+  crf::GraphOptions graph;
+  graph.neighborhood = Neighborhood::Knn(args.graph_k);
+
+  std::vector<pipeline::SceneData> train = load_scenes(args, false, features, graph);
+  std::vector<pipeline::SceneData> val = load_scenes(args, true, features, graph);
+  const std::vector<std::uint32_t> class_ids = pipeline::classes_present(train);
+  if (class_ids.empty()) {
+    std::fprintf(stderr, "primlabel-train: error: the training data has no labeled point\n");
+    return cli::kExitFailure;
+  }
+  for (auto* set : {&train, &val})
+    for (auto& scene : *set) pipeline::assign_labels(scene, class_ids);
+  std::string names;
+  for (std::uint32_t id : class_ids) names += " " + std::string(name(*class_from_id(id)));
+  say(args, "classes:" + names);
+
+  pipeline::ModelTrainingOptions options;
+  options.kind = args.kind == "node"  ? ModelKind::kNodeOnly
+                 : args.kind == "svm" ? ModelKind::kSvm
+                                      : ModelKind::kCrf;
+  options.svm.c = args.svm_c;
+  options.svm.gamma = args.svm_gamma;
+  options.svm.max_training_points = args.svm_max_points;
+  options.objective = args.objective == "bethe" ? crf::TrainingObjective::kBetheBp
+                      : args.objective == "pl"  ? crf::TrainingObjective::kPseudoLikelihood
+                                                : crf::TrainingObjective::kPiecewise;
+  options.l2 = args.l2;
+  options.iterations = args.iterations;
+  options.node_knots = args.node_knots;
+  options.threads = args.threads;
+  std::vector<crf::TrainingIteration> curve;
+  if (options.kind != ModelKind::kSvm && (!args.curve_csv.empty() || !args.curve_png.empty()))
+    options.on_iteration = [&](const crf::TrainingIteration& it) {
+      curve.push_back(it);
+      char line[256];
+      std::snprintf(
+          line, sizeof line, "iteration %d: objective %.5f, train %.4f, validation %.4f (%.1f s)",
+          it.iteration, it.objective, it.train_accuracy, it.validation_accuracy, it.seconds);
+      say(args, line);
+    };
+  say(args, "training " + args.kind + " (" +
+                (options.kind == ModelKind::kNodeOnly ? std::string("node-only")
+                 : options.kind == ModelKind::kSvm    ? std::string("libsvm RBF")
+                                                      : args.objective) +
+                ")...");
+  pipeline::ModelTrainingResult trained =
+      pipeline::train_label_model(train, val, class_ids, features, graph, options);
+  LabelModel& model = trained.model;
+  if (options.kind != ModelKind::kNodeOnly) say(args, model.training.objective);
+  if (!args.name.empty()) model.name = args.name;
+  save_model(args.output, model);
+
+  if (!args.curve_csv.empty()) {
+    std::ofstream out(args.curve_csv);
+    crf::write_training_curve_csv(out, curve);
+    if (!out) throw std::runtime_error(args.curve_csv + ": cannot be written");
+  }
+  if (!args.curve_png.empty()) research::write_curve_png(args.curve_png, curve);
+
+  const std::string how = options.kind == ModelKind::kSvm
+                              ? std::string("libsvm")
+                              : std::to_string(trained.details.iterations) + " iterations (" +
+                                    trained.details.message + ")";
+  char line[512];
+  std::snprintf(line, sizeof line, "trained in %.1f s, %s; validation accuracy %s; wrote %s",
+                trained.seconds, how.c_str(),
+                val.empty() ? "-" : std::to_string(model.validation.accuracy).c_str(),
+                args.output.c_str());
+  say(args, line);
+  return cli::kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Train a point labeling model (CRF, node-only or SVM) from labeled clouds."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-train"));
+  app.name("primlabel-train");
+  Arguments args;
+  auto* synth_train =
+      app.add_option("--synth-train", args.synth_train, "synthetic training scenes (default 8)")
+          ->check(CLI::PositiveNumber);
+  auto* synth_val =
+      app.add_option("--synth-val", args.synth_val, "synthetic validation scenes (default 1)")
+          ->check(CLI::NonNegativeNumber);
+  app.add_option("--sensor", args.sensor, "synthetic sensor: lms400 or kinect")
+      ->check(CLI::IsMember({"lms400", "kinect"}));
+  app.add_option("--radius", args.label_radius, "label radius of the synthetic ground truth (m)")
+      ->check(CLI::PositiveNumber);
+  auto* train_files = app.add_option("--train", args.train_files, "labeled PCD/PLY training files")
+                          ->excludes(synth_train);
+  app.add_option("--val", args.val_files, "labeled PCD/PLY validation files")
+      ->needs(train_files)
+      ->excludes(synth_val);
+  app.add_option("--classes", args.classes, "class map of the files' labels (id name per line)")
+      ->needs(train_files);
+  app.add_option("--kind", args.kind, "crf, node (node-only) or svm")
+      ->check(CLI::IsMember({"crf", "node", "svm"}));
+  app.add_option("--svm-c", args.svm_c, "SVM: C (default 10)")->check(CLI::PositiveNumber);
+  app.add_option("--svm-gamma", args.svm_gamma,
+                 "SVM: RBF gamma (default 0: 1 / mean squared feature distance)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--svm-max-points", args.svm_max_points,
+                 "SVM: train on at most this many points, a seeded subsample (default 20000)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--objective", args.objective,
+                 "CRF objective: piecewise (default: node factors, then a validated coupling), "
+                 "pl (pseudo-likelihood) or bethe (loopy BP)")
+      ->check(CLI::IsMember({"piecewise", "pl", "bethe"}));
+  app.add_option("--descriptor", args.descriptor, "fpfh or pfh")
+      ->check(CLI::IsMember({"fpfh", "pfh"}));
+  app.add_option("--fpfh-variant", args.fpfh_variant,
+                 "paper (default: also the point's own SPFH, as Open3D) or pcl (as PCL)")
+      ->check(CLI::IsMember({"pcl", "paper"}));
+  app.add_option("--node-basis", args.node_basis,
+                 "CRF / node-only node features: tent (default: a piecewise-linear function of "
+                 "each bin) or linear (the bins themselves, as the paper)")
+      ->check(CLI::IsMember({"tent", "linear"}));
+  app.add_option("--node-knots", args.node_knots, cli::kNodeKnotsHelp)->delimiter(',');
+  app.add_option("--l2", args.l2, "L2 regularisation (default 1e-6)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--iterations", args.iterations, "L-BFGS iterations (default 200)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--feature-radius", args.feature_radius, "descriptor radius (m, default 0.025)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--normal-radius", args.normal_radius, "normal radius (m, default 0.01)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--graph-k", args.graph_k, "CRF graph: K nearest neighbours (default 8)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("-o,--output", args.output, "model file to write")->required();
+  app.add_option("--name", args.name, "model name recorded in the file");
+  app.add_option("--curve", args.curve_csv, "training curve CSV (objective, accuracies)");
+  app.add_option("--curve-png", args.curve_png, "training curve plot (PNG)");
+  app.add_option("--threads", args.threads, "worker threads (default: all cores)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "primlabel-train: usage error: %s (see --help)\n", e.what());
+    return cli::kExitUsage;
+  }
+  try {  // before any scene is described
+    args.node_knots = cli::node_knots(args.node_basis, args.node_knots);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "primlabel-train: usage error: %s\n", e.what());
+    return cli::kExitUsage;
+  }
+  if (args.kind == "svm" && (!args.curve_csv.empty() || !args.curve_png.empty())) {
+    std::fprintf(stderr,
+                 "primlabel-train: usage error: --curve and --curve-png need an iterative model "
+                 "(--kind crf or node)\n");
+    return cli::kExitUsage;
+  }
+  try {
+    return run(args);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "primlabel-train: usage error: %s\n", e.what());
+    return cli::kExitUsage;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "primlabel-train: error: %s\n", e.what());
+    return cli::kExitFailure;
+  }
+}
