@@ -4,10 +4,12 @@
 #include <exception>
 #include <iostream>
 
+#include "primlabel/build_version.hpp"
 #include "features_bench.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"primlabel benchmarks: throughput and memory, optionally against PCL"};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-bench"));
   app.require_subcommand(1);
 
   primlabel::bench::FeaturesBenchOptions features_options;

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "primlabel/build_version.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
 #include "synthetic.hpp"
@@ -81,6 +82,7 @@ double accuracy(const InferenceResult& r, const LabeledGraph& scene) {
 int main(int argc, char** argv) {
   Arguments args;
   CLI::App app{"CRF inference throughput (points/s) on a synthetic kNN scene"};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-bench-crf"));
   app.add_option("--points", args.points, "points in the test scene (a square grid)");
   app.add_option("--classes", args.classes, "classes K");
   app.add_option("--neighbors", args.neighbors, "k of the kNN graph");

@@ -23,6 +23,7 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+#include "primlabel/build_version.hpp"
 
 namespace {
 
@@ -147,6 +148,7 @@ bool has_field(const pcl::PCLPointCloud2& blob, const std::string& name) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Writes PCL 1.13 reference normals/FPFH/PFH for a PCD as CSV fixtures"};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-pcl-reference"));
   std::string input;
   std::string output_dir = ".";
   std::string name;

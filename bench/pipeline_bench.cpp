@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "primlabel/build_version.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
@@ -237,6 +238,7 @@ int run(const Arguments& args) {
 int main(int argc, char** argv) {
   CLI::App app{
       "End-to-end labeling throughput (label_cloud) on synthetic LMS400 and Kinect scenes."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-bench-pipeline"));
   app.name("primlabel-bench-pipeline");
   Arguments args;
   app.add_option("--model", args.model, "model file (default: a quick model per sensor)");

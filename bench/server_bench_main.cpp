@@ -20,6 +20,7 @@
 #include <stop_token>
 #include <thread>
 
+#include "primlabel/build_version.hpp"
 #include "label_server.hpp"
 #include "logging.hpp"
 #include "primlabel/pipeline/labeling.hpp"
@@ -185,6 +186,7 @@ int main(int argc, char** argv) {
   // When to stop the cancelled request (ms after it started / after the upload ended).
   std::vector<int> cancel_at = {300, 1500, 4000, 8000};
   CLI::App app{"End-to-end latency of primlabel-server against label_cloud in process."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-bench-server"));
   app.name("primlabel-bench-server");
   app.add_option("--reps-table", reps_table, "repetitions on the 22k table scene")
       ->capture_default_str();

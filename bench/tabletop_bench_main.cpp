@@ -12,6 +12,7 @@
 #include <limits>
 #include <sstream>
 
+#include "primlabel/build_version.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/tabletop/segmentation_eval.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
@@ -146,6 +147,7 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Milliseconds per scene of the table-top pre-filter, optionally against PCL."};
+  app.set_version_flag("--version", primlabel::version_line("primlabel-bench-tabletop"));
   app.name("primlabel-bench-tabletop");
   Arguments args;
   app.add_option("inputs", args.inputs, "scans (.pcd or .ply)")->required();
