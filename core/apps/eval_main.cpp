@@ -17,6 +17,7 @@
 
 #include "cli_common.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/core/atomic_file.hpp"
 #include "primlabel/core/cloud_io.hpp"
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/pipeline/confusion_plot.hpp"
@@ -192,7 +193,7 @@ int mosd_report(const Arguments& args) {
   const std::string json = pipeline::mosd_report_json(report);
   const std::string json_path =
       (std::filesystem::path(args.mosd_dir) / "mosd_report.json").string();
-  std::ofstream(json_path) << json;
+  atomic_write_file(json_path, json);
   std::fputs((args.json ? json : pipeline::mosd_report_text(report)).c_str(), stdout);
   return cli::kExitOk;
 }

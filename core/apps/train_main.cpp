@@ -9,10 +9,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 
 #include "cli_common.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/core/atomic_file.hpp"
 #include "primlabel/pipeline/curve_plot.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/labeled_cloud.hpp"
@@ -136,9 +137,9 @@ int run(const Arguments& args) {
   save_model(args.output, model);
 
   if (!args.curve_csv.empty()) {
-    std::ofstream out(args.curve_csv);
-    crf::write_training_curve_csv(out, curve);
-    if (!out) throw std::runtime_error(args.curve_csv + ": cannot be written");
+    std::ostringstream csv;
+    crf::write_training_curve_csv(csv, curve);
+    atomic_write_file(args.curve_csv, csv.str());
   }
   if (!args.curve_png.empty()) pipeline::write_curve_png(args.curve_png, curve);
 
