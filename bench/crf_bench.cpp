@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "primlabel/core/exit_codes.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
 #include "synthetic.hpp"
@@ -81,6 +82,8 @@ double accuracy(const InferenceResult& r, const LabeledGraph& scene) {
 int main(int argc, char** argv) {
   Arguments args;
   CLI::App app{"CRF inference throughput (points/s) on a synthetic kNN scene"};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.add_option("--points", args.points, "points in the test scene (a square grid)");
   app.add_option("--classes", args.classes, "classes K");
   app.add_option("--neighbors", args.neighbors, "k of the kNN graph");
@@ -92,7 +95,13 @@ int main(int argc, char** argv) {
                  "piecewise training makes) or trained (pseudo-likelihood)")
       ->check(CLI::IsMember({"prototype", "potts", "trained"}));
   app.add_option("--methods", args.methods, "bp-sum,bp-max,mean-field,node-only")->delimiter(',');
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "primlabel-bench-crf: usage error: %s (see --help)\n", e.what());
+    return primlabel::kExitUsage;
+  }
 
   testing::SceneSpec spec;
   spec.width = std::max(4, static_cast<int>(std::lround(std::sqrt(double(args.points)))));

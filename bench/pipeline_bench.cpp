@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "primlabel/core/exit_codes.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 
@@ -236,6 +237,8 @@ int run(const Arguments& args) {
 int main(int argc, char** argv) {
   CLI::App app{
       "End-to-end labeling throughput (label_cloud) on synthetic LMS400 and Kinect scenes."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.name("primlabel-bench-pipeline");
   Arguments args;
   app.add_option("--model", args.model, "model file (default: a quick model per sensor)");
@@ -250,11 +253,17 @@ int main(int argc, char** argv) {
   app.add_option("--stop-latency", args.stop_latency,
                  "instead: stop this many runs per input at random moments, print the latency")
       ->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "primlabel-bench-pipeline: usage error: %s (see --help)\n", e.what());
+    return primlabel::kExitUsage;
+  }
   try {
     return run(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "primlabel-bench-pipeline: error: %s\n", e.what());
-    return 1;
+    return primlabel::kExitFailure;
   }
 }

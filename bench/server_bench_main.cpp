@@ -22,6 +22,7 @@
 
 #include "label_server.hpp"
 #include "logging.hpp"
+#include "primlabel/core/exit_codes.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/scrape/exposition_parser.hpp"
@@ -184,6 +185,8 @@ int main(int argc, char** argv) {
   // When to stop the cancelled request (ms after it started / after the upload ended).
   std::vector<int> cancel_at = {300, 1500, 4000, 8000};
   CLI::App app{"End-to-end latency of primlabel-server against label_cloud in process."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.name("primlabel-bench-server");
   app.add_option("--reps-table", reps_table, "repetitions on the 22k table scene")
       ->capture_default_str();
@@ -196,7 +199,13 @@ int main(int argc, char** argv) {
   app.add_flag("--cancel-only", cancel_only, "only the cancellation figures (no table / kinect)");
   app.add_option("--cancel-at", cancel_at, "moments (ms) at which the 5M request is cancelled")
       ->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "primlabel-bench-server: usage error: %s (see --help)\n", e.what());
+    return primlabel::kExitUsage;
+  }
 
   server::set_log_level(server::LogLevel::kWarn);
   const fs::path repo = fs::temp_directory_path() / ("primlabel_bench_" + std::to_string(getpid()));

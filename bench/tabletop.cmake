@@ -2,7 +2,8 @@
 # SACSegmentation + ConvexHull + ExtractPolygonalPrismData + EuclideanClusterExtraction.
 # Included by bench/CMakeLists.txt (include(${CMAKE_CURRENT_SOURCE_DIR}/tabletop.cmake)).
 add_executable(primlabel-bench-tabletop ${CMAKE_CURRENT_LIST_DIR}/tabletop_bench_main.cpp)
-target_link_libraries(primlabel-bench-tabletop PRIVATE primlabel::core CLI11::CLI11)
+target_link_libraries(primlabel-bench-tabletop PRIVATE primlabel::core CLI11::CLI11
+  nlohmann_json::nlohmann_json)
 
 if(PRIMLABEL_WITH_PCL)
   # As in bench/CMakeLists.txt: Debian 12's VTK config names MPI::MPI_C without finding MPI.

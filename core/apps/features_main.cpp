@@ -102,6 +102,8 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Estimate normals and FPFH/PFH descriptors for every point of a PCD/PLY cloud."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-features"));
   app.name("primlabel-features");
   Arguments args;

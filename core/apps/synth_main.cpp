@@ -13,7 +13,9 @@
 
 #include "cli_common.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/core/atomic_file.hpp"
 #include "primlabel/core/cloud_io.hpp"
+#include "primlabel/core/json_text.hpp"
 #include "primlabel/core/taxonomy.hpp"
 #include "primlabel/synth/generate.hpp"
 
@@ -73,15 +75,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 int write_one(const Arguments& args) {
   const auto start = std::chrono::steady_clock::now();
   const Generated scan = generate(options_from(args, args.seed));
@@ -106,7 +99,7 @@ int write_set(const Arguments& args) {
   std::filesystem::create_directories(args.out_dir);
   const std::filesystem::path dir(args.out_dir);
   write_class_map((dir / "classes.txt").string(), ClassMap::taxonomy());
-  std::string scenes;
+  json::Json scenes = json::Json::array();
   for (int i = 0; i < args.count; ++i) {
     const std::uint64_t seed = set_seed(set, i);
     char file[64];
@@ -114,28 +107,23 @@ int write_set(const Arguments& args) {
     const Generated scan = generate(options_from(args, seed));
     write_tagged_cloud((dir / file).string(), scan.cloud, scan.tags);
     const std::size_t valid = count_finite(scan.cloud);
-    scenes += std::string(i ? ",\n" : "") + "    {\"file\": " + json_string(file) +
-              ", \"seed\": " + std::to_string(seed) + ", \"points\": " + std::to_string(valid) +
-              ", \"objects\": " + json_string(scan.tags.at("objects")) + "}";
+    scenes.push_back(
+        {{"file", file}, {"seed", seed}, {"points", valid}, {"objects", scan.tags.at("objects")}});
     if (!args.quiet)
       std::fprintf(stderr, "%s: %zu points (seed %llu)\n", file, valid,
                    static_cast<unsigned long long>(seed));
   }
-  std::string classes;
+  json::Json classes = json::Json::array();
   for (PrimitiveClass c : all_classes())
-    classes += std::string(classes.empty() ? "" : ", ") +
-               "{\"id\": " + std::to_string(class_id(c)) +
-               ", \"name\": " + json_string(std::string(name(c))) + "}";
-  char radius[32];
-  std::snprintf(radius, sizeof radius, "%.6g", args.radius);
+    classes.push_back({{"id", class_id(c)}, {"name", std::string(name(c))}});
+  const json::Json manifest = {{"set", args.set},
+                               {"scene", args.scene},
+                               {"sensor", args.sensor},
+                               {"label_radius", json::rounded(args.radius, "%.6g")},
+                               {"classes", std::move(classes)},
+                               {"scenes", std::move(scenes)}};
   const std::string manifest_path = (dir / (args.set + "_manifest.json")).string();
-  std::ofstream manifest(manifest_path);
-  manifest << "{\n  \"set\": " << json_string(args.set)
-           << ",\n  \"scene\": " << json_string(args.scene)
-           << ",\n  \"sensor\": " << json_string(args.sensor) << ",\n  \"label_radius\": " << radius
-           << ",\n  \"classes\": [" << classes << "],\n  \"scenes\": [\n"
-           << scenes << "\n  ]\n}\n";
-  if (!manifest) throw std::runtime_error(manifest_path + ": cannot write");
+  atomic_write_file(manifest_path, json::dump(manifest, 2) + "\n");
   if (!args.quiet)
     std::fprintf(stderr, "wrote %d %s scenes and %s\n", args.count, args.set.c_str(),
                  manifest_path.c_str());
@@ -151,6 +139,8 @@ int usage_error(const std::string& message) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Labeled synthetic table scenes from a simulated laser line scanner or Kinect."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-synth"));
   app.name("primlabel-synth");
   Arguments args;

@@ -160,6 +160,8 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Train a point labeling model (CRF, node-only or SVM) from labeled clouds."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-train"));
   app.name("primlabel-train");
   Arguments args;

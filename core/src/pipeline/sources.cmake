@@ -21,5 +21,5 @@ target_link_libraries(primlabel-train PRIVATE primlabel::core CLI11::CLI11)
 add_executable(primlabel-eval
   ${CMAKE_CURRENT_SOURCE_DIR}/apps/eval_main.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/apps/cli_common.cpp)
-target_link_libraries(primlabel-eval PRIVATE primlabel::core CLI11::CLI11)
+target_link_libraries(primlabel-eval PRIVATE primlabel::core CLI11::CLI11 nlohmann_json::nlohmann_json)
 

@@ -15,4 +15,4 @@ target_sources(primlabel_core PRIVATE
 add_executable(primlabel-synth
   ${CMAKE_CURRENT_SOURCE_DIR}/apps/synth_main.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/apps/cli_common.cpp)
-target_link_libraries(primlabel-synth PRIVATE primlabel::core CLI11::CLI11)
+target_link_libraries(primlabel-synth PRIVATE primlabel::core CLI11::CLI11 nlohmann_json::nlohmann_json)

@@ -14,4 +14,5 @@ target_sources(primlabel_core PRIVATE
 # primlabel-tabletop: segments table scenes, scores them against mOSD labels, renders them.
 add_executable(primlabel-tabletop ${CMAKE_CURRENT_SOURCE_DIR}/apps/tabletop_main.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/apps/cli_common.cpp)
-target_link_libraries(primlabel-tabletop PRIVATE primlabel::core CLI11::CLI11)
+target_link_libraries(primlabel-tabletop PRIVATE primlabel::core CLI11::CLI11
+  nlohmann_json::nlohmann_json)
