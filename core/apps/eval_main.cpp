@@ -275,8 +275,9 @@ int main(int argc, char** argv) {
   app.add_option("--fig4-scenes", args.fig4_scenes, "Fig. 4: training scenes (default 3)")
       ->check(CLI::PositiveNumber)
       ->needs(f4);
-  app.add_option("--threads", args.threads, "worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--threads", args.threads, "worker threads")
+      ->check(CLI::PositiveNumber)
+      ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
   t1->excludes(model)->excludes(files)->excludes(f4);
   f4->excludes(model)->excludes(files);

@@ -158,20 +158,28 @@ int main(int argc, char** argv) {
                  "write a scene set from its own seed range: train (1000..), "
                  "val (2000..), test (3000..)")
       ->check(CLI::IsMember({"train", "val", "test"}));
-  app.add_option("--count", args.count, "scenes in the set (--set)")
-      ->check(CLI::Range(1, kMaxSetSize));
+  app.add_option("--count", args.count, "scenes in the set (--set, which needs it)")
+      ->check(CLI::Range(1, kMaxSetSize))
+      ->default_str("");
   app.add_option("--out-dir", args.out_dir, "directory for the set's clouds and manifest (--set)");
   app.add_option("--noise-scale", args.noise_scale, "multiply the sensor noise (0 = exact)")
       ->check(CLI::NonNegativeNumber);
+  // Unset (0, -1) means the sensor's or the scene's own value; --help says so.
   app.add_option("--dropout", args.dropout, "probability that a return is lost")
-      ->check(CLI::Range(0.0, 0.99));
-  app.add_option("--lines", args.lines, "lms400: sweep lines")->check(CLI::PositiveNumber);
+      ->check(CLI::Range(0.0, 0.99))
+      ->default_str("the sensor's");
+  app.add_option("--lines", args.lines, "lms400: sweep lines")
+      ->check(CLI::PositiveNumber)
+      ->default_str("the sensor's");
   app.add_option("--angular-step", args.angular_step, "lms400: degrees between beams of a line")
-      ->check(CLI::Range(0.01, 5.0));
+      ->check(CLI::Range(0.01, 5.0))
+      ->default_str("the sensor's");
   app.add_option("--min-objects", args.min_objects, "table scene: fewest objects")
-      ->check(CLI::Range(1, 20));
+      ->check(CLI::Range(1, 20))
+      ->default_str("the scene's");
   app.add_option("--max-objects", args.max_objects, "table scene: most objects")
-      ->check(CLI::Range(1, 20));
+      ->check(CLI::Range(1, 20))
+      ->default_str("the scene's");
   app.add_flag("--list-classes", args.list_classes,
                "print the classes as '<id> <name>' lines (a class map file) and exit");
   app.add_flag("-q,--quiet", args.quiet, "no summary on stderr");

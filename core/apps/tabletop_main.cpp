@@ -187,8 +187,9 @@ int main(int argc, char** argv) {
   app.add_option("--voxel-leaf", o.voxel_leaf, "fit and cluster on voxel centroids (m; 0 = off)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--seed", o.seed, "RANSAC seed");
-  app.add_option("--threads", o.threads, "worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--threads", o.threads, "worker threads")
+      ->check(CLI::PositiveNumber)
+      ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no summary lines (the JSON line stays)");
 
   try {

@@ -219,8 +219,9 @@ int main(int argc, char** argv) {
   app.add_option("--name", args.name, "model name recorded in the file");
   app.add_option("--curve", args.curve_csv, "training curve CSV (objective, accuracies)");
   app.add_option("--curve-png", args.curve_png, "training curve plot (PNG)");
-  app.add_option("--threads", args.threads, "worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--threads", args.threads, "worker threads")
+      ->check(CLI::PositiveNumber)
+      ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
 
   try {
