@@ -3,4 +3,4 @@
 add_executable(primlabel-bench-crf ${CMAKE_CURRENT_LIST_DIR}/crf_bench.cpp)
 # The scene generator is the header-only one the CRF tests use.
 target_include_directories(primlabel-bench-crf PRIVATE ${CMAKE_SOURCE_DIR}/tests/crf)
-target_link_libraries(primlabel-bench-crf PRIVATE primlabel::core CLI11::CLI11)
+target_link_libraries(primlabel-bench-crf PRIVATE primlabel::core CLI11::CLI11 nlohmann_json::nlohmann_json)

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "primlabel/core/exit_codes.hpp"
+#include "primlabel/core/json_text.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
 #include "synthetic.hpp"
@@ -205,24 +206,26 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::ostringstream json;
-  json << "{\"bench\":\"crf\",\"points\":" << n << ",\"edges\":" << scene.graph.num_edges()
-       << ",\"classes\":" << spec.num_classes << ",\"dim\":" << spec.dim << ",\"model\":\""
-       << args.model << "\",\"results\":[";
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    const Row& row = rows[r];
-    char buf[320];
-    std::snprintf(
-        buf, sizeof buf,
-        "%s{\"method\":\"%s\",\"threads\":%d,\"marginals\":%s,\"workspace\":%s,"
-        "\"ms\":%.2f,\"cpu_ms\":%.2f,\"points_per_s\":%.0f,\"iterations\":%d,\"converged\":%s,"
-        "\"accuracy\":%.4f}",
-        r ? "," : "", row.name.c_str(), row.threads, row.marginals ? "true" : "false",
-        row.workspace ? "true" : "false", row.ms, row.cpu_ms, row.points_per_s, row.iterations,
-        row.converged ? "true" : "false", row.accuracy);
-    json << buf;
-  }
-  json << "]}";
-  std::printf("%s\n", json.str().c_str());
+  namespace json = primlabel::json;
+  json::Json results = json::Json::array();
+  for (const Row& row : rows)
+    results.push_back({{"method", row.name},
+                       {"threads", row.threads},
+                       {"marginals", row.marginals},
+                       {"workspace", row.workspace},
+                       {"ms", json::rounded(row.ms, "%.2f")},
+                       {"cpu_ms", json::rounded(row.cpu_ms, "%.2f")},
+                       {"points_per_s", json::whole(row.points_per_s)},
+                       {"iterations", row.iterations},
+                       {"converged", row.converged},
+                       {"accuracy", json::rounded(row.accuracy, "%.4f")}});
+  const json::Json line = {{"bench", "crf"},
+                           {"points", n},
+                           {"edges", scene.graph.num_edges()},
+                           {"classes", spec.num_classes},
+                           {"dim", spec.dim},
+                           {"model", args.model},
+                           {"results", std::move(results)}};
+  std::printf("%s\n", json::dump(line).c_str());
   return 0;
 }

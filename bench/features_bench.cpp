@@ -21,7 +21,9 @@
 #include <vector>
 
 #include "primlabel/core/cloud_io.hpp"
+#include "primlabel/core/exit_codes.hpp"
 #include "primlabel/core/features.hpp"
+#include "primlabel/core/json_text.hpp"
 #include "primlabel/core/neighbor_search.hpp"
 #include "primlabel/core/normals.hpp"
 #include "primlabel/core/point_cloud.hpp"
@@ -29,8 +31,6 @@
 
 #ifdef PRIMLABEL_HAVE_PCL
 #include "pcl_peer.hpp"
-#include "primlabel/core/exit_codes.hpp"
-#include "primlabel/core/json_text.hpp"
 #endif
 
 namespace primlabel::bench {

@@ -23,6 +23,7 @@
 #include "label_server.hpp"
 #include "logging.hpp"
 #include "primlabel/core/exit_codes.hpp"
+#include "primlabel/core/json_text.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/scrape/exposition_parser.hpp"
@@ -279,17 +280,25 @@ int main(int argc, char** argv) {
 
   auto p50 = [](const std::vector<double>& v) { return v.empty() ? 0.0 : percentile(v, 0.5); };
   auto p99 = [](const std::vector<double>& v) { return v.empty() ? 0.0 : percentile(v, 0.99); };
-  std::printf(
-      "{\"table_points\":%zu,\"table_server_p50_ms\":%.2f,\"table_server_p99_ms\":%.2f,"
-      "\"table_local_p50_ms\":%.2f,\"kinect_points\":%zu,\"kinect_server_p50_ms\":%.2f,"
-      "\"kinect_server_p99_ms\":%.2f,\"kinect_local_p50_ms\":%.2f,\"kinect_overhead\":%.4f,"
-      "\"cancel_grpc_p99_ms\":%.1f,\"cancel_grpc_max_ms\":%.1f,\"cancel_local_max_ms\":%.1f}\n",
-      std::size_t(22000), p50(table.server_ms), p99(table.server_ms), p50(table.local_ms),
-      kinect.size(), p50(frame.server_ms), p99(frame.server_ms), p50(frame.local_ms),
-      frame.local_ms.empty() ? 0.0
-                             : (p50(frame.server_ms) - p50(frame.local_ms)) / p50(frame.local_ms),
-      p99(cancel_ms),
-      cancel_ms.empty() ? 0.0 : *std::max_element(cancel_ms.begin(), cancel_ms.end()),
-      local_stop_ms.empty() ? 0.0 : *std::max_element(local_stop_ms.begin(), local_stop_ms.end()));
+  namespace json = primlabel::json;
+  const auto max_of = [](const std::vector<double>& v) {
+    return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+  };
+  const double overhead = frame.local_ms.empty()
+                              ? 0.0
+                              : (p50(frame.server_ms) - p50(frame.local_ms)) / p50(frame.local_ms);
+  const json::Json line = {{"table_points", std::size_t(22000)},
+                           {"table_server_p50_ms", json::rounded(p50(table.server_ms), "%.2f")},
+                           {"table_server_p99_ms", json::rounded(p99(table.server_ms), "%.2f")},
+                           {"table_local_p50_ms", json::rounded(p50(table.local_ms), "%.2f")},
+                           {"kinect_points", kinect.size()},
+                           {"kinect_server_p50_ms", json::rounded(p50(frame.server_ms), "%.2f")},
+                           {"kinect_server_p99_ms", json::rounded(p99(frame.server_ms), "%.2f")},
+                           {"kinect_local_p50_ms", json::rounded(p50(frame.local_ms), "%.2f")},
+                           {"kinect_overhead", json::rounded(overhead, "%.4f")},
+                           {"cancel_grpc_p99_ms", json::rounded(p99(cancel_ms), "%.1f")},
+                           {"cancel_grpc_max_ms", json::rounded(max_of(cancel_ms), "%.1f")},
+                           {"cancel_local_max_ms", json::rounded(max_of(local_stop_ms), "%.1f")}};
+  std::printf("%s\n", json::dump(line).c_str());
   return 0;
 }

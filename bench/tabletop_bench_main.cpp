@@ -13,11 +13,11 @@
 #include <sstream>
 
 #include "primlabel/core/cloud_io.hpp"
+#include "primlabel/core/exit_codes.hpp"
+#include "primlabel/core/json_text.hpp"
 #include "primlabel/tabletop/segmentation_eval.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
 #ifdef PRIMLABEL_HAVE_PCL
-#include "primlabel/core/exit_codes.hpp"
-#include "primlabel/core/json_text.hpp"
 #include "tabletop_pcl_peer.hpp"
 #endif
 
