@@ -18,7 +18,9 @@
 #include <string>
 #include <vector>
 
+#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
 #include "synthetic.hpp"
@@ -83,6 +85,8 @@ int main(int argc, char** argv) {
   Arguments args;
   CLI::App app{"CRF inference throughput (points/s) on a synthetic kNN scene"};
   app.set_version_flag("--version", primlabel::version_line("primlabel-bench-crf"));
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.add_option("--points", args.points, "points in the test scene (a square grid)");
   app.add_option("--classes", args.classes, "classes K");
   app.add_option("--neighbors", args.neighbors, "k of the kNN graph");
@@ -94,7 +98,13 @@ int main(int argc, char** argv) {
                  "piecewise training makes) or trained (pseudo-likelihood)")
       ->check(CLI::IsMember({"prototype", "potts", "trained"}));
   app.add_option("--methods", args.methods, "bp-sum,bp-max,mean-field,node-only")->delimiter(',');
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "primlabel-bench-crf: usage error: %s (see --help)\n", e.what());
+    return primlabel::kExitUsage;
+  }
 
   testing::SceneSpec spec;
   spec.width = std::max(4, static_cast<int>(std::lround(std::sqrt(double(args.points)))));
@@ -198,24 +208,26 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::ostringstream json;
-  json << "{\"bench\":\"crf\",\"points\":" << n << ",\"edges\":" << scene.graph.num_edges()
-       << ",\"classes\":" << spec.num_classes << ",\"dim\":" << spec.dim << ",\"model\":\""
-       << args.model << "\",\"results\":[";
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    const Row& row = rows[r];
-    char buf[320];
-    std::snprintf(
-        buf, sizeof buf,
-        "%s{\"method\":\"%s\",\"threads\":%d,\"marginals\":%s,\"workspace\":%s,"
-        "\"ms\":%.2f,\"cpu_ms\":%.2f,\"points_per_s\":%.0f,\"iterations\":%d,\"converged\":%s,"
-        "\"accuracy\":%.4f}",
-        r ? "," : "", row.name.c_str(), row.threads, row.marginals ? "true" : "false",
-        row.workspace ? "true" : "false", row.ms, row.cpu_ms, row.points_per_s, row.iterations,
-        row.converged ? "true" : "false", row.accuracy);
-    json << buf;
-  }
-  json << "]}";
-  std::printf("%s\n", json.str().c_str());
+  namespace json = primlabel::json;
+  json::Json results = json::Json::array();
+  for (const Row& row : rows)
+    results.push_back({{"method", row.name},
+                       {"threads", row.threads},
+                       {"marginals", row.marginals},
+                       {"workspace", row.workspace},
+                       {"ms", json::rounded(row.ms, "%.2f")},
+                       {"cpu_ms", json::rounded(row.cpu_ms, "%.2f")},
+                       {"points_per_s", json::whole(row.points_per_s)},
+                       {"iterations", row.iterations},
+                       {"converged", row.converged},
+                       {"accuracy", json::rounded(row.accuracy, "%.4f")}});
+  const json::Json line = {{"bench", "crf"},
+                           {"points", n},
+                           {"edges", scene.graph.num_edges()},
+                           {"classes", spec.num_classes},
+                           {"dim", spec.dim},
+                           {"model", args.model},
+                           {"results", std::move(results)}};
+  std::printf("%s\n", json::dump(line).c_str());
   return 0;
 }

@@ -20,8 +20,10 @@
 #include <utility>
 #include <vector>
 
+#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/features.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/normals.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
@@ -37,8 +39,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr int kExitOk = 0;
-constexpr int kExitUsage = 2;
+using primlabel::kExitOk;
+using primlabel::kExitUsage;
 
 // Points sampled (evenly spaced indices) to estimate neighbourhood sizes outside the timed runs.
 constexpr std::size_t kNeighborhoodSamples = 2000;
@@ -65,45 +67,20 @@ double peak_rss_mb() {
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
 }
 
-// One JSON object on one line, keys in insertion order. Non-finite numbers become null.
+// One JSON object on one line (nlohmann-json), keys in insertion order. Numbers keep the 9
+// significant digits the line has always had; non-finite ones become null.
 class JsonLine {
  public:
-  void add(const std::string& key, double value) {
-    if (!std::isfinite(value)) return add_raw(key, "null");
-    char buffer[40];
-    std::snprintf(buffer, sizeof(buffer), "%.9g", value);
-    add_raw(key, buffer);
-  }
-  void add(const std::string& key, std::size_t value) { add_raw(key, std::to_string(value)); }
-  void add(const std::string& key, int value) { add_raw(key, std::to_string(value)); }
-  void add(const std::string& key, bool value) { add_raw(key, value ? "true" : "false"); }
-  void add(const std::string& key, const std::string& value) { add_raw(key, quote(value)); }
-  void add_null(const std::string& key) { add_raw(key, "null"); }
-  std::string str() const { return "{" + body_.str() + "}"; }
+  void add(const std::string& key, double value) { line_[key] = json::rounded(value, "%.9g"); }
+  void add(const std::string& key, std::size_t value) { line_[key] = value; }
+  void add(const std::string& key, int value) { line_[key] = value; }
+  void add(const std::string& key, bool value) { line_[key] = value; }
+  void add(const std::string& key, const std::string& value) { line_[key] = value; }
+  void add_null(const std::string& key) { line_[key] = nullptr; }
+  std::string str() const { return json::dump(line_); }
 
  private:
-  static std::string quote(const std::string& text) {
-    std::string out = "\"";
-    for (char c : text) {
-      if (c == '"' || c == '\\') {
-        out += '\\';
-        out += c;
-      } else if (static_cast<unsigned char>(c) < 0x20) {
-        char buffer[8];
-        std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
-        out += buffer;
-      } else {
-        out += c;
-      }
-    }
-    return out + "\"";
-  }
-  void add_raw(const std::string& key, const std::string& value) {
-    body_ << (first_ ? "" : ",") << quote(key) << ":" << value;
-    first_ = false;
-  }
-  std::ostringstream body_;
-  bool first_ = true;
+  json::Json line_ = json::Json::object();
 };
 
 // The finite points of `cloud` as a new unorganised cloud (xyz and viewpoint only): both

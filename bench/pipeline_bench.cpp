@@ -24,7 +24,9 @@
 #include <thread>
 #include <vector>
 
+#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
@@ -166,11 +168,10 @@ int run_stop_latency(const Arguments& args) {
   const int threads = args.threads.front();
   std::printf("%-16s %8s %9s %6s %9s %9s %9s\n", "input", "points", "full s", "stops", "p50 ms",
               "p99 ms", "max ms");
-  std::ostringstream json;
-  json << "{\"bench\":\"stop_latency\",\"threads\":" << threads << ",\"rows\":[";
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
+  namespace json = primlabel::json;
+  json::Json rows = json::Json::array();
+  for (const auto& [name, cloud] : inputs) {
     double full_s = 0;
-    const auto& [name, cloud] = inputs[i];
     const std::vector<double> ms = stop_latencies(model, cloud, threads, args.stop_latency, full_s);
     const auto at = [&](double q) {
       return ms.empty() ? 0.0 : ms[std::min(ms.size() - 1, std::size_t(q * double(ms.size())))];
@@ -178,16 +179,17 @@ int run_stop_latency(const Arguments& args) {
     std::printf("%-16s %8zu %9.3f %6zu %9.1f %9.1f %9.1f\n", name.c_str(), cloud.size(), full_s,
                 ms.size(), at(0.5), at(0.99), ms.empty() ? 0.0 : ms.back());
     std::fflush(stdout);
-    char buffer[256];
-    std::snprintf(buffer, sizeof buffer,
-                  "%s{\"input\":\"%s\",\"points\":%zu,\"full_s\":%.3f,\"stops\":%zu,"
-                  "\"p50_ms\":%.2f,\"p99_ms\":%.2f,\"max_ms\":%.2f}",
-                  i ? "," : "", name.c_str(), cloud.size(), full_s, ms.size(), at(0.5), at(0.99),
-                  ms.empty() ? 0.0 : ms.back());
-    json << buffer;
+    rows.push_back({{"input", name},
+                    {"points", cloud.size()},
+                    {"full_s", json::rounded(full_s, "%.3f")},
+                    {"stops", ms.size()},
+                    {"p50_ms", json::rounded(at(0.5), "%.2f")},
+                    {"p99_ms", json::rounded(at(0.99), "%.2f")},
+                    {"max_ms", json::rounded(ms.empty() ? 0.0 : ms.back(), "%.2f")}});
   }
-  json << "]}";
-  std::printf("%s\n", json.str().c_str());
+  const json::Json line = {
+      {"bench", "stop_latency"}, {"threads", threads}, {"rows", std::move(rows)}};
+  std::printf("%s\n", json::dump(line).c_str());
   return 0;
 }
 
@@ -215,21 +217,20 @@ int run(const Arguments& args) {
       rows.push_back(row);
     }
   }
-  std::ostringstream json;
-  json << "{\"bench\":\"pipeline\",\"rows\":[";
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const Row& r = rows[i];
-    char buffer[512];
-    std::snprintf(buffer, sizeof buffer,
-                  "%s{\"sensor\":\"%s\",\"model\":\"%s\",\"threads\":%d,\"points\":%zu,"
-                  "\"labeled\":%zu,\"feature_s\":%.4f,\"inference_s\":%.4f,\"total_s\":%.4f,"
-                  "\"points_per_s\":%.0f}",
-                  i ? "," : "", r.sensor.c_str(), r.model.c_str(), r.threads, r.points, r.labeled,
-                  r.feature_s, r.inference_s, r.total_s, r.points_per_s());
-    json << buffer;
-  }
-  json << "]}";
-  std::printf("%s\n", json.str().c_str());
+  namespace json = primlabel::json;
+  json::Json out_rows = json::Json::array();
+  for (const Row& r : rows)
+    out_rows.push_back({{"sensor", r.sensor},
+                        {"model", r.model},
+                        {"threads", r.threads},
+                        {"points", r.points},
+                        {"labeled", r.labeled},
+                        {"feature_s", json::rounded(r.feature_s, "%.4f")},
+                        {"inference_s", json::rounded(r.inference_s, "%.4f")},
+                        {"total_s", json::rounded(r.total_s, "%.4f")},
+                        {"points_per_s", json::whole(r.points_per_s())}});
+  const json::Json line = {{"bench", "pipeline"}, {"rows", std::move(out_rows)}};
+  std::printf("%s\n", json::dump(line).c_str());
   return 0;
 }
 
@@ -239,6 +240,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "End-to-end labeling throughput (label_cloud) on synthetic LMS400 and Kinect scenes."};
   app.set_version_flag("--version", primlabel::version_line("primlabel-bench-pipeline"));
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.name("primlabel-bench-pipeline");
   Arguments args;
   app.add_option("--model", args.model, "model file (default: a quick model per sensor)");
@@ -253,11 +256,17 @@ int main(int argc, char** argv) {
   app.add_option("--stop-latency", args.stop_latency,
                  "instead: stop this many runs per input at random moments, print the latency")
       ->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "primlabel-bench-pipeline: usage error: %s (see --help)\n", e.what());
+    return primlabel::kExitUsage;
+  }
   try {
     return run(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "primlabel-bench-pipeline: error: %s\n", e.what());
-    return 1;
+    return primlabel::kExitFailure;
   }
 }

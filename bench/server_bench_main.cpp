@@ -23,6 +23,8 @@
 #include "primlabel/build_version.hpp"
 #include "label_server.hpp"
 #include "logging.hpp"
+#include "primlabel/cli/exit_codes.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
@@ -187,6 +189,8 @@ int main(int argc, char** argv) {
   std::vector<int> cancel_at = {300, 1500, 4000, 8000};
   CLI::App app{"End-to-end latency of primlabel-server against label_cloud in process."};
   app.set_version_flag("--version", primlabel::version_line("primlabel-bench-server"));
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.name("primlabel-bench-server");
   app.add_option("--reps-table", reps_table, "repetitions on the 22k table scene")
       ->capture_default_str();
@@ -199,7 +203,13 @@ int main(int argc, char** argv) {
   app.add_flag("--cancel-only", cancel_only, "only the cancellation figures (no table / kinect)");
   app.add_option("--cancel-at", cancel_at, "moments (ms) at which the 5M request is cancelled")
       ->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "primlabel-bench-server: usage error: %s (see --help)\n", e.what());
+    return primlabel::kExitUsage;
+  }
 
   server::set_log_level(server::LogLevel::kWarn);
   const fs::path repo = fs::temp_directory_path() / ("primlabel_bench_" + std::to_string(getpid()));
@@ -273,17 +283,25 @@ int main(int argc, char** argv) {
 
   auto p50 = [](const std::vector<double>& v) { return v.empty() ? 0.0 : percentile(v, 0.5); };
   auto p99 = [](const std::vector<double>& v) { return v.empty() ? 0.0 : percentile(v, 0.99); };
-  std::printf(
-      "{\"table_points\":%zu,\"table_server_p50_ms\":%.2f,\"table_server_p99_ms\":%.2f,"
-      "\"table_local_p50_ms\":%.2f,\"kinect_points\":%zu,\"kinect_server_p50_ms\":%.2f,"
-      "\"kinect_server_p99_ms\":%.2f,\"kinect_local_p50_ms\":%.2f,\"kinect_overhead\":%.4f,"
-      "\"cancel_grpc_p99_ms\":%.1f,\"cancel_grpc_max_ms\":%.1f,\"cancel_local_max_ms\":%.1f}\n",
-      std::size_t(22000), p50(table.server_ms), p99(table.server_ms), p50(table.local_ms),
-      kinect.size(), p50(frame.server_ms), p99(frame.server_ms), p50(frame.local_ms),
-      frame.local_ms.empty() ? 0.0
-                             : (p50(frame.server_ms) - p50(frame.local_ms)) / p50(frame.local_ms),
-      p99(cancel_ms),
-      cancel_ms.empty() ? 0.0 : *std::max_element(cancel_ms.begin(), cancel_ms.end()),
-      local_stop_ms.empty() ? 0.0 : *std::max_element(local_stop_ms.begin(), local_stop_ms.end()));
+  namespace json = primlabel::json;
+  const auto max_of = [](const std::vector<double>& v) {
+    return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+  };
+  const double overhead = frame.local_ms.empty()
+                              ? 0.0
+                              : (p50(frame.server_ms) - p50(frame.local_ms)) / p50(frame.local_ms);
+  const json::Json line = {{"table_points", std::size_t(22000)},
+                           {"table_server_p50_ms", json::rounded(p50(table.server_ms), "%.2f")},
+                           {"table_server_p99_ms", json::rounded(p99(table.server_ms), "%.2f")},
+                           {"table_local_p50_ms", json::rounded(p50(table.local_ms), "%.2f")},
+                           {"kinect_points", kinect.size()},
+                           {"kinect_server_p50_ms", json::rounded(p50(frame.server_ms), "%.2f")},
+                           {"kinect_server_p99_ms", json::rounded(p99(frame.server_ms), "%.2f")},
+                           {"kinect_local_p50_ms", json::rounded(p50(frame.local_ms), "%.2f")},
+                           {"kinect_overhead", json::rounded(overhead, "%.4f")},
+                           {"cancel_grpc_p99_ms", json::rounded(p99(cancel_ms), "%.1f")},
+                           {"cancel_grpc_max_ms", json::rounded(max_of(cancel_ms), "%.1f")},
+                           {"cancel_local_max_ms", json::rounded(max_of(local_stop_ms), "%.1f")}};
+  std::printf("%s\n", json::dump(line).c_str());
   return 0;
 }

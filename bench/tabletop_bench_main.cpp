@@ -12,8 +12,10 @@
 #include <limits>
 #include <sstream>
 
+#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/tabletop/segmentation_eval.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
 #ifdef PRIMLABEL_HAVE_PCL
@@ -38,12 +40,8 @@ struct Row {
   bool labeled = false, pcl_found = false;
 };
 
-std::string number(double v) {
-  if (!std::isfinite(v)) return "null";
-  char text[32];
-  std::snprintf(text, sizeof text, "%.4g", v);
-  return text;
-}
+// The JSON line's figures at 4 significant digits; null when not finite.
+json::Json number(double v) { return json::rounded(v, "%.4g"); }
 
 int run(const Arguments& args) {
   std::vector<Row> rows;
@@ -63,7 +61,7 @@ int run(const Arguments& args) {
     if (!result.ok()) {
       std::fprintf(stderr, "primlabel-bench-tabletop: error: %s: %s\n", path.c_str(),
                    result.message.c_str());
-      return 1;
+      return primlabel::kExitFailure;
     }
     if (row.labeled) row.ours = evaluate_segmentation(cloud, result);
 #ifdef PRIMLABEL_HAVE_PCL
@@ -112,35 +110,38 @@ int run(const Arguments& args) {
   }
 
   double ours_total = 0, pcl_total = 0;
-  std::ostringstream json;
-  json << "{\"threads\":" << args.threads << ",\"repeat\":" << args.repeat << ",\"scenes\":[";
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    const Row& r = rows[k];
+  json::Json scenes = json::Json::array();
+  for (const Row& r : rows) {
     ours_total += r.ours_ms;
     pcl_total += r.pcl_ms;
-    json << (k ? "," : "") << "{\"file\":\"" << r.file << "\",\"ours_ms\":" << number(r.ours_ms);
-    if (r.labeled)
-      json << ",\"ours_table_f1\":" << number(r.ours.table_f1)
-           << ",\"ours_mean_object_iou\":" << number(r.ours.mean_object_iou);
-    if (args.compare_pcl) {
-      json << ",\"pcl_ms\":" << number(r.pcl_ms);
-      if (r.labeled && r.pcl_found)
-        json << ",\"pcl_table_f1\":" << number(r.pcl.table_f1)
-             << ",\"pcl_mean_object_iou\":" << number(r.pcl.mean_object_iou);
+    json::Json scene = {{"file", r.file}, {"ours_ms", number(r.ours_ms)}};
+    if (r.labeled) {
+      scene["ours_table_f1"] = number(r.ours.table_f1);
+      scene["ours_mean_object_iou"] = number(r.ours.mean_object_iou);
     }
-    json << "}";
+    if (args.compare_pcl) {
+      scene["pcl_ms"] = number(r.pcl_ms);
+      if (r.labeled && r.pcl_found) {
+        scene["pcl_table_f1"] = number(r.pcl.table_f1);
+        scene["pcl_mean_object_iou"] = number(r.pcl.mean_object_iou);
+      }
+    }
+    scenes.push_back(std::move(scene));
   }
   const double n = double(std::max<std::size_t>(rows.size(), 1));
-  json << "],\"mean_ours_ms\":" << number(ours_total / n);
-  if (args.compare_pcl)
-    json << ",\"mean_pcl_ms\":" << number(pcl_total / n)
-         << ",\"speedup\":" << number(pcl_total / ours_total);
+  json::Json line = {{"threads", args.threads},
+                     {"repeat", args.repeat},
+                     {"scenes", std::move(scenes)},
+                     {"mean_ours_ms", number(ours_total / n)}};
+  if (args.compare_pcl) {
+    line["mean_pcl_ms"] = number(pcl_total / n);
+    line["speedup"] = number(pcl_total / ours_total);
+  }
 #ifdef PRIMLABEL_HAVE_PCL
-  if (args.compare_pcl) json << ",\"pcl_version\":\"" << bench::pcl_tabletop_version() << "\"";
+  if (args.compare_pcl) line["pcl_version"] = bench::pcl_tabletop_version();
 #endif
-  json << "}";
-  std::printf("%s\n", json.str().c_str());
-  return 0;
+  std::printf("%s\n", json::dump(line).c_str());
+  return primlabel::kExitOk;
 }
 
 }  // namespace
@@ -148,6 +149,8 @@ int run(const Arguments& args) {
 int main(int argc, char** argv) {
   CLI::App app{"Milliseconds per scene of the table-top pre-filter, optionally against PCL."};
   app.set_version_flag("--version", primlabel::version_line("primlabel-bench-tabletop"));
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.name("primlabel-bench-tabletop");
   Arguments args;
   app.add_option("inputs", args.inputs, "scans (.pcd or .ply)")->required();
@@ -162,20 +165,20 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
     std::fprintf(stderr, "primlabel-bench-tabletop: usage error: %s (see --help)\n", e.what());
-    return 2;
+    return primlabel::kExitUsage;
   }
 #ifndef PRIMLABEL_HAVE_PCL
   if (args.compare_pcl) {
     std::fprintf(stderr,
                  "primlabel-bench-tabletop: error: built without PCL (install libpcl-dev and "
                  "rebuild) for --compare-pcl\n");
-    return 1;
+    return primlabel::kExitFailure;
   }
 #endif
   try {
     return run(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "primlabel-bench-tabletop: error: %s\n", e.what());
-    return 1;
+    return primlabel::kExitFailure;
   }
 }

@@ -27,7 +27,7 @@ PACKAGES=(
   libprotobuf-dev protobuf-compiler liblbfgspp-dev libsvm-dev
   libgrpc++-dev protobuf-compiler-grpc
   prometheus-cpp-dev libcurl4-openssl-dev
-  libssl-dev
+  libssl-dev nlohmann-json3-dev
   libgtest-dev
 )
 # Only the tests need these: the deployment checks (YAML, nginx -t, promtool, the local

@@ -15,10 +15,12 @@
 #include <fstream>
 #include <string>
 
-#include "cli_common.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "node_basis.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/research/confusion_plot.hpp"
 #include "primlabel/research/fig4.hpp"
@@ -46,62 +48,53 @@ std::string class_name(std::uint32_t id) {
   return c ? std::string(name(*c)) : std::to_string(id);
 }
 
-// JSON numbers cannot be NaN.
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.6f", v);
-  return buffer;
-}
+// Scores at the 6 decimals the JSON lines have always carried; null when undefined (NaN).
+json::Json score(double value) { return json::rounded(value, "%.6f"); }
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) >= 0x20) out += c;
-  }
-  return out + "\"";
-}
-
-void print_scores(const std::string& path, const crf::ConfusionMatrix& confusion, bool json) {
+void print_scores(const std::string& path, const crf::ConfusionMatrix& confusion, bool as_json) {
   std::vector<std::string> names;
   for (std::uint32_t id : confusion.class_ids()) names.push_back(class_name(id));
-  if (!json) {
+  if (!as_json) {
     std::printf("%s: %llu points scored, accuracy %.2f%%\n%s\n", path.c_str(),
                 static_cast<unsigned long long>(confusion.total()), 100 * confusion.accuracy(),
                 confusion.to_text(names).c_str());
     return;
   }
-  std::string line = "{\"file\":" + json_string(path) +
-                     ",\"points\":" + std::to_string(confusion.total()) +
-                     ",\"accuracy\":" + json_number(confusion.accuracy()) +
-                     ",\"macro_f1\":" + json_number(confusion.macro_f1()) + ",\"classes\":{";
+  json::Json classes = json::Json::object();
   for (int k = 0; k < confusion.num_classes(); ++k) {
     const crf::ClassScores s = confusion.scores(k);
-    line += (k ? "," : "") + json_string(names[k]) + ":{\"precision\":" + json_number(s.precision) +
-            ",\"recall\":" + json_number(s.recall) + ",\"f1\":" + json_number(s.f1) +
-            ",\"support\":" + std::to_string(s.support) + "}";
+    classes[names[k]] = {{"precision", score(s.precision)},
+                         {"recall", score(s.recall)},
+                         {"f1", score(s.f1)},
+                         {"support", s.support}};
   }
-  line += "},\"confusion\":[";
+  json::Json matrix = json::Json::array();
   for (int t = 0; t < confusion.num_classes(); ++t) {
-    line += t ? ",[" : "[";
-    for (int p = 0; p <= confusion.num_classes(); ++p)
-      line += (p ? "," : "") + std::to_string(confusion.count(t, p));
-    line += "]";
+    json::Json row = json::Json::array();
+    for (int p = 0; p <= confusion.num_classes(); ++p) row.push_back(confusion.count(t, p));
+    matrix.push_back(std::move(row));
   }
-  std::printf("%s]}\n", line.c_str());
+  const json::Json line = {{"file", path},
+                           {"points", confusion.total()},
+                           {"accuracy", score(confusion.accuracy())},
+                           {"macro_f1", score(confusion.macro_f1())},
+                           {"classes", std::move(classes)},
+                           {"confusion", std::move(matrix)}};
+  std::printf("%s\n", json::dump(line).c_str());
 }
 
-void print_histogram(const std::string& path, const std::vector<std::uint32_t>& labels, bool json) {
+void print_histogram(const std::string& path, const std::vector<std::uint32_t>& labels,
+                     bool as_json) {
   std::vector<std::uint64_t> counts(kPrimitiveClassCount, 0);
   for (std::uint32_t id : labels)
     if (id < kPrimitiveClassCount) ++counts[id];
-  if (json) {
-    std::string line = "{\"file\":" + json_string(path) +
-                       ",\"points\":" + std::to_string(labels.size()) + ",\"histogram\":{";
+  if (as_json) {
+    json::Json histogram = json::Json::object();
     for (std::uint32_t id = 0; id < kPrimitiveClassCount; ++id)
-      line += (id ? "," : "") + json_string(class_name(id)) + ":" + std::to_string(counts[id]);
-    std::printf("%s}}\n", line.c_str());
+      histogram[class_name(id)] = counts[id];
+    const json::Json line = {
+        {"file", path}, {"points", labels.size()}, {"histogram", std::move(histogram)}};
+    std::printf("%s\n", json::dump(line).c_str());
     return;
   }
   std::printf("%s: %zu points, predicted labels:\n", path.c_str(), labels.size());
@@ -193,7 +186,7 @@ int mosd_report(const Arguments& args) {
   const std::string json = research::mosd_report_json(report);
   const std::string json_path =
       (std::filesystem::path(args.mosd_dir) / "mosd_report.json").string();
-  std::ofstream(json_path) << json;
+  atomic_write_file(json_path, json);
   std::fputs((args.json ? json : research::mosd_report_text(report)).c_str(), stdout);
   return cli::kExitOk;
 }
@@ -211,20 +204,18 @@ int fig4(const Arguments& args) {
     return cli::kExitOk;
   }
   const research::ClassSignatures& s = result.signatures;
-  std::string line = "{\"classes\":[";
-  for (std::size_t k = 0; k < s.class_ids.size(); ++k)
-    line += (k ? "," : "") + json_string(class_name(s.class_ids[k]));
-  line += "],\"points\":[";
-  for (std::size_t k = 0; k < s.points.size(); ++k)
-    line += (k ? "," : "") + std::to_string(s.points[k]);
-  line += "],\"hik\":[";
+  json::Json classes = json::Json::array(), points = json::Json::array();
+  for (std::uint32_t id : s.class_ids) classes.push_back(class_name(id));
+  for (const auto count : s.points) points.push_back(count);
+  json::Json hik = json::Json::array();
   for (Eigen::Index r = 0; r < result.hik.rows(); ++r) {
-    line += r ? ",[" : "[";
-    for (Eigen::Index c = 0; c < result.hik.cols(); ++c)
-      line += (c ? "," : "") + json_number(result.hik(r, c));
-    line += "]";
+    json::Json row = json::Json::array();
+    for (Eigen::Index c = 0; c < result.hik.cols(); ++c) row.push_back(score(result.hik(r, c)));
+    hik.push_back(std::move(row));
   }
-  std::printf("%s]}\n", line.c_str());
+  const json::Json line = {
+      {"classes", std::move(classes)}, {"points", std::move(points)}, {"hik", std::move(hik)}};
+  std::printf("%s\n", json::dump(line).c_str());
   return cli::kExitOk;
 }
 
@@ -232,6 +223,8 @@ int fig4(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Label clouds with a trained model and score them, or re-measure Table I."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-eval"));
   app.name("primlabel-eval");
   Arguments args;
@@ -283,8 +276,9 @@ int main(int argc, char** argv) {
   app.add_option("--fig4-scenes", args.fig4_scenes, "Fig. 4: training scenes (default 3)")
       ->check(CLI::PositiveNumber)
       ->needs(f4);
-  app.add_option("--threads", args.threads, "worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--threads", args.threads, "worker threads")
+      ->check(CLI::PositiveNumber)
+      ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
   t1->excludes(model)->excludes(files)->excludes(f4);
   f4->excludes(model)->excludes(files);

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <optional>
 
-#include "cli_common.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/features.hpp"
@@ -102,24 +102,32 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Estimate normals and FPFH/PFH descriptors for every point of a PCD/PLY cloud."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-features"));
   app.name("primlabel-features");
   Arguments args;
   app.add_option("input", args.input, "input cloud (.pcd or .ply)")->required();
   app.add_option("-o,--output", args.output, "output cloud (.pcd or .ply)")->required();
+  // 0 stands for "not given"; --help shows what is used then.
   auto* nk = app.add_option("--normal-k", args.normal_k, "normals from the K nearest points")
-                 ->check(CLI::PositiveNumber);
+                 ->check(CLI::PositiveNumber)
+                 ->default_str("10");
   app.add_option("--normal-radius", args.normal_radius, "normals from points within R")
       ->check(CLI::PositiveNumber)
+      ->default_str("")
       ->excludes(nk);
   auto* fk = app.add_option("--feature-k", args.feature_k, "descriptors from the K nearest points")
-                 ->check(CLI::PositiveNumber);
+                 ->check(CLI::PositiveNumber)
+                 ->default_str("10");
   app.add_option("--feature-radius", args.feature_radius, "descriptors from points within R")
       ->check(CLI::PositiveNumber)
+      ->default_str("")
       ->excludes(fk);
   app.add_option("--max-neighbors", args.max_neighbors,
                  "cap radius neighbourhoods at the M nearest points")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->default_str("none");
   app.add_option("--descriptor", args.descriptor, "fpfh (33 bins) or pfh (125 bins)")
       ->check(CLI::IsMember({"fpfh", "pfh"}));
   app.add_option("--fpfh-variant", args.variant,
@@ -129,8 +137,9 @@ int main(int argc, char** argv) {
                "use the normals stored in the input instead of estimating them");
   app.add_option("--viewpoint", args.viewpoint,
                  "X,Y,Z the normals face (default: the file's VIEWPOINT)");
-  app.add_option("--threads", args.threads, "worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--threads", args.threads, "worker threads")
+      ->check(CLI::PositiveNumber)
+      ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no progress or summary on stderr");
 
   try {

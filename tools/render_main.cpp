@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "cli_common.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
@@ -104,6 +104,8 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Render a point cloud to PNG, coloured by label, segment, rgb or a field."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-render"));
   app.name("primlabel-render");
   Arguments args;

@@ -11,9 +11,11 @@
 #include <fstream>
 #include <map>
 
-#include "cli_common.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/synth/generate.hpp"
 
@@ -73,15 +75,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
-
 int write_one(const Arguments& args) {
   const auto start = std::chrono::steady_clock::now();
   const Generated scan = generate(options_from(args, args.seed));
@@ -106,7 +99,7 @@ int write_set(const Arguments& args) {
   std::filesystem::create_directories(args.out_dir);
   const std::filesystem::path dir(args.out_dir);
   write_class_map((dir / "classes.txt").string(), ClassMap::taxonomy());
-  std::string scenes;
+  json::Json scenes = json::Json::array();
   for (int i = 0; i < args.count; ++i) {
     const std::uint64_t seed = set_seed(set, i);
     char file[64];
@@ -114,28 +107,23 @@ int write_set(const Arguments& args) {
     const Generated scan = generate(options_from(args, seed));
     write_tagged_cloud((dir / file).string(), scan.cloud, scan.tags);
     const std::size_t valid = count_finite(scan.cloud);
-    scenes += std::string(i ? ",\n" : "") + "    {\"file\": " + json_string(file) +
-              ", \"seed\": " + std::to_string(seed) + ", \"points\": " + std::to_string(valid) +
-              ", \"objects\": " + json_string(scan.tags.at("objects")) + "}";
+    scenes.push_back(
+        {{"file", file}, {"seed", seed}, {"points", valid}, {"objects", scan.tags.at("objects")}});
     if (!args.quiet)
       std::fprintf(stderr, "%s: %zu points (seed %llu)\n", file, valid,
                    static_cast<unsigned long long>(seed));
   }
-  std::string classes;
+  json::Json classes = json::Json::array();
   for (PrimitiveClass c : all_classes())
-    classes += std::string(classes.empty() ? "" : ", ") +
-               "{\"id\": " + std::to_string(class_id(c)) +
-               ", \"name\": " + json_string(std::string(name(c))) + "}";
-  char radius[32];
-  std::snprintf(radius, sizeof radius, "%.6g", args.radius);
+    classes.push_back({{"id", class_id(c)}, {"name", std::string(name(c))}});
+  const json::Json manifest = {{"set", args.set},
+                               {"scene", args.scene},
+                               {"sensor", args.sensor},
+                               {"label_radius", json::rounded(args.radius, "%.6g")},
+                               {"classes", std::move(classes)},
+                               {"scenes", std::move(scenes)}};
   const std::string manifest_path = (dir / (args.set + "_manifest.json")).string();
-  std::ofstream manifest(manifest_path);
-  manifest << "{\n  \"set\": " << json_string(args.set)
-           << ",\n  \"scene\": " << json_string(args.scene)
-           << ",\n  \"sensor\": " << json_string(args.sensor) << ",\n  \"label_radius\": " << radius
-           << ",\n  \"classes\": [" << classes << "],\n  \"scenes\": [\n"
-           << scenes << "\n  ]\n}\n";
-  if (!manifest) throw std::runtime_error(manifest_path + ": cannot write");
+  atomic_write_file(manifest_path, json::dump(manifest, 2) + "\n");
   if (!args.quiet)
     std::fprintf(stderr, "wrote %d %s scenes and %s\n", args.count, args.set.c_str(),
                  manifest_path.c_str());
@@ -151,6 +139,8 @@ int usage_error(const std::string& message) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Labeled synthetic table scenes from a simulated laser line scanner or Kinect."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-synth"));
   app.name("primlabel-synth");
   Arguments args;
@@ -168,20 +158,28 @@ int main(int argc, char** argv) {
                  "write a scene set from its own seed range: train (1000..), "
                  "val (2000..), test (3000..)")
       ->check(CLI::IsMember({"train", "val", "test"}));
-  app.add_option("--count", args.count, "scenes in the set (--set)")
-      ->check(CLI::Range(1, kMaxSetSize));
+  app.add_option("--count", args.count, "scenes in the set (--set, which needs it)")
+      ->check(CLI::Range(1, kMaxSetSize))
+      ->default_str("");
   app.add_option("--out-dir", args.out_dir, "directory for the set's clouds and manifest (--set)");
   app.add_option("--noise-scale", args.noise_scale, "multiply the sensor noise (0 = exact)")
       ->check(CLI::NonNegativeNumber);
+  // Unset (0, -1) means the sensor's or the scene's own value; --help says so.
   app.add_option("--dropout", args.dropout, "probability that a return is lost")
-      ->check(CLI::Range(0.0, 0.99));
-  app.add_option("--lines", args.lines, "lms400: sweep lines")->check(CLI::PositiveNumber);
+      ->check(CLI::Range(0.0, 0.99))
+      ->default_str("the sensor's");
+  app.add_option("--lines", args.lines, "lms400: sweep lines")
+      ->check(CLI::PositiveNumber)
+      ->default_str("the sensor's");
   app.add_option("--angular-step", args.angular_step, "lms400: degrees between beams of a line")
-      ->check(CLI::Range(0.01, 5.0));
+      ->check(CLI::Range(0.01, 5.0))
+      ->default_str("the sensor's");
   app.add_option("--min-objects", args.min_objects, "table scene: fewest objects")
-      ->check(CLI::Range(1, 20));
+      ->check(CLI::Range(1, 20))
+      ->default_str("the scene's");
   app.add_option("--max-objects", args.max_objects, "table scene: most objects")
-      ->check(CLI::Range(1, 20));
+      ->check(CLI::Range(1, 20))
+      ->default_str("the scene's");
   app.add_flag("--list-classes", args.list_classes,
                "print the classes as '<id> <name>' lines (a class map file) and exit");
   app.add_flag("-q,--quiet", args.quiet, "no summary on stderr");

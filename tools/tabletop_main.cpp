@@ -10,9 +10,10 @@
 #include <sstream>
 #include <string>
 
-#include "cli_common.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/render/render.hpp"
 #include "primlabel/tabletop/segmentation_eval.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
@@ -37,15 +38,8 @@ std::uint32_t cluster_colour(std::size_t k) {
   return kClusterColours[k % (sizeof kClusterColours / sizeof kClusterColours[0])];
 }
 
-std::string json_escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) continue;
-    out += c;
-  }
-  return out;
-}
+// The report's measurements at the 6 significant digits it has always printed.
+json::Json measured(double value) { return json::rounded(value, "%.6g"); }
 
 void render(const PointCloud& cloud, const TabletopResult& result, const Arguments& args,
             const std::string& title) {
@@ -84,21 +78,21 @@ int run(const Arguments& args) {
   const TabletopResult result = segment_tabletop(cloud, args.options);
   const std::string name = std::filesystem::path(args.input).filename().string();
 
-  std::ostringstream json;
-  json.precision(6);
-  json << "{\"file\":\"" << json_escape(args.input) << "\",\"status\":\""
-       << to_string(result.status) << "\",\"message\":\"" << json_escape(result.message)
-       << "\",\"points\":" << cloud.size() << ",\"valid_points\":" << result.valid_points
-       << ",\"table_points\":" << result.table_inliers.size()
-       << ",\"objects_found\":" << result.clusters.size();
+  json::Json report = {{"file", args.input},
+                       {"status", to_string(result.status)},
+                       {"message", result.message},
+                       {"points", cloud.size()},
+                       {"valid_points", result.valid_points},
+                       {"table_points", result.table_inliers.size()},
+                       {"objects_found", result.clusters.size()}};
   if (result.ok()) {
-    json << ",\"plane\":[" << result.plane[0] << "," << result.plane[1] << "," << result.plane[2]
-         << "," << result.plane[3] << "],\"tilt_deg\":" << result.tilt_deg
-         << ",\"hull_vertices\":" << result.hull.size();
-    json << ",\"cluster_sizes\":[";
-    for (std::size_t k = 0; k < result.clusters.size(); ++k)
-      json << (k ? "," : "") << result.clusters[k].size();
-    json << "]";
+    report["plane"] = {measured(result.plane[0]), measured(result.plane[1]),
+                       measured(result.plane[2]), measured(result.plane[3])};
+    report["tilt_deg"] = measured(result.tilt_deg);
+    report["hull_vertices"] = result.hull.size();
+    json::Json sizes = json::Json::array();
+    for (const auto& cluster : result.clusters) sizes.push_back(cluster.size());
+    report["cluster_sizes"] = std::move(sizes);
   }
   std::string title = name + ": " + to_string(result.status);
   if (!args.quiet)
@@ -106,13 +100,14 @@ int run(const Arguments& args) {
                 result.valid_points, cloud.size(), result.timings.total_ms);
   if (args.eval && result.ok()) {
     const SegmentationScores scores = evaluate_segmentation(cloud, result);
-    json << ",\"table_precision\":" << scores.table_precision
-         << ",\"table_recall\":" << scores.table_recall << ",\"table_f1\":" << scores.table_f1
-         << ",\"mean_object_iou\":" << scores.mean_object_iou
-         << ",\"objects_true\":" << scores.objects_true << ",\"object_iou\":[";
-    for (std::size_t k = 0; k < scores.objects.size(); ++k)
-      json << (k ? "," : "") << scores.objects[k].best_iou;
-    json << "]";
+    report["table_precision"] = measured(scores.table_precision);
+    report["table_recall"] = measured(scores.table_recall);
+    report["table_f1"] = measured(scores.table_f1);
+    report["mean_object_iou"] = measured(scores.mean_object_iou);
+    report["objects_true"] = scores.objects_true;
+    json::Json ious = json::Json::array();
+    for (const auto& object : scores.objects) ious.push_back(measured(object.best_iou));
+    report["object_iou"] = std::move(ious);
     char text[200];
     std::snprintf(text, sizeof text,
                   "table precision %.4f recall %.4f F1 %.4f; mean object IoU %.4f (%zu found, "
@@ -126,15 +121,18 @@ int run(const Arguments& args) {
     title += short_text;
   }
   const TabletopTimings& t = result.timings;
-  json << ",\"ms\":" << t.total_ms << ",\"ms_prepare\":" << t.prepare_ms
-       << ",\"ms_plane\":" << t.plane_ms << ",\"ms_table\":" << t.table_ms
-       << ",\"ms_objects\":" << t.objects_ms << ",\"ms_refine\":" << t.refine_ms << "}";
+  report["ms"] = measured(t.total_ms);
+  report["ms_prepare"] = measured(t.prepare_ms);
+  report["ms_plane"] = measured(t.plane_ms);
+  report["ms_table"] = measured(t.table_ms);
+  report["ms_objects"] = measured(t.objects_ms);
+  report["ms_refine"] = measured(t.refine_ms);
 
   if (!args.png.empty()) {
     render(cloud, result, args, title);
     if (!args.quiet) std::printf("%s: wrote %s\n", name.c_str(), args.png.c_str());
   }
-  if (args.json) std::printf("%s\n", json.str().c_str());
+  if (args.json) std::printf("%s\n", json::dump(report).c_str());
   if (!result.ok()) {
     std::fprintf(stderr, "primlabel-tabletop: error: %s: %s\n", args.input.c_str(),
                  result.message.c_str());
@@ -149,6 +147,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Find the table (largest horizontal plane) and the objects on it in a scan; "
       "score against mOSD labels; render to PNG."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-tabletop"));
   app.name("primlabel-tabletop");
   Arguments args;
@@ -187,8 +187,9 @@ int main(int argc, char** argv) {
   app.add_option("--voxel-leaf", o.voxel_leaf, "fit and cluster on voxel centroids (m; 0 = off)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--seed", o.seed, "RANSAC seed");
-  app.add_option("--threads", o.threads, "worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--threads", o.threads, "worker threads")
+      ->check(CLI::PositiveNumber)
+      ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no summary lines (the JSON line stays)");
 
   try {

@@ -9,11 +9,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
+#include <sstream>
 
-#include "cli_common.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "node_basis.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/research/curve_plot.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
@@ -138,9 +139,9 @@ int run(const Arguments& args) {
   save_model(args.output, model);
 
   if (!args.curve_csv.empty()) {
-    std::ofstream out(args.curve_csv);
-    crf::write_training_curve_csv(out, curve);
-    if (!out) throw std::runtime_error(args.curve_csv + ": cannot be written");
+    std::ostringstream csv;
+    crf::write_training_curve_csv(csv, curve);
+    atomic_write_file(args.curve_csv, csv.str());
   }
   if (!args.curve_png.empty()) research::write_curve_png(args.curve_png, curve);
 
@@ -161,6 +162,8 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Train a point labeling model (CRF, node-only or SVM) from labeled clouds."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-train"));
   app.name("primlabel-train");
   Arguments args;
@@ -218,8 +221,9 @@ int main(int argc, char** argv) {
   app.add_option("--name", args.name, "model name recorded in the file");
   app.add_option("--curve", args.curve_csv, "training curve CSV (objective, accuracies)");
   app.add_option("--curve-png", args.curve_png, "training curve plot (PNG)");
-  app.add_option("--threads", args.threads, "worker threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+  app.add_option("--threads", args.threads, "worker threads")
+      ->check(CLI::PositiveNumber)
+      ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
 
   try {

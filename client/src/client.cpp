@@ -14,6 +14,7 @@
 #include "label_assembler.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "primlabel/wire/packing.hpp"
+#include "primlabel/wire/status_names.hpp"
 
 namespace primlabel::client {
 
@@ -58,25 +59,7 @@ void fill_chunk(const PointCloud& cloud, const LabelOptions& o, std::size_t firs
 // Errors
 
 std::string status_code_name(grpc::StatusCode code) {
-  static const char* const kNames[] = {"OK",
-                                       "CANCELLED",
-                                       "UNKNOWN",
-                                       "INVALID_ARGUMENT",
-                                       "DEADLINE_EXCEEDED",
-                                       "NOT_FOUND",
-                                       "ALREADY_EXISTS",
-                                       "PERMISSION_DENIED",
-                                       "RESOURCE_EXHAUSTED",
-                                       "FAILED_PRECONDITION",
-                                       "ABORTED",
-                                       "OUT_OF_RANGE",
-                                       "UNIMPLEMENTED",
-                                       "INTERNAL",
-                                       "UNAVAILABLE",
-                                       "DATA_LOSS",
-                                       "UNAUTHENTICATED"};
-  const int i = static_cast<int>(code);
-  return i >= 0 && i < 17 ? kNames[i] : "STATUS_" + std::to_string(i);
+  return ::primlabel::wire::status_code_name(code);
 }
 
 std::string health_status_name(HealthStatus status) {

@@ -5,6 +5,7 @@
 
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/wire/packing.hpp"
+#include "stage_times.hpp"
 
 namespace primlabel::server {
 
@@ -87,11 +88,8 @@ void fill_summary(const RequestRecord& record, const ModelEntry& entry,
     count->set_points(points);
     count->set_name(class_name_of(entry, id));
   }
-  const std::pair<const char*, double> stages[] = {
-      {"receive", record.stages.receive},     {"prefilter", record.stages.prefilter},
-      {"normals", record.stages.normals},     {"features", record.stages.features},
-      {"inference", record.stages.inference}, {"send", record.stages.send}};
-  for (const auto& [name, seconds] : stages) {
+  for (const auto& [name, field] : kStages) {
+    const double seconds = record.stages.*field;
     if (seconds < 0) continue;
     v1::StageTiming* timing = summary.add_timings();
     timing->set_stage(name);

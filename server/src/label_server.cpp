@@ -63,7 +63,7 @@ LabelServer::LabelServer(ServerConfig config)
   // A default or pin naming nothing loaded is a typo that would otherwise only show as failed
   // requests (or a silently different version) in production.
   if (std::string problem = registry_.configuration_problem(); !problem.empty())
-    throw ConfigError{std::move(problem), 2};
+    throw ConfigError{std::move(problem), kExitUsage};
   if (auth_.admin_open())
     log_warn("insecure_admin")
         .kv("message",

@@ -5,7 +5,7 @@
 #include <random>
 
 #include "logging.hpp"
-#include "status_names.hpp"
+#include "primlabel/wire/status_names.hpp"
 #include "user_text.hpp"
 
 namespace primlabel::server {
@@ -33,14 +33,11 @@ grpc::Status RequestRecord::finish(const grpc::Status& status) {
   if (finished_) return status;
   finished_ = true;
   const double seconds = elapsed_seconds();
-  const std::string code = status_code_name(status.error_code());
+  const std::string code = ::primlabel::wire::status_code_name(status.error_code());
   const std::string metric_model = model_resolved ? user_text(model) : std::string();
   metrics_.request_finished(method_, metric_model, code, seconds);
   if (status.ok() && points > 0) metrics_.points_labeled(metric_model, double(points));
   if (dropped_non_finite > 0) metrics_.points_dropped("non_finite", double(dropped_non_finite));
-  const std::pair<const char*, double> named_stages[] = {
-      {"receive", stages.receive},   {"prefilter", stages.prefilter}, {"normals", stages.normals},
-      {"features", stages.features}, {"inference", stages.inference}, {"send", stages.send}};
   LogLine line(status.ok() ? LogLevel::kInfo : LogLevel::kWarn, "request");
   line.kv("method", method_)
       .kv("request_id", id_)
@@ -51,7 +48,8 @@ grpc::Status RequestRecord::finish(const grpc::Status& status) {
       .kv("dropped_non_finite", dropped_non_finite)
       .kv("duration_ms", seconds * 1e3)
       .kv("status", code);
-  for (const auto& [name, value] : named_stages) {
+  for (const auto& [name, field] : kStages) {
+    const double value = stages.*field;
     if (value < 0) continue;
     metrics_.stage(name, value);
     line.kv(std::string(name) + "_ms", value * 1e3);

@@ -9,13 +9,9 @@
 #include <string>
 
 #include "server_metrics.hpp"
+#include "stage_times.hpp"
 
 namespace primlabel::server {
-
-// Seconds per stage; negative = the stage did not run.
-struct StageTimes {
-  double receive = -1, prefilter = -1, normals = -1, features = -1, inference = -1, send = -1;
-};
 
 class RequestRecord {
  public:

@@ -15,13 +15,13 @@ namespace {
 
 std::string read_token_file(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw ConfigError{"cannot read the token file '" + path + "'", 2};
+  if (!in) throw ConfigError{"cannot read the token file '" + path + "'", kExitUsage};
   std::stringstream text;
   text << in.rdbuf();
   std::string token = text.str();
   while (!token.empty() && (token.back() == '\n' || token.back() == '\r' || token.back() == ' '))
     token.pop_back();
-  if (token.empty()) throw ConfigError{"the token file '" + path + "' is empty", 2};
+  if (token.empty()) throw ConfigError{"the token file '" + path + "' is empty", kExitUsage};
   return token;
 }
 
@@ -51,14 +51,15 @@ std::vector<std::string> with_config_file(CLI::App& app, int argc, const char* c
   std::vector<std::string> out{argv[0]};
   if (!path.empty()) {
     std::ifstream in(path);
-    if (!in) throw ConfigError{"cannot read the config file '" + path + "'", 2};
+    if (!in) throw ConfigError{"cannot read the config file '" + path + "'", kExitUsage};
     std::string line;
     for (int number = 1; std::getline(in, line); ++number) {
       line = trim(line);
       if (line.empty() || line[0] == '#' || line[0] == ';') continue;
       const auto eq = line.find('=');
       const std::string where = path + ":" + std::to_string(number);
-      if (eq == std::string::npos) throw ConfigError{where + ": expected `key = value`", 2};
+      if (eq == std::string::npos)
+        throw ConfigError{where + ": expected `key = value`", kExitUsage};
       std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
       if (key.rfind("--", 0) == 0) key = key.substr(2);
       if (value.size() >= 2 && (value.front() == '"' || value.front() == '\'') &&
@@ -67,7 +68,7 @@ std::vector<std::string> with_config_file(CLI::App& app, int argc, const char* c
       const std::string flag = "--" + key;
       const CLI::Option* option = app.get_option_no_throw(flag);
       if (!option || key == "config" || key == "help")
-        throw ConfigError{where + ": unknown setting '" + key + "'", 2};
+        throw ConfigError{where + ": unknown setting '" + key + "'", kExitUsage};
       const std::string env = option->get_envname();
       if (given_on_command_line(args, flag) || (!env.empty() && std::getenv(env.c_str()))) continue;
       out.push_back(flag + "=" + value);
@@ -93,6 +94,8 @@ int effective_threads_per_job(const ServerConfig& config) {
 ServerConfig parse_server_config(int argc, const char* const* argv) {
   ServerConfig config;
   CLI::App app{"primlabel-server: the gRPC point labeling service."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-server"));
   app.name("primlabel-server");
   std::string config_file;  // read before parsing, see with_config_file
@@ -231,26 +234,27 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
     std::ostringstream out, err;
     app.exit(e, out, err);
     throw ConfigError{e.get_exit_code() == 0 ? out.str() : err.str(),
-                      e.get_exit_code() == 0 ? 0 : 2};
+                      e.get_exit_code() == 0 ? kExitOk : kExitUsage};
   }
 
   for (const std::string& pin : pins) {
     const auto eq = pin.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == pin.size())
-      throw ConfigError{"--pin expects MODEL=VERSION, got '" + pin + "'", 2};
+      throw ConfigError{"--pin expects MODEL=VERSION, got '" + pin + "'", kExitUsage};
     config.pins[pin.substr(0, eq)] = pin.substr(eq + 1);
   }
   if (config.tls_cert.empty() != config.tls_key.empty())
-    throw ConfigError{"--tls-cert and --tls-key go together", 2};
+    throw ConfigError{"--tls-cert and --tls-key go together", kExitUsage};
   if (!config.tls_client_ca.empty() && config.tls_cert.empty())
-    throw ConfigError{"--tls-client-ca needs --tls-cert and --tls-key", 2};
+    throw ConfigError{"--tls-client-ca needs --tls-cert and --tls-key", kExitUsage};
   if (!token_file.empty()) {
     config.token = read_token_file(token_file);
   } else if (const char* token = std::getenv("PRIMLABEL_TOKEN"); token && *token) {
     config.token = token;
   }
   if (config.token_for_all && config.token.empty())
-    throw ConfigError{"--token-for-all needs a token (--token-file or PRIMLABEL_TOKEN)", 2};
+    throw ConfigError{"--token-for-all needs a token (--token-file or PRIMLABEL_TOKEN)",
+                      kExitUsage};
   return config;
 }
 

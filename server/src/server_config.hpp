@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "primlabel/cli/exit_codes.hpp"
+
 namespace primlabel::server {
 
 struct ServerConfig {
@@ -50,7 +52,7 @@ struct ServerConfig {
 // Thrown for bad usage (unknown flag, bad value, unreadable file); the message says what.
 struct ConfigError {
   std::string message;
-  int exit_code;  // 0 for --help (message is the help text), 2 otherwise
+  int exit_code = kExitUsage;  // kExitOk for --help (message is the help text)
 };
 
 // Parses argv (and the environment and the config file). Throws ConfigError.

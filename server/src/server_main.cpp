@@ -1,6 +1,7 @@
 // primlabel-server: serves the labeling API until SIGTERM or SIGINT, then drains and exits 0.
-// Exit codes: 0 clean shutdown, 1 could not start (e.g. the address is in use), 2 bad usage
-// (including a --default-model or --pin that names no loaded model).
+// Exit codes (exit_codes.hpp): 0 clean shutdown, 1 could not start (e.g. the
+// address is in use), 2 bad usage (including a --default-model or --pin that names no loaded
+// model).
 
 #include <signal.h>
 
@@ -12,6 +13,7 @@
 #include "server_config.hpp"
 
 int main(int argc, char** argv) {
+  using namespace primlabel;
   using namespace primlabel::server;
   ServerConfig config;
   try {
@@ -39,12 +41,12 @@ int main(int argc, char** argv) {
     return error.exit_code;
   } catch (const std::exception& e) {
     log_error("startup_failed").kv("error", e.what());
-    return 1;
+    return kExitFailure;
   }
   int signal_number = 0;
   sigwait(&signals, &signal_number);
   log_info("signal").kv("signal", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
   server->shutdown(std::chrono::milliseconds(static_cast<long long>(config.drain_seconds * 1e3)));
   server.reset();
-  return 0;
+  return kExitOk;
 }

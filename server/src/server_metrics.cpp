@@ -4,6 +4,7 @@
 
 #include "primlabel/build_version.hpp"
 #include "process_collector.hpp"
+#include "stage_times.hpp"
 
 namespace primlabel::server {
 
@@ -75,8 +76,8 @@ ServerMetrics::ServerMetrics()
                            .Help("Model versions that failed to load (the old one kept serving)")
                            .Register(*registry_)
                            .Add({})) {
-  for (const char* stage : {"receive", "prefilter", "normals", "features", "inference", "send"})
-    stage_seconds_.Add({{"stage", stage}}, seconds_buckets());
+  for (const StageField& stage : kStages)
+    stage_seconds_.Add({{"stage", stage.name}}, seconds_buckets());
   dropped_.Add({{"reason", "non_finite"}});
   BuildGauge()
       .Name("primlabel_build_info")

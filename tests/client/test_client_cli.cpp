@@ -28,13 +28,16 @@ std::string dead_address() { return FakeServer().address(); }
 TEST(ClientCli, HelpListsTheExitCodes) {
   const auto r = test::run_command(cli() + " --help");
   EXPECT_EQ(r.exit_code, 0);
-  EXPECT_NE(r.output.find("3 server unavailable"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("1 input/output file error, 2 usage error, 3 server unavailable"),
+            std::string::npos)
+      << r.output;
 }
 
-TEST(ClientCli, UsageErrorsExitOneWithOneLine) {
+// The scheme every primlabel binary shares: 2 = bad usage, 1 = the run failed.
+TEST(ClientCli, UsageErrorsExitTwoWithOneLine) {
   for (const char* args : {"", " frobnicate", " label", " --deadline -3 health"}) {
     const auto r = test::run_command(cli() + args);
-    EXPECT_EQ(r.exit_code, 1) << args << ": " << r.output;
+    EXPECT_EQ(r.exit_code, 2) << args << ": " << r.output;
     EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
   }
 }
@@ -88,19 +91,19 @@ TEST(ClientCli, SeveralFilesGoToTheOutputDirectory) {
   EXPECT_EQ(read_cloud(dir.file("out/b_labeled.pcd")).labels.size(), 40u);
 }
 
-TEST(ClientCli, MissingOrBrokenInputExitsTwo) {
+TEST(ClientCli, MissingOrBrokenInputExitsOne) {
   FakeServer server;
   test::TempDir dir;
   std::ofstream(dir.file("broken.pcd")) << "not a pcd\n";
   for (const std::string& input : {dir.file("missing.pcd"), dir.file("broken.pcd")}) {
     const auto r = test::run_command(cli() + " --server " + server.address() + " label " + input);
-    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find(input), std::string::npos) << r.output;
   }
   const auto r = test::run_command(cli() + " --server " + server.address() + " --token-file " +
                                    dir.file("none") + " health");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(r.exit_code, 1) << r.output;
 }
 
 TEST(ClientCli, UnreachableServerExitsThree) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <filesystem>
 #include <functional>
 
 #include "primlabel/geometry/taxonomy.hpp"
@@ -79,6 +80,30 @@ TEST(LabelModel, CrfRoundTrip) {
   EXPECT_EQ(loaded.validation.per_class.size(), 3u);
   EXPECT_DOUBLE_EQ(loaded.validation.per_class[1].f1, 0.85);
   EXPECT_EQ(loaded.created_unix_ms, saved.created_unix_ms);
+}
+
+// Model files go through the one atomic writer: no fixed "<path>.tmp" that two trainers (or a
+// stale leftover) share, nothing left beside the file, and a failed save keeps the old model.
+TEST(LabelModel, SavesAtomicallyWithoutASharedTemporaryName) {
+  test::TempDir dir;
+  const std::string path = dir.file("m.plm");
+  std::filesystem::create_directories(path + ".tmp/stale");  // blocked the old fixed name
+  save_model(path, sample_crf());
+  EXPECT_EQ(load_model(path).name, "tabletop");
+  std::size_t entries = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.file(""))) {
+    (void)entry;
+    ++entries;
+  }
+  EXPECT_EQ(entries, 2u);  // m.plm and the stale m.plm.tmp/, no temporary of ours
+  std::filesystem::create_directories(dir.file("busy/inside"));
+  try {
+    save_model(dir.file("busy"), sample_crf());
+    FAIL() << "saved over a directory";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find(dir.file("busy")), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(std::filesystem::is_directory(dir.file("busy/inside")));
 }
 
 TEST(LabelModel, NodeOnlyAndSvmRoundTrip) {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <nlohmann/json.hpp>
 
 #include "../test_util.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
@@ -51,6 +52,26 @@ TEST(TabletopCli, AllNanCloudGivesAClearResult) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.output.find("\"status\":\"no_valid_points\""), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("no point has finite coordinates"), std::string::npos) << r.output;
+}
+
+// The JSON line goes through nlohmann-json: a file name with quotes, a backslash, a tab and a byte
+// that is not UTF-8 still gives one line of valid JSON naming the file.
+TEST(TabletopCli, HostileFileNamesStayValidJson) {
+  test::TempDir dir;
+  PointCloud cloud;
+  cloud.xyz.assign(16, Vec3f::Constant(std::numeric_limits<float>::quiet_NaN()));
+  const std::string path = dir.file("we\"ird\\ na\tme_\xff.pcd");
+  write_pcd(path, cloud);
+  // Only stdout, the JSON line (the one-line error goes to stderr).
+  const Result r = test::run_command("(" + test::binary("primlabel-tabletop") + " '" + path +
+                                     "' --json -q 2>/dev/null)");
+  EXPECT_EQ(r.exit_code, 1);
+  nlohmann::json line;
+  ASSERT_NO_THROW(line = nlohmann::json::parse(last_line(r.output))) << r.output;
+  const std::string file = line["file"];
+  EXPECT_EQ(file.substr(0, file.size() - 7), path.substr(0, path.size() - 5));  // up to the \xff
+  EXPECT_NE(file.find("\xef\xbf\xbd"), std::string::npos) << file;              // replaced, U+FFFD
+  EXPECT_EQ(line["status"], "no_valid_points");
 }
 
 TEST(TabletopCli, EvalWithoutLabelsFails) {

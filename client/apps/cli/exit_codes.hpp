@@ -1,18 +1,22 @@
 #pragma once
-// The exit codes of `primlabel`, which scripts rely on (listed in --help).
+// The exit codes of `primlabel`, which scripts rely on (listed in --help): the scheme every
+// primlabel binary shares (exit_codes.hpp) plus two of its own.
 
 #include <grpcpp/support/status.h>
 
+#include "primlabel/cli/exit_codes.hpp"
+
 namespace primlabel::client::tools {
 
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitUsage = 1;
-inline constexpr int kExitFile = 2;         // an input (or output) file could not be read/written
+using ::primlabel::kExitOk;
+using ::primlabel::kExitUsage;
+inline constexpr int kExitFile = ::primlabel::kExitFailure;  // an input or output file failed
 inline constexpr int kExitUnavailable = 3;  // server unreachable, not serving, or too slow
 inline constexpr int kExitRejected = 4;     // the server answered the request with an error
+static_assert(kExitUnavailable >= ::primlabel::kExitFirstToolSpecific);
 
 inline constexpr const char* kExitCodesHelp =
-    "Exit codes: 0 ok, 1 usage error, 2 input/output file error, 3 server unavailable "
+    "Exit codes: 0 ok, 1 input/output file error, 2 usage error, 3 server unavailable "
     "(unreachable, NOT_SERVING or deadline exceeded), 4 server rejected the request (its "
     "status is shown).";
 

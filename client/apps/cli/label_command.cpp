@@ -6,7 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "cli_common.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "commands.hpp"
 #include "common/labeled_output.hpp"
 #include "exit_codes.hpp"

@@ -23,6 +23,8 @@ using namespace primlabel::client::tools;
 int main(int argc, char** argv) {
   CLI::App app{"primlabel: label point clouds with a primlabel server, list its models, check it.",
                "primlabel"};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel"));
   app.footer(kExitCodesHelp);
   app.require_subcommand(1);

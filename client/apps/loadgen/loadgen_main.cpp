@@ -12,6 +12,7 @@
 #include "common/client_flags.hpp"
 #include "load_runner.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/synth/generate.hpp"
 #include "report.hpp"
@@ -22,15 +23,16 @@ using namespace primlabel::client::loadgen;
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitUsage = 1;
-constexpr int kExitInput = 2;
+// The shared scheme (exit_codes.hpp), then the load generator's own codes.
+using primlabel::kExitOk;
+using primlabel::kExitUsage;
+constexpr int kExitInput = primlabel::kExitFailure;  // an input file could not be read
 constexpr int kExitMetrics = 3;
 constexpr int kExitCallsFailed = 4;
 
 constexpr const char* kFooter =
     "Latency is from sending a cloud to its last label (open loop: from its scheduled send "
-    "time). Exit codes: 0 every call succeeded, 1 usage, 2 an input file could not be read, 3 "
+    "time). Exit codes: 0 every call succeeded, 1 an input file could not be read, 2 usage, 3 "
     "the --metrics-url could not be read, 4 some calls failed (the report shows them by status).";
 
 PointCloud first_points(PointCloud cloud, std::size_t n) {
@@ -46,6 +48,8 @@ PointCloud first_points(PointCloud cloud, std::size_t n) {
 
 int main(int argc, char** argv) {
   CLI::App app{"primlabel-loadgen: load a primlabel server and measure it.", "primlabel-loadgen"};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-loadgen"));
   app.footer(kFooter);
   tools::ConnectionFlags connection;

@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "primlabel/geometry/json_text.hpp"
+
 namespace primlabel::client::loadgen {
 
 namespace {
@@ -100,41 +102,41 @@ void write_csv(std::FILE* out, const std::vector<ReportRow>& rows) {
   }
 }
 
+// Status names come from the server's metrics page as well as from gRPC: nlohmann escapes them.
 void write_json(std::FILE* out, const std::vector<ReportRow>& rows) {
-  std::fprintf(out, "{\"steps\":[");
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const StepResult& r = rows[i].step;
+  json::Json steps = json::Json::array();
+  for (const ReportRow& row : rows) {
+    const StepResult& r = row.step;
     const Figures f = figures_of(r);
-    std::fprintf(out,
-                 "%s{\"mode\":\"%s\",\"calls\":\"%s\",\"concurrency\":%d,\"rate\":%g,"
-                 "\"elapsed_s\":%.3f,\"ok\":%llu,\"errors\":%llu,\"skipped\":%llu,"
-                 "\"clouds_per_s\":%.3f,\"points_per_s\":%.0f,\"latency_ms\":{\"p50\":%.2f,"
-                 "\"p90\":%.2f,\"p95\":%.2f,\"p99\":%.2f,\"max\":%.2f},\"errors_by_status\":{",
-                 i ? "," : "", f.mode.c_str(), f.transport.c_str(), r.spec.concurrency,
-                 r.spec.mode == LoadMode::kOpen ? r.spec.rate : 0.0, r.elapsed_s,
-                 static_cast<unsigned long long>(r.stats.ok()),
-                 static_cast<unsigned long long>(r.stats.errors()),
-                 static_cast<unsigned long long>(r.stats.skipped()), f.clouds_per_s, f.points_per_s,
-                 f.p50, f.p90, f.p95, f.p99, f.max);
-    bool first = true;
-    for (const auto& [status, n] : r.stats.errors_by_status()) {
-      std::fprintf(out, "%s\"%s\":%llu", first ? "" : ",", status.c_str(),
-                   static_cast<unsigned long long>(n));
-      first = false;
+    json::Json errors = json::Json::object();
+    for (const auto& [status, n] : r.stats.errors_by_status()) errors[status] = n;
+    json::Json step = {
+        {"mode", f.mode},
+        {"calls", f.transport},
+        {"concurrency", r.spec.concurrency},
+        {"rate", json::rounded(r.spec.mode == LoadMode::kOpen ? r.spec.rate : 0.0, "%g")},
+        {"elapsed_s", json::rounded(r.elapsed_s, "%.3f")},
+        {"ok", r.stats.ok()},
+        {"errors", r.stats.errors()},
+        {"skipped", r.stats.skipped()},
+        {"clouds_per_s", json::rounded(f.clouds_per_s, "%.3f")},
+        {"points_per_s", json::whole(f.points_per_s)},
+        {"latency_ms",
+         {{"p50", json::rounded(f.p50, "%.2f")},
+          {"p90", json::rounded(f.p90, "%.2f")},
+          {"p95", json::rounded(f.p95, "%.2f")},
+          {"p99", json::rounded(f.p99, "%.2f")},
+          {"max", json::rounded(f.max, "%.2f")}}},
+        {"errors_by_status", std::move(errors)}};
+    if (row.server) {
+      json::Json by_status = json::Json::object();
+      for (const auto& [status, n] : row.server->by_status) by_status[status] = json::whole(n);
+      step["server"] = {{"requests", json::whole(row.server->total)},
+                        {"by_status", std::move(by_status)}};
     }
-    std::fprintf(out, "}");
-    if (rows[i].server) {
-      std::fprintf(out, ",\"server\":{\"requests\":%.0f,\"by_status\":{", rows[i].server->total);
-      first = true;
-      for (const auto& [status, n] : rows[i].server->by_status) {
-        std::fprintf(out, "%s\"%s\":%.0f", first ? "" : ",", status.c_str(), n);
-        first = false;
-      }
-      std::fprintf(out, "}}");
-    }
-    std::fprintf(out, "}");
+    steps.push_back(std::move(step));
   }
-  std::fprintf(out, "]}\n");
+  std::fprintf(out, "%s\n", json::dump({{"steps", std::move(steps)}}).c_str());
 }
 
 }  // namespace

@@ -7,12 +7,13 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
+
+#include "primlabel/geometry/atomic_file.hpp"
 
 namespace primlabel::client::upload {
 
@@ -78,51 +79,6 @@ std::string scan_id(std::string_view bytes) {
   unsigned char digest[SHA256_DIGEST_LENGTH];
   SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), digest);
   return id_from_digest(digest);
-}
-
-void fsync_path(const fs::path& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) fail_errno("cannot open to sync", path);
-  const int rc = ::fsync(fd);
-  ::close(fd);
-  if (rc != 0) fail_errno("fsync failed", path);
-}
-
-void write_file_durably(const fs::path& target, std::string_view bytes, const fs::path& temp_dir) {
-  static std::atomic<std::uint64_t> counter{0};
-  const fs::path temp = temp_dir / (target.filename().string() + "." + std::to_string(::getpid()) +
-                                    "." + std::to_string(counter++) + ".part");
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) fail_errno("cannot create", temp);
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int saved = errno;
-      ::close(fd);
-      ::unlink(temp.c_str());
-      errno = saved;
-      fail_errno("write failed", temp);
-    }
-    written += static_cast<std::size_t>(n);
-  }
-  const bool synced = ::fsync(fd) == 0;
-  const int sync_error = errno;
-  const bool closed = ::close(fd) == 0;  // always, even when fsync failed
-  if (!synced || !closed) {
-    const int saved = synced ? errno : sync_error;
-    ::unlink(temp.c_str());
-    errno = saved;
-    fail_errno(synced ? "close failed" : "fsync failed", temp);
-  }
-  if (::rename(temp.c_str(), target.c_str()) != 0) {
-    const int saved = errno;
-    ::unlink(temp.c_str());
-    errno = saved;
-    fail_errno("cannot rename into place", target);
-  }
-  fsync_path(target.parent_path());
 }
 
 Spool::Spool(fs::path dir, SpoolLimits limits) : dir_(std::move(dir)), limits_(limits) {
@@ -203,7 +159,7 @@ Spool::Accepted Spool::accept(const std::string& id, std::string_view bytes, con
                 static_cast<unsigned long long>(next_sequence_));
   const fs::path target = dir_ / kScans / (sequence + id + ext);
   try {
-    write_file_durably(target, bytes, dir_ / kTemp);
+    atomic_write_file(target, bytes, {.temp_dir = dir_ / kTemp});
   } catch (const std::exception& e) {
     // The temp file is gone; a renamed file whose directory fsync failed must go too, or the
     // next start would resume a scan nobody was told was accepted.
@@ -261,7 +217,7 @@ void Spool::complete(const std::string& id) {
 
 void Spool::move_to_failed(const std::string& id, const fs::path& path, const std::string& reason) {
   const fs::path target = dir_ / kFailed / (id + path.extension().string());
-  write_file_durably(dir_ / kFailed / (id + ".error"), reason + "\n", dir_ / kTemp);
+  atomic_write_file(dir_ / kFailed / (id + ".error"), reason + "\n", {.temp_dir = dir_ / kTemp});
   if (::rename(path.c_str(), target.c_str()) != 0) fail_errno("cannot move", path);
   fsync_path(dir_ / kFailed);
   fsync_path(dir_ / kScans);

@@ -113,12 +113,4 @@ class Spool {
   std::vector<CorruptEntry> corrupt_;
 };
 
-// Durable-write helpers the uploader shares with its output writer.
-void fsync_path(const std::filesystem::path& path);  // a file or a directory
-// Writes `bytes` to `target` via a temp file in `temp_dir` (same filesystem), fsync and rename,
-// then fsyncs target's directory. On failure the temp file is gone; `target` may exist only when
-// the final directory fsync failed. Throws std::runtime_error naming the file and the reason.
-void write_file_durably(const std::filesystem::path& target, std::string_view bytes,
-                        const std::filesystem::path& temp_dir);
-
 }  // namespace primlabel::client::upload

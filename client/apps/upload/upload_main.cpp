@@ -16,6 +16,7 @@
 #include "directory_watch.hpp"
 #include "framing.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/exit_codes.hpp"
 #include "uploader.hpp"
 
 using namespace primlabel::client;
@@ -24,9 +25,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitUsage = 1;
-constexpr int kExitInput = 2;
+// The shared scheme (exit_codes.hpp), then the uploader's own codes.
+using primlabel::kExitOk;
+using primlabel::kExitUsage;
+constexpr int kExitInput = primlabel::kExitFailure;  // an input, the spool or the output failed
 constexpr int kExitTimedOut = 3;
 constexpr int kExitRefused = 4;
 constexpr int kExitNotAccepted = 5;  // full spool, full disk or a failed spool write
@@ -36,7 +38,7 @@ constexpr const char* kFooter =
     "queued = already in the spool, labeled = output exists, rejected = the spool could not take "
     "it) and labeled into OUT/<id>.pcd, id = content hash. Scans already spooled are uploaded "
     "before new input is read. Exit codes (the highest that applies): 0 every scan labeled (or "
-    "--watch stopped by a signal), 1 usage, 2 an input could not be read, 3 --timeout passed "
+    "--watch stopped by a signal), 1 an input could not be read, 2 usage, 3 --timeout passed "
     "with scans still spooled, 4 scans were moved to SPOOL/failed (refused by the server for "
     "good, or corrupt in the spool), 5 scans were not accepted: the spool was full, its disk "
     "short of --spool-min-free-mb, or the write failed (one line on stderr names the file and "
@@ -181,6 +183,8 @@ std::string summary_line(const UploadCounters& c, std::size_t left) {
 int main(int argc, char** argv) {
   CLI::App app{"primlabel-upload: upload scans to a primlabel server through a durable spool.",
                "primlabel-upload"};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-upload"));
   app.footer(kFooter);
   tools::ConnectionFlags connection;

@@ -4,6 +4,7 @@
 #include <future>
 
 #include "common/labeled_output.hpp"
+#include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel::client::upload {
@@ -21,12 +22,12 @@ bool permanent(grpc::StatusCode code) {
          code == grpc::StatusCode::UNIMPLEMENTED;
 }
 
-// Temp files of output writes a crash interrupted (core's atomic write: ".<name>.tmp.<pid>.<n>").
+// Temp files of output writes a crash interrupted (core's atomic_write_file).
 void remove_output_temp_files(const fs::path& dir) {
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string name = entry.path().filename().string();
-    if (name.starts_with(".") && name.find(".tmp.") != std::string::npos) fs::remove(entry, ec);
+    if (is_atomic_write_temp_name(name)) fs::remove(entry, ec);
   }
 }
 
@@ -204,7 +205,8 @@ bool Uploader::upload(const SpooledScan& scan) {
   }
   const std::size_t points = result.size();
   write_pcd(output_path(scan.id).string(), tools::labeled_cloud(std::move(cloud), result));
-  fsync_path(options_.output_dir);  // the rename is durable before the spool forgets the scan
+  // write_pcd returns once the file and its directory entry are durable (atomic_write_file), so
+  // the spool may forget the scan now.
   spool_.complete(scan.id);
   std::lock_guard lock(mutex_);
   ++counters_.uploaded;

@@ -7,6 +7,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "primlabel/geometry/atomic_file.hpp"
+
 namespace primlabel {
 namespace {
 
@@ -173,9 +175,11 @@ ClassMap read_class_map(const std::string& path) {
 }
 
 void write_class_map(const std::string& path, const ClassMap& map) {
-  std::ofstream out(path);
-  if (out) out << map.to_text();
-  if (!out) throw std::runtime_error(path + ": cannot write class map");
+  try {
+    atomic_write_file(path, map.to_text());
+  } catch (const AtomicWriteError& e) {
+    throw std::runtime_error(std::string("cannot write class map: ") + e.what());
+  }
 }
 
 }  // namespace primlabel

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/model/svm_baseline.hpp"
 #include "primlabel/v1/model.pb.h"
@@ -301,19 +302,10 @@ LabelModel parse_model(const std::string& bytes, const std::string& source) {
 
 void save_model(const std::string& path, const LabelModel& model) {
   const std::string bytes = serialize_model(model);
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) fail(path, "cannot write (" + std::string(std::strerror(errno)) + ")");
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    out.flush();
-    if (!out) fail(path, "write failed (" + std::string(std::strerror(errno)) + ")");
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    std::filesystem::remove(temporary, ec);
-    fail(path, "cannot move the written model into place");
+  try {
+    atomic_write_file(path, bytes);
+  } catch (const AtomicWriteError& e) {
+    throw ModelError(std::string("cannot write the model file: ") + e.what());
   }
 }
 

@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "font5x7.hpp"
+#include "primlabel/geometry/atomic_file.hpp"
 
 namespace primlabel {
 
@@ -82,38 +83,39 @@ int Raster::text_width(std::string_view s, int scale) {
 int Raster::text_height(int scale) { return kGlyphHeight * scale; }
 
 void Raster::write_png(const std::string& path) const {
-  FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) throw std::runtime_error("cannot write PNG '" + path + "': " + std::strerror(errno));
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!png || !info) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(file);
-    throw std::runtime_error("cannot write PNG '" + path + "': out of memory");
+  const std::string what = "cannot write PNG '" + path + "': ";
+  try {
+    atomic_write_file(path, [&](FILE* file) {
+      png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+      png_infop info = png ? png_create_info_struct(png) : nullptr;
+      if (!png || !info) {
+        png_destroy_write_struct(&png, &info);
+        throw std::runtime_error(what + "out of memory");
+      }
+      std::vector<png_byte> row(std::size_t(width_) * 3);
+      if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        throw std::runtime_error(what + "libpng failed (disk full?)");
+      }
+      png_init_io(png, file);
+      png_set_IHDR(png, info, width_, height_, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                   PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+      png_write_info(png, info);
+      for (int y = 0; y < height_; ++y) {
+        for (int x = 0; x < width_; ++x) {
+          const std::uint32_t c = rgb_[std::size_t(y) * width_ + x];
+          row[3 * x] = png_byte(c >> 16);
+          row[3 * x + 1] = png_byte(c >> 8);
+          row[3 * x + 2] = png_byte(c);
+        }
+        png_write_row(png, row.data());
+      }
+      png_write_end(png, nullptr);
+      png_destroy_write_struct(&png, &info);
+    });
+  } catch (const AtomicWriteError& e) {
+    throw std::runtime_error(what + e.what());
   }
-  std::vector<png_byte> row(std::size_t(width_) * 3);
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(file);
-    throw std::runtime_error("cannot write PNG '" + path + "': libpng failed (disk full?)");
-  }
-  png_init_io(png, file);
-  png_set_IHDR(png, info, width_, height_, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-               PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < height_; ++y) {
-    for (int x = 0; x < width_; ++x) {
-      const std::uint32_t c = rgb_[std::size_t(y) * width_ + x];
-      row[3 * x] = png_byte(c >> 16);
-      row[3 * x + 1] = png_byte(c >> 8);
-      row[3 * x + 2] = png_byte(c);
-    }
-    png_write_row(png, row.data());
-  }
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  if (std::fclose(file) != 0)
-    throw std::runtime_error("cannot write PNG '" + path + "': " + std::strerror(errno));
 }
 
 std::uint32_t contrasting_text_color(std::uint32_t background) {

@@ -7,7 +7,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <bit>
 #include <cerrno>
 #include <charconv>
@@ -25,6 +24,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel::io_detail {
@@ -101,46 +101,14 @@ inline std::string read_whole_file(const std::string& path) {
   return bytes;
 }
 
-// Writes `bytes` to a temporary file next to `path`, syncs it and renames it over `path`, so
-// readers (and a crash) see either the old file or the complete new one, never a partial file.
+// Replaces `path` with `bytes` through the one atomic writer (temp file, fsync, rename, directory
+// fsync), reporting failures as IoError like every other I/O error of the formats.
 inline void write_file_atomically(const std::string& path, std::string_view bytes) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  const std::string file_name = target.filename().string();
-  if (file_name.empty()) throw_io_error(path, "cannot write: path names no file");
-  const fs::path directory = target.has_parent_path() ? target.parent_path() : fs::path(".");
-
-  static std::atomic<unsigned> sequence{0};
-  std::string temp_path;
-  int fd = -1;
-  for (int attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-    temp_path =
-        (directory / cat(".", file_name, ".tmp.", ::getpid(), ".", sequence.fetch_add(1))).string();
-    fd = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0 && errno != EEXIST) break;
+  try {
+    atomic_write_file(path, bytes);
+  } catch (const AtomicWriteError& e) {
+    throw IoError(e.what());
   }
-  if (fd < 0) throw_io_error(path, "cannot create temporary file: " + errno_message(errno));
-
-  auto fail = [&](const char* step) {
-    const int error = errno;
-    if (fd >= 0) ::close(fd);
-    ::unlink(temp_path.c_str());
-    throw_io_error(path, cat(step, ": ", errno_message(error)));
-  };
-  std::size_t written = 0;
-  while (written < bytes.size()) {
-    const ssize_t put = ::write(fd, bytes.data() + written, bytes.size() - written);
-    if (put < 0) {
-      if (errno == EINTR) continue;
-      fail("write failed");
-    }
-    written += static_cast<std::size_t>(put);
-  }
-  if (::fsync(fd) != 0) fail("fsync failed");
-  const int closing = fd;
-  fd = -1;
-  if (::close(closing) != 0) fail("close failed");
-  if (::rename(temp_path.c_str(), path.c_str()) != 0) fail("cannot replace file");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel {
@@ -50,9 +51,11 @@ void write_tagged_cloud(const std::string& path, const PointCloud& cloud, const 
   if (ply && at != std::string::npos) at = bytes.find('\n', at + 1);
   if (at == std::string::npos) throw IoError(path + ": unexpected header written, cannot add tags");
   bytes.insert(at + 1, lines);
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  if (!out) throw IoError(path + ": cannot write");
+  try {
+    atomic_write_file(path, bytes);
+  } catch (const AtomicWriteError& e) {
+    throw IoError(e.what());
+  }
 }
 
 CloudTags read_cloud_tags(const std::string& path) {

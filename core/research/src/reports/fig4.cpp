@@ -9,6 +9,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
@@ -30,10 +31,11 @@ std::string format(const char* fmt, double v) {
 }
 
 void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) throw std::runtime_error(path + ": cannot be written");
+  try {
+    atomic_write_file(path, text);
+  } catch (const AtomicWriteError& e) {
+    throw std::runtime_error(std::string("cannot be written: ") + e.what());
+  }
 }
 
 std::string signatures_csv(const ClassSignatures& s) {

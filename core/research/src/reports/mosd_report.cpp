@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/render/colorize.hpp"
 #include "primlabel/render/render.hpp"
@@ -25,16 +26,7 @@ std::string format(const char* fmt, auto... args) {
   return buffer;
 }
 
-std::string json_number(double v) { return std::isfinite(v) ? format("%.6f", v) : "null"; }
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) >= 0x20) out += c;
-  }
-  return out + "\"";
-}
+json::Json json_number(double v) { return json::rounded(v, "%.6f"); }
 
 void render_labels(const PointCloud& cloud, const std::vector<std::uint32_t>& labels,
                    const std::string& title, const std::string& path) {
@@ -123,32 +115,30 @@ std::string mosd_report_text(const MosdReport& report) {
 }
 
 std::string mosd_report_json(const MosdReport& report) {
-  std::string out = "{\"scenes\":[";
-  for (std::size_t k = 0; k < report.scenes.size(); ++k) {
-    const MosdSceneReport& s = report.scenes[k];
-    out += (k ? "," : "") + std::string("{\"file\":") + json_string(s.file) +
-           ",\"points\":" + std::to_string(s.points) +
-           ",\"table_points\":" + std::to_string(s.table_points) +
-           ",\"table_plane\":" + std::to_string(s.table_plane) +
-           ",\"plane_share\":" + json_number(s.plane_share()) +
-           ",\"object_points\":" + std::to_string(s.object_points) +
-           ",\"object_plane_share\":" + json_number(s.object_plane_share()) +
-           ",\"table_predicted\":{";
-    bool first = true;
+  json::Json scenes = json::Json::array();
+  for (const MosdSceneReport& s : report.scenes) {
+    json::Json predicted = json::Json::object();
     for (std::uint32_t id = 0; id < s.table_predicted.size(); ++id) {
       if (!s.table_predicted[id]) continue;
       const auto c = class_from_id(id);
-      out += (first ? "" : ",") + json_string(c ? std::string(name(*c)) : std::to_string(id)) +
-             ":" + std::to_string(s.table_predicted[id]);
-      first = false;
+      predicted[c ? std::string(name(*c)) : std::to_string(id)] = s.table_predicted[id];
     }
-    out += "},\"seconds\":" + json_number(s.feature_seconds + s.inference_seconds) +
-           ",\"png\":" + json_string(s.png) + "}";
+    scenes.push_back({{"file", s.file},
+                      {"points", s.points},
+                      {"table_points", s.table_points},
+                      {"table_plane", s.table_plane},
+                      {"plane_share", json_number(s.plane_share())},
+                      {"object_points", s.object_points},
+                      {"object_plane_share", json_number(s.object_plane_share())},
+                      {"table_predicted", std::move(predicted)},
+                      {"seconds", json_number(s.feature_seconds + s.inference_seconds)},
+                      {"png", s.png}});
   }
-  out += "],\"table_points\":" + std::to_string(report.table_points) +
-         ",\"table_plane\":" + std::to_string(report.table_plane) +
-         ",\"plane_share\":" + json_number(report.plane_share()) + "}\n";
-  return out;
+  const json::Json out = {{"scenes", std::move(scenes)},
+                          {"table_points", report.table_points},
+                          {"table_plane", report.table_plane},
+                          {"plane_share", json_number(report.plane_share())}};
+  return json::dump(out) + "\n";
 }
 
 }  // namespace primlabel::research

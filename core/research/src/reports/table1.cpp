@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/model/svm_baseline.hpp"
 #include "primlabel/pipeline/training.hpp"
@@ -156,12 +157,15 @@ std::string table1_text(const std::vector<Table1Row>& rows) {
 
 std::string table1_json(const std::vector<Table1Row>& rows) {
   std::string out;
-  for (const Table1Row& r : rows)
-    out += format(
-        "{\"method\":\"%s\",\"descriptor\":\"%s\",\"feature_pts_s\":%.1f,\"train_s\":%.3f,"
-        "\"test_pts_s\":%.1f,\"accuracy\":%.6f}\n",
-        r.method.c_str(), r.descriptor.c_str(), r.feature_pts_s, r.train_s, r.test_pts_s,
-        r.accuracy);
+  for (const Table1Row& r : rows) {
+    const json::Json row = {{"method", r.method},
+                            {"descriptor", r.descriptor},
+                            {"feature_pts_s", json::rounded(r.feature_pts_s, "%.1f")},
+                            {"train_s", json::rounded(r.train_s, "%.3f")},
+                            {"test_pts_s", json::rounded(r.test_pts_s, "%.1f")},
+                            {"accuracy", json::rounded(r.accuracy, "%.6f")}};
+    out += json::dump(row) + "\n";
+  }
   return out;
 }
 

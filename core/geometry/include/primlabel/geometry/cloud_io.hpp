@@ -1,8 +1,9 @@
 #pragma once
 // Reading and writing point clouds: PCD v0.7 (ascii, binary, binary_compressed) and PLY (ascii,
 // binary_little_endian; binary_big_endian is read too). Errors are reported as IoError whose
-// message starts with the file path and says what is wrong with it. Writes are atomic (a
-// temporary file in the same directory renamed over the target).
+// message starts with the file path and says what is wrong with it. Writes are atomic and durable
+// (atomic_write_file: a temporary file beside the target, fsynced, renamed over it, directory
+// fsynced).
 //
 // Field mapping (PCD field / PLY vertex property -> PointCloud):
 //   x y z -> xyz (required); normal_x normal_y normal_z (PLY: nx ny nz) -> normals;

@@ -93,7 +93,8 @@ struct LabelModel {
 std::string serialize_model(const LabelModel& model);
 LabelModel parse_model(const std::string& bytes, const std::string& source);
 
-// Writes atomically (temporary file + rename); reads with the checks above.
+// Writes through atomic_write_file (temporary file, fsync, rename, directory fsync); reads with
+// the checks above.
 void save_model(const std::string& path, const LabelModel& model);
 LabelModel load_model(const std::string& path);
 

@@ -1,20 +1,21 @@
 #pragma once
 // Small pieces every primlabel command-line tool shares: progress on stderr, parsing of vector
-// arguments, and the exit-code convention (0 ok, 1 failure while running, 2 bad usage).
+// arguments, and the exit codes of every binary (exit_codes.hpp).
 
 #include <chrono>
 #include <cstddef>
 #include <string>
 #include <vector>
 
+#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/progress.hpp"
 
 namespace primlabel::cli {
 
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailure = 1;
-inline constexpr int kExitUsage = 2;
+using ::primlabel::kExitFailure;
+using ::primlabel::kExitOk;
+using ::primlabel::kExitUsage;
 
 // Parses "X,Y,Z" into a vector; throws std::invalid_argument with a readable reason.
 Vec3f parse_vec3(const std::string& text);
