@@ -11,7 +11,7 @@ namespace primlabel::testing {
 
 inline LabelModel train_small_svm_model() {
   const FeatureSettings features;
-  const crf::GraphOptions graph;
+  const crf::GraphSettings graph;
   std::vector<std::uint32_t> every_class;
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
   std::vector<pipeline::SceneData> train;

@@ -16,7 +16,7 @@ namespace {
 TEST(Parallel, AnExceptionInABlockIsRethrownAfterTheRegion) {
   std::atomic<int> ran{0};
   const auto make_scratch = [] { return 0; };
-  EXPECT_THROW(detail::for_each_block(2, 10000, {}, make_scratch,
+  EXPECT_THROW(detail::for_each_block(10000, RunContext{2}, make_scratch,
                                       [&](int&, std::ptrdiff_t block) {
                                         ++ran;
                                         if (block == 3) throw std::runtime_error("block 3");
@@ -27,8 +27,9 @@ TEST(Parallel, AnExceptionInABlockIsRethrownAfterTheRegion) {
 
 TEST(Parallel, AFailingScratchIsAnExceptionToo) {
   const auto make_scratch = []() -> int { throw std::bad_alloc(); };
-  EXPECT_THROW(detail::for_each_block(2, 100, {}, make_scratch, [](int&, std::ptrdiff_t) {}),
-               std::bad_alloc);
+  EXPECT_THROW(
+      detail::for_each_block(100, RunContext{2}, make_scratch, [](int&, std::ptrdiff_t) {}),
+      std::bad_alloc);
 }
 
 TEST(Parallel, TheBarrierKeepsTheFirstException) {

@@ -150,7 +150,7 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
     SpfhScratch pairs;
   };
   detail::for_each_block(
-      threads, blocks, options.stop, [] { return Pass1Scratch(); },
+      blocks, RunContext{threads, options.stop, {}}, [] { return Pass1Scratch(); },
       [&](Pass1Scratch& scratch, std::ptrdiff_t block) {
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
         for (std::size_t p = first; p < last; ++p) {
@@ -175,7 +175,7 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
   detail::assign_checked(fpfh, n * kFpfhSize, 0.0f, options.stop, "FPFH");
   std::atomic<std::size_t> computed{0}, isolated{0};
   detail::for_each_block(
-      threads, blocks, options.stop, [] { return NeighborList(); },
+      blocks, RunContext{threads, options.stop, {}}, [] { return NeighborList(); },
       [&](NeighborList& neighbors, std::ptrdiff_t block) {
         std::size_t block_computed = 0, block_isolated = 0;
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);

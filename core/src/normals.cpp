@@ -77,7 +77,7 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
   const auto blocks = static_cast<std::ptrdiff_t>((n + kBlock - 1) / kBlock);
   const auto make_scratch = [] { return NeighborList(); };
   detail::for_each_block(
-      threads, blocks, options.stop, make_scratch,
+      blocks, RunContext{threads, options.stop, {}}, make_scratch,
       [&](NeighborList& neighbors, std::ptrdiff_t block) {
         std::size_t block_estimated = 0, block_too_few = 0, block_invalid = 0;
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);

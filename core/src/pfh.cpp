@@ -68,7 +68,7 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
   };
   const auto make_scratch = [] { return Scratch(); };
   detail::for_each_block(
-      detail::resolve_threads(options.threads), blocks, options.stop, make_scratch,
+      blocks, RunContext{options.threads, options.stop, {}}, make_scratch,
       [&](Scratch& scratch, std::ptrdiff_t block) {
         std::size_t block_computed = 0, block_isolated = 0;
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);

@@ -102,8 +102,7 @@ TEST(CrfTraining, BetheObjectiveIsExactOnATree) {
     detail::BpSettings bp;
     bp.max_iterations = 300;
     bp.tolerance = 1e-7f;
-    bp.threads = 1;
-    auto objective = detail::make_bethe(prepared, shape, bp);
+    auto objective = detail::make_bethe(prepared, shape, bp, RunContext{1});
     const Eigen::VectorXd x = random_parameters(shape.size(), 11, 1.5);
     Eigen::VectorXd grad(x.size());
     const double value_bethe = objective->evaluate(x, grad);
@@ -130,7 +129,7 @@ TEST(CrfTraining, CrfBeatsNodeOnlyOnHeldOutData) {
   const std::vector<LabeledGraph> train = {testing::make_grid_scene(spec)};
   spec.seed = 2;
   const std::vector<LabeledGraph> test = {testing::make_grid_scene(spec)};
-  InferenceOptions inference;
+  InferenceSettings inference;
   const auto run = [&](TrainingObjective objective) {
     TrainingOptions options;
     options.objective = objective;
@@ -160,10 +159,8 @@ TEST(CrfTraining, SameModelForOneAndTwoThreads) {
     TrainingOptions options;
     options.objective = objective;
     options.max_iterations = 10;
-    options.threads = 1;
-    const TrainingResult one = train_crf(scenes, {}, ids(3), options);
-    options.threads = 2;
-    const TrainingResult two = train_crf(scenes, {}, ids(3), options);
+    const TrainingResult one = train_crf(scenes, {}, ids(3), options, RunContext{1});
+    const TrainingResult two = train_crf(scenes, {}, ids(3), options, RunContext{2});
     EXPECT_TRUE(one.model.node_weights.cwiseEqual(two.model.node_weights).all());
     EXPECT_TRUE(one.model.edge_weights.cwiseEqual(two.model.edge_weights).all());
     EXPECT_EQ(one.objective, two.objective);

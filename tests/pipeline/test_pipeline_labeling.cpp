@@ -25,7 +25,7 @@ struct Trained {
 };
 
 Trained train_on_two_scenes() {
-  const crf::GraphOptions graph;
+  const crf::GraphSettings graph;
   const FeatureSettings features;
   std::vector<std::uint32_t> every_class;
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
@@ -129,7 +129,7 @@ TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRo
 // The default CRF training is piecewise: node factors alone, then the one Potts coupling that
 // labels the validation scene best, never worse there than no coupling (node-only).
 TEST(PipelineLabeling, PiecewiseCrfTrainingKeepsTheCouplingThatValidatesBest) {
-  const crf::GraphOptions graph;
+  const crf::GraphSettings graph;
   const FeatureSettings features;
   std::vector<std::uint32_t> every_class;
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));

@@ -176,7 +176,7 @@ TEST(PipelineServiceOptions, InferenceHonoursItsStopToken) {
   const auto graph = pipeline::build_scene_graph(cloud, described, model.graph);
   std::stop_source source;
   source.request_stop();
-  crf::InferenceOptions options;
+  crf::InferenceSettings options;
   options.stop = source.get_token();
   EXPECT_THROW(crf::infer(model.weights, described.descriptors, graph, options), Cancelled);
   options.stop = {};
@@ -193,7 +193,7 @@ TEST(PipelineServiceOptions, StoppedTokensCancelTheIndexAndTheGraph) {
   describe.stop = source.get_token();
   EXPECT_THROW(pipeline::describe_cloud(cloud, model.features, describe), Cancelled);
   const auto described = pipeline::describe_cloud(cloud, model.features, 0);
-  crf::GraphOptions graph = model.graph;
+  crf::GraphSettings graph = model.graph;
   graph.stop = source.get_token();
   EXPECT_THROW(pipeline::build_scene_graph(cloud, described, graph), Cancelled);
 }

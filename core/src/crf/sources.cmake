@@ -4,7 +4,7 @@ target_sources(primlabel_core PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/graph.cpp
   ${CMAKE_CURRENT_LIST_DIR}/model.cpp
   ${CMAKE_CURRENT_LIST_DIR}/potentials.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/loopy_bp.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/belief_propagation.cpp
   ${CMAKE_CURRENT_LIST_DIR}/mean_field.cpp
   ${CMAKE_CURRENT_LIST_DIR}/inference.cpp
 )

@@ -187,7 +187,8 @@ Fig4 run_fig4(const Fig4Options& options) {
   SignatureAccumulator accumulator(options.features.descriptor_dim());
   for (int i = 0; i < options.scenes; ++i) {
     PointCloud cloud = synthetic_scene(synth::SceneSet::kTrain, i, options.sensor);
-    const DescribedCloud described = describe_cloud(cloud, options.features, options.threads);
+    const DescribedCloud described =
+        describe_cloud(cloud, options.features, RunContext{options.threads});
     accumulator.add(cloud.labels, described.descriptors);
     if (options.progress)
       options.progress("fig4: " + std::string(synth::set_name(synth::SceneSet::kTrain)) + " seed " +
