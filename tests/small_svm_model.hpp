@@ -17,14 +17,14 @@ inline LabelModel train_small_svm_model() {
   std::vector<pipeline::SceneData> train;
   train.push_back(pipeline::prepare_scene(
       pipeline::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
-      features, graph, every_class, 2));
+      features, graph, every_class, RunContext{2}));
   const auto class_ids = pipeline::classes_present(train);
   pipeline::assign_labels(train.front(), class_ids);
   pipeline::ModelTrainingOptions options;
   options.kind = ModelKind::kSvm;
   options.svm.max_training_points = 1500;
-  options.threads = 2;
-  return pipeline::train_label_model(train, {}, class_ids, features, graph, options).model;
+  return pipeline::train_label_model(train, {}, class_ids, features, graph, options, RunContext{2})
+      .model;
 }
 
 }  // namespace primlabel::testing

@@ -115,6 +115,28 @@ TEST(CrfTraining, BetheObjectiveIsExactOnATree) {
   }
 }
 
+// On a loopy graph the Bethe value is an approximation, but at a BP fixed point its gradient is
+// still exactly the BP marginals' expectation: the analytic gradient (from the kernel's beliefs
+// and messages) matches central differences of the value.
+TEST(CrfTraining, BetheGradientMatchesFiniteDifferencesOnALoopyGraph) {
+  const std::vector<LabeledGraph> scenes = {small_scene(7, 6, 5)};
+  const CrfModel like = CrfModel::zeros(ids(3), 5, 0.01f, kKnots);
+  auto prepared = detail::prepare_scenes(scenes, like, true);
+  // As train_crf does: the graph over the labelled nodes only.
+  std::vector<std::uint8_t> labelled(scenes[0].labels.size());
+  for (std::size_t i = 0; i < labelled.size(); ++i) labelled[i] = scenes[0].labels[i] >= 0;
+  const Graph restricted = restrict_graph(scenes[0].graph, labelled);
+  prepared[0].graph = &restricted;
+  ASSERT_GT(restricted.num_edges(), restricted.num_active());  // loops
+  const detail::ParameterShape shape = shape_of(like, true);
+  detail::BpSettings bp;
+  bp.max_iterations = 500;
+  bp.tolerance = 1e-7f;
+  auto objective = detail::make_bethe(prepared, shape, bp, RunContext{1});
+  const Eigen::VectorXd x = random_parameters(shape.size(), 13, 0.5);
+  EXPECT_LT(gradient_error(*objective, x, 1e-4), 2e-3);
+}
+
 struct Accuracies {
   double node_only, pseudo_likelihood, bethe;
 };

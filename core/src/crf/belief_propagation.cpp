@@ -184,6 +184,7 @@ struct Sweep {
   float keep;
   float tolerance;
   bool max_product;
+  bool fixed_point;  // update every node; report message (not belief) changes
 };
 
 // One iteration over fixed node blocks; returns the largest belief change.
@@ -213,7 +214,7 @@ float sweep(const Sweep& it, const RunContext& context) {
           // A node whose messages and inputs all settled (moved < tolerance last iteration)
           // would only repeat itself: skip it. Decided from the previous iteration alone, so the
           // result still does not depend on the thread count.
-          bool needed = it.first || it.moved_before[i];
+          bool needed = it.first || it.fixed_point || it.moved_before[i];
           for (std::uint32_t p = begin; !needed && p < end; ++p)
             needed = it.moved_before[g.neighbors[p]] != 0;
           if (!needed) {
@@ -231,7 +232,7 @@ float sweep(const Sweep& it, const RunContext& context) {
               scratch.updater.update(message_change, g, it.pr, it.old, it.next, it.beliefs,
                                      it.first, it.keep, it.max_product, i);
           it.moved[i] = message_change >= it.tolerance;
-          block_max = std::max(block_max, change);
+          block_max = std::max(block_max, it.fixed_point ? message_change : change);
         }
         it.block_change[block] = block_max;
       });
@@ -305,12 +306,14 @@ BpRun BeliefPropagation::run(const BpSettings& settings, const RunContext& conte
                    first,
                    first ? 0.0f : settings.damping,
                    settings.tolerance,
-                   settings.max_product};
+                   settings.max_product,
+                   settings.fixed_point};
     const float change = sweep_dispatch(it, context);
     std::swap(messages_, next_);
     std::swap(moved_a, moved_b);
     uniform_ = false;
-    if (report.record(iteration, change, iteration > 1 ? settings.tolerance : 0.0f)) break;
+    const bool can_converge = settings.fixed_point ? !first : iteration > 1;
+    if (report.record(iteration, change, can_converge ? settings.tolerance : 0.0f)) break;
   }
   return report;
 }

@@ -35,6 +35,10 @@ struct BpSettings {
   int max_iterations = 30;
   float damping = 0.5f;  // new = (1 - damping) * update + damping * old
   float tolerance = 1e-3f;
+  // false (inference): stop on the beliefs and skip settled nodes, see above. true (the Bethe
+  // objective, whose value and gradient are only right at a fixed point): every node is updated
+  // in every iteration, and a run stops once no message moved more than the tolerance.
+  bool fixed_point = false;
 };
 
 struct BpRun {
@@ -71,7 +75,8 @@ class BeliefPropagation {
   void set_potentials(const BpPotentials& potentials);
 
   // Iterates until converged (see above) or settings.max_iterations. The first iteration of a
-  // run has no earlier belief under these potentials to compare with, so it never converges.
+  // run has no earlier belief under these potentials to compare with, so it never converges on
+  // beliefs; on messages (fixed_point), only the first one from the uniform start cannot.
   // Once context.stop is requested the run returns early with unusable messages; the caller
   // throws Cancelled.
   BpRun run(const BpSettings& settings, const RunContext& context);

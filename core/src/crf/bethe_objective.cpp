@@ -42,6 +42,8 @@ class BetheLikelihood final : public Objective {
   BetheLikelihood(const std::vector<PreparedScene>& scenes, const ParameterShape& shape,
                   const BpSettings& bp, const RunContext& context)
       : scenes_(scenes), shape_(shape), bp_(bp), context_(context), blocks_(node_blocks(scenes)) {
+    bp_.max_product = false;
+    bp_.fixed_point = true;
     for (const auto& s : scenes_) {
       auto state = std::make_unique<SceneBp>();
       number_edges(*s.graph, context_.threads, state->edge_of, state->block_first_edge,

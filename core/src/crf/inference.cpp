@@ -75,23 +75,6 @@ void outputs_from_rows(const float* rows, bool log_scores, const CrfModel& model
   barrier.rethrow();
 }
 
-// phi_i(k) = exp(theta_i(k) - max_k theta_i(k)), pads 0.
-void node_potentials_padded(const float* theta, std::size_t n, int k_count, int threads,
-                            float* phi) {
-  const int kp = detail::padded_classes(k_count);
-  const long long count = static_cast<long long>(n);
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (long long i = 0; i < count; ++i)
-    barrier.run([&] {
-      const Eigen::Map<const Eigen::ArrayXf> t(theta + i * kp, k_count);
-      Eigen::Map<Eigen::ArrayXf> out(phi + i * kp, kp);
-      out.head(k_count) = (t - t.maxCoeff()).exp();
-      out.tail(kp - k_count).setZero();
-    });
-  barrier.rethrow();
-}
-
 }  // namespace
 
 InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
@@ -156,7 +139,7 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
     detail::edge_terms_padded(model, descriptors, graph, ws.block_first_edge.data(), threads, true,
                               edge_terms, stop);
     float* phi = ws.phi.resize(n * kp);
-    node_potentials_padded(theta, n, k_count, threads, phi);
+    detail::node_potentials_padded(theta, n, k_count, threads, phi);
     ws.bp.reset({&graph, k_count, phi, edge_terms, ws.edge_of.data()});
     run = ws.bp.run(bp_settings, run_context);
     throw_if_stopped(stop, "inference");
