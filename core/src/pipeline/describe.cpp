@@ -39,14 +39,15 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   DescribedCloud out;
   // The index build checks the token itself (a 5M-point k-d tree takes about a second).
   out.search = std::make_unique<NeighborSearch>(cloud.xyz, context.stop);
+  // The stages' own progress counts (points, then twice the points for FPFH) would not add up to
+  // one describe call: only threads and stop go down.
+  const RunContext stage{context.threads, context.stop, {}};
 
   if (!options.use_cloud_normals) {
     const auto start = std::chrono::steady_clock::now();
     NormalOptions normal_options;
     normal_options.neighborhood = capped(settings.normals);
-    normal_options.threads = context.threads;
-    normal_options.stop = context.stop;
-    estimate_normals(cloud, normal_options, out.search.get());
+    estimate_normals(cloud, normal_options, stage, out.search.get());
     out.normal_seconds = seconds_since(start);
   }
 
@@ -54,11 +55,9 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   FeatureOptions feature_options;
   feature_options.neighborhood = capped(settings.features);
   feature_options.fpfh_variant = settings.fpfh_variant;
-  feature_options.threads = context.threads;
-  feature_options.stop = context.stop;
   const bool fpfh = settings.descriptor == DescriptorKind::kFpfh;
-  out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, nullptr, out.search.get())
-                         : compute_pfh(cloud, feature_options, nullptr, out.search.get());
+  out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, stage, nullptr, out.search.get())
+                         : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
   out.descriptor_dim = settings.descriptor_dim();
   out.feature_seconds = seconds_since(start);
   return out;
