@@ -360,7 +360,7 @@ void BeliefPropagation::beliefs(std::size_t node, std::span<double> out) const {
     std::fill_n(out.data(), k_count, std::numeric_limits<double>::quiet_NaN());
     return;
   }
-  std::vector<double> b(padded_classes(k_count));
+  std::array<double, kMaxBpClasses> b;  // padded_classes(K) <= kMaxBpClasses: no allocation
   product(node, b.data());
   normalise(b.data(), k_count, out.data(), 1);
 }
