@@ -165,22 +165,24 @@ int main(int argc, char** argv) {
     for (const int threads : args.threads) {
       for (const bool marginals : {false, true}) {
         for (const bool keep_workspace : {false, true}) {
-          InferenceOptions options;
+          InferenceSettings options;
           options.method = c.method;
           options.max_product = c.max_product;
-          options.compute_marginals = marginals;
-          options.threads = threads;
+          const InferenceOutputs outputs{.marginals = marginals};
+          const RunContext context{threads};
           const CrfModel& m = c.edges ? model : node_only;
           InferenceWorkspace workspace;
-          InferenceResult result = infer(m, scene.descriptors, scene.graph, options, workspace);
+          InferenceResult result =
+              infer(m, scene.descriptors, scene.graph, options, outputs, context, workspace);
           std::vector<double> ms, cpu_ms;
           for (int r = 0; r < args.repeat; ++r) {
             const double cpu_start = cpu_seconds();
             const auto start = std::chrono::steady_clock::now();
             if (keep_workspace) {
-              result = infer(m, scene.descriptors, scene.graph, options, workspace);
+              result =
+                  infer(m, scene.descriptors, scene.graph, options, outputs, context, workspace);
             } else {
-              result = infer(m, scene.descriptors, scene.graph, options);
+              result = infer(m, scene.descriptors, scene.graph, options, outputs, context);
             }
             ms.push_back(
                 1e3 *

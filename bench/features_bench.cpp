@@ -164,12 +164,14 @@ struct PfhRun {
 // the full cloud's mean pair count. The API computes every point of the cloud it is given, so a
 // query subset with full-cloud neighbourhoods cannot be timed directly.
 PfhRun run_pfh(const PointCloud& cloud, const NeighborSearch& search, const FeatureOptions& options,
-               const NeighborhoodSizes& full_sizes, double max_pairs, int repeat) {
+               const RunContext& context, const NeighborhoodSizes& full_sizes, double max_pairs,
+               int repeat) {
   PfhRun run;
   const double n = static_cast<double>(cloud.size());
   const double full_pairs = full_sizes.mean_pfh_pairs * n;
   if (full_pairs <= max_pairs) {
-    run.seconds = best_seconds(repeat, [&] { compute_pfh(cloud, options, &run.stats, &search); });
+    run.seconds =
+        best_seconds(repeat, [&] { compute_pfh(cloud, options, context, &run.stats, &search); });
     run.pts_s = n / run.seconds;
     run.timed_points = cloud.size();
     run.pairs_per_s = full_pairs / run.seconds;
@@ -188,8 +190,8 @@ PfhRun run_pfh(const PointCloud& cloud, const NeighborSearch& search, const Feat
   }
   thinned.width = static_cast<std::uint32_t>(thinned.xyz.size());
   const NeighborSearch thinned_search(thinned.xyz);
-  run.seconds =
-      best_seconds(repeat, [&] { compute_pfh(thinned, options, &run.stats, &thinned_search); });
+  run.seconds = best_seconds(
+      repeat, [&] { compute_pfh(thinned, options, context, &run.stats, &thinned_search); });
   const NeighborhoodSizes thinned_sizes = measure_neighborhoods(
       thinned, thinned_search, options.neighborhood, stride_sample(thinned.size(), thinned.size()));
   run.extrapolated = true;
@@ -388,10 +390,10 @@ int run_features_bench(const FeaturesBenchOptions& options) {
   NormalOptions normal_options;
   normal_options.neighborhood = *normal_hood;
   normal_options.viewpoint = viewpoint;
-  normal_options.threads = threads;
   NormalStats normal_stats;
-  const double normals_seconds = best_seconds(
-      options.repeat, [&] { normal_stats = estimate_normals(cloud, normal_options, &search); });
+  const double normals_seconds = best_seconds(options.repeat, [&] {
+    normal_stats = estimate_normals(cloud, normal_options, RunContext{threads}, &search);
+  });
   std::cerr << "  normals (" << describe(*normal_hood) << ", mean " << normal_sizes.mean_neighbors
             << " neighbours): " << rate(n, normals_seconds) << "; " << normal_stats.estimated
             << " estimated, " << normal_stats.too_few << " with too few neighbours; peak RSS "
@@ -402,14 +404,14 @@ int run_features_bench(const FeaturesBenchOptions& options) {
       measure_neighborhoods(cloud, search, *feature_hood, sample);
   FeatureOptions feature_options;
   feature_options.neighborhood = *feature_hood;
-  feature_options.threads = threads;
 
   std::vector<float> fpfh;
   FeatureStats fpfh_stats;
   double fpfh_seconds = std::numeric_limits<double>::quiet_NaN();
   if (run_fpfh) {
-    fpfh_seconds = best_seconds(
-        options.repeat, [&] { fpfh = compute_fpfh(cloud, feature_options, &fpfh_stats, &search); });
+    fpfh_seconds = best_seconds(options.repeat, [&] {
+      fpfh = compute_fpfh(cloud, feature_options, RunContext{threads}, &fpfh_stats, &search);
+    });
     std::cerr << "  FPFH (" << describe(*feature_hood) << ", mean " << feature_sizes.mean_neighbors
               << " neighbours): " << rate(n, fpfh_seconds) << "; " << fpfh_stats.nan << " NaN, "
               << fpfh_stats.isolated << " isolated (all-zero) descriptors; peak RSS "
@@ -418,8 +420,8 @@ int run_features_bench(const FeaturesBenchOptions& options) {
 
   std::optional<PfhRun> pfh;
   if (run_pfh_stage) {
-    pfh = run_pfh(cloud, search, feature_options, feature_sizes, options.pfh_max_pairs,
-                  options.repeat);
+    pfh = run_pfh(cloud, search, feature_options, RunContext{threads}, feature_sizes,
+                  options.pfh_max_pairs, options.repeat);
     std::cerr << "  PFH (" << describe(*feature_hood) << "): " << pfh->pts_s << " pts/s"
               << (pfh->extrapolated ? " (extrapolated, see above)" : "") << "; " << pfh->stats.nan
               << " NaN, " << pfh->stats.isolated

@@ -53,13 +53,13 @@ struct Row {
 
 LabelModel quick_model(synth::SensorKind sensor) {
   const FeatureSettings features;
-  const crf::GraphOptions graph;
+  const crf::GraphSettings graph;
   std::vector<std::uint32_t> every_class;
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
   std::vector<pipeline::SceneData> train;
   train.push_back(
       pipeline::prepare_scene(synth::synthetic_scene(synth::SceneSet::kTrain, 0, sensor),
-                              "train", features, graph, every_class, 0));
+                              "train", features, graph, every_class));
   const auto class_ids = pipeline::classes_present(train);
   pipeline::assign_labels(train.front(), class_ids);
   pipeline::ModelTrainingOptions options;
@@ -79,10 +79,9 @@ Row measure(const LabelModel& model, const PointCloud& scene, int threads, int r
   best.total_s = std::numeric_limits<double>::infinity();
   for (int r = 0; r < repeat; ++r) {
     PointCloud cloud = scene;  // label_cloud writes normals into it
-    pipeline::LabelingOptions options;
-    options.threads = threads;
     const auto start = std::chrono::steady_clock::now();
-    const pipeline::LabelingResult result = pipeline::label_cloud(model, cloud, options);
+    const pipeline::LabelingResult result =
+        pipeline::label_cloud(model, cloud, {}, RunContext{threads});
     const double total =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (total < best.total_s) {
@@ -115,12 +114,10 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 // Stop latencies (ms) of `stops` runs, each stopped at a uniformly random moment of a full run.
 std::vector<double> stop_latencies(const LabelModel& model, const PointCloud& input, int threads,
                                    int stops, double& full_s) {
-  pipeline::LabelingOptions options;
-  options.threads = threads;
   {
     PointCloud cloud = input;
     const auto start = std::chrono::steady_clock::now();
-    pipeline::label_cloud(model, cloud, options);
+    pipeline::label_cloud(model, cloud, {}, RunContext{threads});
     full_s = seconds_since(start);
   }
   std::mt19937 rng(17);
@@ -129,7 +126,7 @@ std::vector<double> stop_latencies(const LabelModel& model, const PointCloud& in
   for (int s = 0; s < stops; ++s) {
     PointCloud cloud = input;
     std::stop_source source;
-    options.stop = source.get_token();
+    const RunContext context{threads, source.get_token()};
     const double at = moment(rng);
     std::chrono::steady_clock::time_point stopped{};
     std::jthread stopper([&] {
@@ -139,7 +136,7 @@ std::vector<double> stop_latencies(const LabelModel& model, const PointCloud& in
     });
     bool cancelled = false;
     try {
-      pipeline::label_cloud(model, cloud, options);
+      pipeline::label_cloud(model, cloud, {}, context);
     } catch (const Cancelled&) {
       cancelled = true;
     }

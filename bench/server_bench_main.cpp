@@ -129,13 +129,12 @@ struct Latency {
 Latency compare(const char* name, const LabelModel& model, const PointCloud& cloud,
                 v1::Labeler::Stub& stub, int reps, int threads) {
   Latency latency;
-  pipeline::LabelingOptions options;
-  options.threads = threads;
+  const RunContext context{threads};
   std::vector<std::uint32_t> reference;
   for (int rep = -1; rep < reps; ++rep) {  // rep -1 warms both paths up
     PointCloud copy = cloud;
     auto start = Clock::now();
-    reference = pipeline::label_cloud(model, copy, options).labels;
+    reference = pipeline::label_cloud(model, copy, {}, context).labels;
     const double local = ms_since(start);
     start = Clock::now();
     const std::vector<std::uint32_t> labels = label_over_grpc(stub, cloud);
@@ -245,9 +244,7 @@ int main(int argc, char** argv) {
     for (int after_ms : cancel_at) {
       PointCloud copy = big;
       std::stop_source stop;
-      pipeline::LabelingOptions options;
-      options.threads = threads;
-      options.stop = stop.get_token();
+      const RunContext context{threads, stop.get_token()};
       Clock::time_point requested{};
       std::jthread stopper([&] {
         std::this_thread::sleep_for(std::chrono::milliseconds(after_ms));
@@ -255,7 +252,7 @@ int main(int argc, char** argv) {
         stop.request_stop();
       });
       try {
-        pipeline::label_cloud(model, copy, options);
+        pipeline::label_cloud(model, copy, {}, context);
         std::printf("cancel  in-process after %5d ms: finished before the stop\n", after_ms);
       } catch (const pipeline::Cancelled& e) {
         local_stop_ms.push_back(ms_since(requested));

@@ -45,8 +45,8 @@ json::Json number(double v) { return json::rounded(v, "%.4g"); }
 
 int run(const Arguments& args) {
   std::vector<Row> rows;
-  TabletopOptions options;
-  options.threads = args.threads;
+  const TabletopOptions options;
+  const RunContext context{args.threads};
   for (const std::string& path : args.inputs) {
     const PointCloud cloud = read_cloud(path);
     Row row;
@@ -55,7 +55,7 @@ int run(const Arguments& args) {
     TabletopResult result;
     row.ours_ms = std::numeric_limits<double>::infinity();
     for (int r = 0; r < args.repeat; ++r) {
-      result = segment_tabletop(cloud, options);
+      result = segment_tabletop(cloud, options, context);
       row.ours_ms = std::min(row.ours_ms, result.timings.total_ms);
     }
     if (!result.ok()) {

@@ -12,20 +12,20 @@ namespace primlabel::testing {
 
 inline LabelModel train_small_svm_model() {
   const FeatureSettings features;
-  const crf::GraphOptions graph;
+  const crf::GraphSettings graph;
   std::vector<std::uint32_t> every_class;
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
   std::vector<pipeline::SceneData> train;
   train.push_back(pipeline::prepare_scene(
       synth::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
-      features, graph, every_class, 2));
+      features, graph, every_class, RunContext{2}));
   const auto class_ids = pipeline::classes_present(train);
   pipeline::assign_labels(train.front(), class_ids);
   pipeline::ModelTrainingOptions options;
   options.kind = ModelKind::kSvm;
   options.svm.max_training_points = 1500;
-  options.threads = 2;
-  return pipeline::train_label_model(train, {}, class_ids, features, graph, options).model;
+  return pipeline::train_label_model(train, {}, class_ids, features, graph, options, RunContext{2})
+      .model;
 }
 
 }  // namespace primlabel::testing

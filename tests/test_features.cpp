@@ -141,7 +141,7 @@ TEST(Fpfh, SubHistogramsSumTo100AndThePaperVariantAddsTheOwnSpfh) {
   FeatureOptions options;
   options.neighborhood = Neighborhood::Radius(0.02f);
   FeatureStats stats;
-  const auto pcl = compute_fpfh(cloud, options, &stats);
+  const auto pcl = compute_fpfh(cloud, options, {}, &stats);
   EXPECT_EQ(stats.computed, cloud.size());
   EXPECT_EQ(stats.nan, 0u);
   options.fpfh_variant = FpfhVariant::kWithOwnSpfh;
@@ -184,7 +184,7 @@ TEST(Features, InvalidPointsAndNormalsAreNaNAndLeftOutOfNeighbourhoods) {
   FeatureOptions options;
   options.neighborhood = Neighborhood::Radius(0.02f);
   FeatureStats stats;
-  const auto with_gaps = compute_fpfh(cloud, options, &stats);
+  const auto with_gaps = compute_fpfh(cloud, options, {}, &stats);
   EXPECT_EQ(stats.nan, 2u);
   EXPECT_EQ(stats.isolated, 1u);
   EXPECT_EQ(stats.computed, cloud.size() - 3);
@@ -203,7 +203,7 @@ TEST(Features, InvalidPointsAndNormalsAreNaNAndLeftOutOfNeighbourhoods) {
       ASSERT_NEAR(with_gaps[i * kFpfhSize + b], removed[i * kFpfhSize + b], 1e-4f);
   }
   FeatureStats pfh_stats;
-  const auto pfh = compute_pfh(cloud, options, &pfh_stats);
+  const auto pfh = compute_pfh(cloud, options, {}, &pfh_stats);
   EXPECT_EQ(pfh_stats.nan, 2u);
   EXPECT_EQ(pfh_stats.isolated, 1u);
   EXPECT_TRUE(std::isnan(pfh[broken_normal * kPfhSize]));
@@ -229,10 +229,10 @@ TEST(Features, IdenticalForAnyThreadCount) {
   for (int threads : {1, 2, 3}) {
     FeatureOptions options;
     options.neighborhood = Neighborhood::Radius(0.012f);
-    options.threads = threads;
-    const auto fpfh = compute_fpfh(cloud, options);
+    const RunContext context{threads};
+    const auto fpfh = compute_fpfh(cloud, options, context);
     options.neighborhood = Neighborhood::Knn(8);
-    const auto pfh = compute_pfh(cloud, options);
+    const auto pfh = compute_pfh(cloud, options, context);
     if (fpfh_reference.empty()) {
       fpfh_reference = fpfh;
       pfh_reference = pfh;

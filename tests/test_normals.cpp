@@ -92,8 +92,7 @@ TEST(Normals, IdenticalForAnyThreadCount) {
   for (int threads : {1, 2, 3, 4}) {
     NormalOptions options;
     options.neighborhood = Neighborhood::Radius(0.02f);
-    options.threads = threads;
-    estimate_normals(cloud, options);
+    estimate_normals(cloud, options, RunContext{threads});
     if (reference.empty()) {
       reference = cloud.normals;
       continue;

@@ -16,7 +16,7 @@ namespace {
 TEST(Parallel, AnExceptionInABlockIsRethrownAfterTheRegion) {
   std::atomic<int> ran{0};
   const auto make_scratch = [] { return 0; };
-  EXPECT_THROW(detail::for_each_block(2, 10000, {}, make_scratch,
+  EXPECT_THROW(detail::for_each_block(10000, RunContext{2}, make_scratch,
                                       [&](int&, std::ptrdiff_t block) {
                                         ++ran;
                                         if (block == 3) throw std::runtime_error("block 3");
@@ -27,8 +27,9 @@ TEST(Parallel, AnExceptionInABlockIsRethrownAfterTheRegion) {
 
 TEST(Parallel, AFailingScratchIsAnExceptionToo) {
   const auto make_scratch = []() -> int { throw std::bad_alloc(); };
-  EXPECT_THROW(detail::for_each_block(2, 100, {}, make_scratch, [](int&, std::ptrdiff_t) {}),
-               std::bad_alloc);
+  EXPECT_THROW(
+      detail::for_each_block(100, RunContext{2}, make_scratch, [](int&, std::ptrdiff_t) {}),
+      std::bad_alloc);
 }
 
 TEST(Parallel, TheBarrierKeepsTheFirstException) {
@@ -51,21 +52,19 @@ PointCloud grid_cloud() {
 // A progress callback runs inside the parallel loops: what it throws reaches the caller.
 TEST(Parallel, AThrowingProgressCallbackBecomesAnExceptionOfTheCall) {
   PointCloud cloud = grid_cloud();
-  NormalOptions normals;
-  normals.threads = 2;
-  normals.progress = [](std::size_t done, std::size_t) {
+  const NormalOptions normals;
+  RunContext context{2};
+  context.progress = [](std::size_t done, std::size_t) {
     if (done < 10000) throw std::runtime_error("progress says no");
   };
-  EXPECT_THROW(estimate_normals(cloud, normals), std::runtime_error);
-  normals.progress = {};
-  estimate_normals(cloud, normals);
-  FeatureOptions features;
-  features.threads = 2;
-  features.progress = normals.progress = [](std::size_t done, std::size_t) {
+  EXPECT_THROW(estimate_normals(cloud, normals, context), std::runtime_error);
+  estimate_normals(cloud, normals, RunContext{2});
+  const FeatureOptions features;
+  context.progress = [](std::size_t done, std::size_t) {
     if (done < 20000) throw std::runtime_error("progress says no");
   };
-  EXPECT_THROW(compute_fpfh(cloud, features), std::runtime_error);
-  EXPECT_THROW(compute_pfh(cloud, features), std::runtime_error);
+  EXPECT_THROW(compute_fpfh(cloud, features, context), std::runtime_error);
+  EXPECT_THROW(compute_pfh(cloud, features, context), std::runtime_error);
 }
 
 }  // namespace

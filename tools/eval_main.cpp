@@ -115,9 +115,9 @@ int evaluate_files(const Arguments& args) {
     if (scored)  // the labels as taxonomy ids (through the file's or the given class map)
       cloud = args.classes.empty() ? load_labeled_cloud(path) : load_labeled_cloud(path, map);
     pipeline::LabelingOptions options;
-    options.threads = args.threads;
     options.tabletop_only = args.tabletop_only;
-    const pipeline::LabelingResult result = pipeline::label_cloud(model, cloud, options);
+    const pipeline::LabelingResult result =
+        pipeline::label_cloud(model, cloud, options, RunContext{args.threads});
     if (!args.quiet)
       std::fprintf(stderr, "%s: %zu points, features %.2f s, inference %.2f s\n", path.c_str(),
                    cloud.size(), result.feature_seconds, result.inference_seconds);
@@ -169,14 +169,14 @@ int mosd_report(const Arguments& args) {
   std::filesystem::create_directories(args.mosd_dir, ec);
   if (ec) throw std::runtime_error(args.mosd_dir + ": cannot be created (" + ec.message() + ")");
   pipeline::LabelingOptions options;
-  options.threads = args.threads;
   options.tabletop_only = args.tabletop_only;
+  const RunContext context{args.threads};
   std::vector<research::MosdSceneReport> scenes;
   for (const std::string& path : args.files) {
     const std::string png = (std::filesystem::path(args.mosd_dir) /
                              (std::filesystem::path(path).stem().string() + "_labels.png"))
                                 .string();
-    scenes.push_back(research::report_mosd_scene(model, path, png, options));
+    scenes.push_back(research::report_mosd_scene(model, path, png, options, context));
     if (!args.quiet)
       std::fprintf(stderr, "%s: %.2f%% of %llu table points plane, wrote %s\n", path.c_str(),
                    100.0 * scenes.back().plane_share(),

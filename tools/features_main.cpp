@@ -62,9 +62,8 @@ int run(const Arguments& args) {
     options.neighborhood =
         neighborhood_of(args.normal_k, args.normal_radius, args.max_neighbors, 10);
     if (!args.viewpoint.empty()) options.viewpoint = cli::parse_vec3(args.viewpoint);
-    options.threads = args.threads;
-    options.progress = progress.stage("normals");
-    const NormalStats stats = estimate_normals(cloud, options, &search);
+    const NormalStats stats = estimate_normals(
+        cloud, options, RunContext{args.threads, {}, progress.stage("normals")}, &search);
     progress.done();
     if (!args.quiet)
       std::fprintf(stderr, "normals: %zu estimated, %zu with too few neighbours (NaN), %.2f s\n",
@@ -75,13 +74,12 @@ int run(const Arguments& args) {
   options.neighborhood =
       neighborhood_of(args.feature_k, args.feature_radius, args.max_neighbors, 10);
   options.fpfh_variant = args.variant == "paper" ? FpfhVariant::kWithOwnSpfh : FpfhVariant::kPcl;
-  options.threads = args.threads;
-  options.progress = progress.stage(args.descriptor);
+  const RunContext context{args.threads, {}, progress.stage(args.descriptor)};
   const auto features_start = std::chrono::steady_clock::now();
   FeatureStats stats;
   const bool fpfh = args.descriptor == "fpfh";
-  std::vector<float> values = fpfh ? compute_fpfh(cloud, options, &stats, &search)
-                                   : compute_pfh(cloud, options, &stats, &search);
+  std::vector<float> values = fpfh ? compute_fpfh(cloud, options, context, &stats, &search)
+                                   : compute_pfh(cloud, options, context, &stats, &search);
   progress.done();
   const double feature_seconds = seconds_since(features_start);
   FloatField& field = cloud.set_field(args.descriptor, fpfh ? kFpfhSize : kPfhSize);

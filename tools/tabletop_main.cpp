@@ -27,6 +27,7 @@ struct Arguments {
   std::string input, png, up, view = "oblique";
   bool eval = false, json = false, up_from_sensor = false, quiet = false;
   TabletopOptions options;
+  int threads = 0;
 };
 
 constexpr std::uint32_t kTableColour = 0x4C72B0;
@@ -75,7 +76,7 @@ int run(const Arguments& args) {
                  args.input.c_str());
     return cli::kExitFailure;
   }
-  const TabletopResult result = segment_tabletop(cloud, args.options);
+  const TabletopResult result = segment_tabletop(cloud, args.options, RunContext{args.threads});
   const std::string name = std::filesystem::path(args.input).filename().string();
 
   json::Json report = {{"file", args.input},
@@ -187,7 +188,7 @@ int main(int argc, char** argv) {
   app.add_option("--voxel-leaf", o.voxel_leaf, "fit and cluster on voxel centroids (m; 0 = off)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--seed", o.seed, "RANSAC seed");
-  app.add_option("--threads", o.threads, "worker threads")
+  app.add_option("--threads", args.threads, "worker threads")
       ->check(CLI::PositiveNumber)
       ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no summary lines (the JSON line stays)");

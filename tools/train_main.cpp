@@ -43,7 +43,7 @@ void say(const Arguments& args, const std::string& line) {
 
 std::vector<pipeline::SceneData> load_scenes(const Arguments& args, bool validation,
                                              const FeatureSettings& features,
-                                             const crf::GraphOptions& graph) {
+                                             const crf::GraphSettings& graph) {
   const std::vector<std::uint32_t> every_class = [] {
     std::vector<std::uint32_t> ids;
     for (PrimitiveClass c : all_classes()) ids.push_back(class_id(c));
@@ -53,7 +53,7 @@ std::vector<pipeline::SceneData> load_scenes(const Arguments& args, bool validat
   auto add = [&](PointCloud cloud, const std::string& source) {
     const auto start = std::chrono::steady_clock::now();
     scenes.push_back(pipeline::prepare_scene(std::move(cloud), source, features, graph, every_class,
-                                             args.threads));
+                                             RunContext{args.threads}));
     const double s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     char line[512];
@@ -86,7 +86,7 @@ int run(const Arguments& args) {
       args.fpfh_variant == "paper" ? FpfhVariant::kWithOwnSpfh : FpfhVariant::kPcl;
   features.normals = Neighborhood::Radius(args.normal_radius);
   features.features = Neighborhood::Radius(args.feature_radius);
-  crf::GraphOptions graph;
+  crf::GraphSettings graph;
   graph.neighborhood = Neighborhood::Knn(args.graph_k);
 
   std::vector<pipeline::SceneData> train = load_scenes(args, false, features, graph);
@@ -115,7 +115,6 @@ int run(const Arguments& args) {
   options.l2 = args.l2;
   options.iterations = args.iterations;
   options.node_knots = args.node_knots;
-  options.threads = args.threads;
   std::vector<crf::TrainingIteration> curve;
   if (options.kind != ModelKind::kSvm && (!args.curve_csv.empty() || !args.curve_png.empty()))
     options.on_iteration = [&](const crf::TrainingIteration& it) {
@@ -131,8 +130,8 @@ int run(const Arguments& args) {
                  : options.kind == ModelKind::kSvm    ? std::string("libsvm RBF")
                                                       : args.objective) +
                 ")...");
-  pipeline::ModelTrainingResult trained =
-      pipeline::train_label_model(train, val, class_ids, features, graph, options);
+  pipeline::ModelTrainingResult trained = pipeline::train_label_model(
+      train, val, class_ids, features, graph, options, RunContext{args.threads});
   LabelModel& model = trained.model;
   if (options.kind != ModelKind::kNodeOnly) say(args, model.training.objective);
   if (!args.name.empty()) model.name = args.name;

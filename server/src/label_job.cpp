@@ -43,13 +43,10 @@ std::uint64_t answer_bytes_per_point(const LabelPlan& plan) {
 }
 
 std::optional<ServiceError> run_label_job(const LabelPlan& plan, PointCloud& cloud,
-                                          std::stop_token stop, int threads,
+                                          const RunContext& context,
                                           pipeline::LabelingResult& result) {
-  pipeline::LabelingOptions options = plan.options;
-  options.stop = std::move(stop);
-  options.threads = threads;
   try {
-    result = pipeline::label_cloud(*plan.entry->model, cloud, options);
+    result = pipeline::label_cloud(*plan.entry->model, cloud, plan.options, context);
     return std::nullopt;
   } catch (const pipeline::Cancelled&) {
     return ServiceError{ErrorCode::kCancelled, "labeling was cancelled"};

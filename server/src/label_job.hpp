@@ -30,9 +30,9 @@ std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelReg
 // before labeling.
 std::uint64_t answer_bytes_per_point(const LabelPlan& plan);
 
-// Runs label_cloud; never throws. CANCELLED when `stop` was requested.
+// Runs label_cloud; never throws. CANCELLED when context.stop was requested.
 std::optional<ServiceError> run_label_job(const LabelPlan& plan, PointCloud& cloud,
-                                          std::stop_token stop, int threads,
+                                          const RunContext& context,
                                           pipeline::LabelingResult& result);
 
 // RESOURCE_EXHAUSTED naming the limits, for a request refused for lack of a compute slot.

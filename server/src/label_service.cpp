@@ -75,7 +75,8 @@ std::optional<ServiceError> LabelSession::run(std::function<void()> done) {
   if (!ticket_) return server_busy(*env_.admission);
   const int threads = env_.threads_per_job;
   job_ = env_.admission->submit(*ticket_, [this, threads, done = std::move(done)] {
-    job_error_ = run_label_job(plan_, assembler_->cloud(), stop_.get_token(), threads, result_);
+    job_error_ =
+        run_label_job(plan_, assembler_->cloud(), RunContext{threads, stop_.get_token()}, result_);
     // The compute slot and the points go as soon as the result exists, not when it is sent.
     const std::uint64_t points = assembler_->points();
     assembler_->cloud() = PointCloud{};

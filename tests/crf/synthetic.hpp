@@ -58,7 +58,7 @@ inline LabeledGraph make_grid_scene(const SceneSpec& spec,
             std::max(0.0f, prototypes[std::size_t(label) * spec.dim + f] + noise(rng));
     }
   }
-  GraphOptions options;
+  GraphSettings options;
   options.neighborhood = Neighborhood::Knn(spec.neighbors);
   scene.graph = build_graph(points, scene.descriptors, spec.dim, options);
   if (points_out) *points_out = std::move(points);

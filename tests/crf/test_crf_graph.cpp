@@ -43,7 +43,7 @@ void expect_well_formed(const Graph& g) {
 TEST(CrfGraph, KnnIsSymmetricWithoutSelfLoops) {
   const auto points = line_points(50);
   const std::vector<float> descriptors(50 * 2, 1.0f);
-  GraphOptions options;
+  GraphSettings options;
   options.neighborhood = Neighborhood::Knn(4);
   const Graph g = build_graph(points, descriptors, 2, options);
   expect_well_formed(g);
@@ -57,7 +57,7 @@ TEST(CrfGraph, KnnIsSymmetricWithoutSelfLoops) {
 TEST(CrfGraph, RadiusAndHybrid) {
   const auto points = line_points(30);
   const std::vector<float> descriptors(30, 0.0f);  // all-zero descriptors are valid
-  GraphOptions options;
+  GraphSettings options;
   options.neighborhood = Neighborhood::Radius(1.5f);
   const Graph g = build_graph(points, descriptors, 1, options);
   expect_well_formed(g);
@@ -74,7 +74,7 @@ TEST(CrfGraph, InvalidPointsAreInactiveAndIsolated) {
   std::vector<float> descriptors(20 * 3, 5.0f);
   descriptors[4 * 3 + 1] = std::nanf("");
   points[9] = Vec3f::Constant(std::nanf(""));
-  GraphOptions options;
+  GraphSettings options;
   options.neighborhood = Neighborhood::Knn(2);
   const Graph g = build_graph(points, descriptors, 3, options);
   expect_well_formed(g);
@@ -90,13 +90,11 @@ TEST(CrfGraph, DeterministicForAnyThreadsAndWithOrWithoutSearch) {
   for (int i = 0; i < 2000; ++i)
     points.emplace_back(std::sin(0.37f * i) * 3.0f, std::cos(0.11f * i) * 2.0f, 0.001f * i);
   const std::vector<float> descriptors(points.size() * 2, 1.0f);
-  GraphOptions options;
-  options.threads = 1;
-  const Graph one = build_graph(points, descriptors, 2, options);
-  options.threads = 2;
-  const Graph two = build_graph(points, descriptors, 2, options);
+  const GraphSettings options;
+  const Graph one = build_graph(points, descriptors, 2, options, RunContext{1});
+  const Graph two = build_graph(points, descriptors, 2, options, RunContext{2});
   const NeighborSearch search(points);
-  const Graph reused = build_graph(points, descriptors, 2, options, &search);
+  const Graph reused = build_graph(points, descriptors, 2, options, RunContext{2}, &search);
   expect_well_formed(one);
   EXPECT_EQ(one.offsets, two.offsets);
   EXPECT_EQ(one.neighbors, two.neighbors);
@@ -193,13 +191,14 @@ TEST(CrfGraphCancellation, AStoppedTokenCancelsTheBuild) {
   const NeighborSearch search(finite);
   std::stop_source source;
   source.request_stop();
-  GraphOptions options;
-  options.stop = source.get_token();
+  GraphSettings options;
+  RunContext context;
+  context.stop = source.get_token();
   for (const Neighborhood& hood : {Neighborhood::Knn(8), Neighborhood::Radius(0.05f)}) {
     options.neighborhood = hood;
     // Its own index over the valid points, and the shared index.
-    EXPECT_THROW(build_graph(patch.points, patch.descriptors, 2, options), Cancelled);
-    EXPECT_THROW(build_graph(finite, all_valid, 2, options, &search), Cancelled);
+    EXPECT_THROW(build_graph(patch.points, patch.descriptors, 2, options, context), Cancelled);
+    EXPECT_THROW(build_graph(finite, all_valid, 2, options, context, &search), Cancelled);
   }
 }
 
@@ -209,15 +208,12 @@ TEST(CrfGraphCancellation, ANeverStoppedTokenGivesTheSameGraph) {
   for (const Neighborhood& hood :
        {Neighborhood::Knn(8), Neighborhood::Radius(0.05f), Neighborhood::Hybrid(0.05f, 6)}) {
     const auto expected = brute_force_rows(patch, hood);
-    GraphOptions plain;
+    GraphSettings plain;
     plain.neighborhood = hood;
-    plain.threads = 1;
-    const Graph reference = build_graph(patch.points, patch.descriptors, 2, plain);
+    const Graph reference = build_graph(patch.points, patch.descriptors, 2, plain, RunContext{1});
     for (int threads : {1, 3}) {
-      GraphOptions options = plain;
-      options.threads = threads;
-      options.stop = never.get_token();
-      const Graph g = build_graph(patch.points, patch.descriptors, 2, options);
+      const RunContext context{threads, never.get_token()};
+      const Graph g = build_graph(patch.points, patch.descriptors, 2, plain, context);
       expect_well_formed(g);
       ASSERT_EQ(g.num_nodes(), expected.size());
       for (std::size_t i = 0; i < expected.size(); ++i)

@@ -60,12 +60,12 @@ TEST(CrfInference, Speed70k) {
   const std::size_t n = scene.graph.num_nodes();
   std::printf("graph: %zu nodes, %zu edges\n", n, scene.graph.num_edges());
   for (const auto& [method, max_product] : kMethods) {
-    InferenceOptions options;
+    InferenceSettings options;
     options.method = method;
     options.max_product = max_product;
-    options.threads = 2;
     const auto start = std::chrono::steady_clock::now();
-    const InferenceResult result = infer(model, scene.descriptors, scene.graph, options);
+    const InferenceResult result =
+        infer(model, scene.descriptors, scene.graph, options, {}, RunContext{2});
     const double s = seconds_since(start);
     std::printf("%-10s %-11s %6.1f ms  %9.0f points/s  %2d iterations%s  accuracy %.3f\n",
                 method == InferenceMethod::kLoopyBp ? "loopy-bp" : "mean-field",
@@ -110,12 +110,13 @@ TinyProblem tiny_problem(std::size_t n,
 // Loopy BP to a tight fixed point, to be compared with the brute-force answer: sum-product with
 // marginals, or max-product labels.
 InferenceResult infer_tightly(const TinyProblem& t, bool max_product) {
-  InferenceOptions options;
+  InferenceSettings options;
   options.max_product = max_product;
-  options.compute_marginals = !max_product;
   options.max_iterations = 200;
   options.tolerance = 1e-7f;
-  return infer(t.model, t.descriptors, t.graph, options);
+  InferenceOutputs outputs;
+  outputs.marginals = !max_product;
+  return infer(t.model, t.descriptors, t.graph, options, outputs);
 }
 
 const std::vector<std::pair<std::uint32_t, std::uint32_t>> kTree = {{0, 1}, {1, 2}, {1, 3},
@@ -162,16 +163,16 @@ TEST(CrfInference, SameResultForAnyThreadCount) {
   const CrfModel model = testing::prototype_model(spec, 3.0f, 0.8f);
   for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
     for (const bool max_product : {false, true}) {
-      InferenceOptions options;
+      InferenceSettings options;
       options.method = method;
       options.max_product = max_product;
-      options.compute_marginals = true;
       options.max_iterations = 15;
-      options.threads = 1;
-      const InferenceResult one = infer(model, scene.descriptors, scene.graph, options);
+      const InferenceOutputs outputs{.marginals = true};
+      const InferenceResult one =
+          infer(model, scene.descriptors, scene.graph, options, outputs, RunContext{1});
       for (int threads : {2, 3}) {
-        options.threads = threads;
-        const InferenceResult many = infer(model, scene.descriptors, scene.graph, options);
+        const InferenceResult many =
+            infer(model, scene.descriptors, scene.graph, options, outputs, RunContext{threads});
         EXPECT_EQ(one.labels, many.labels);
         EXPECT_EQ(one.iterations, many.iterations);
         EXPECT_TRUE(one.marginals.cwiseEqual(many.marginals).all());
@@ -198,14 +199,15 @@ TEST(CrfInference, WorkspaceReuseGivesIdenticalResults) {
   for (const LabeledGraph* scene : {&big_scene, &small_scene}) {
     for (const auto& [method, max_product] : kMethods) {
       for (const int threads : {1, 2}) {
-        InferenceOptions options;
+        InferenceSettings options;
         options.method = method;
         options.max_product = max_product;
-        options.compute_marginals = true;
-        options.threads = threads;
-        const InferenceResult fresh = infer(model, scene->descriptors, scene->graph, options);
+        const InferenceOutputs outputs{.marginals = true};
+        const RunContext context{threads};
+        const InferenceResult fresh =
+            infer(model, scene->descriptors, scene->graph, options, outputs, context);
         const InferenceResult kept =
-            infer(model, scene->descriptors, scene->graph, options, workspace);
+            infer(model, scene->descriptors, scene->graph, options, outputs, context, workspace);
         EXPECT_EQ(fresh.labels, kept.labels);
         EXPECT_EQ(fresh.iterations, kept.iterations);
         EXPECT_TRUE(fresh.marginals.cwiseEqual(kept.marginals).all());
@@ -223,7 +225,7 @@ TEST(CrfInference, DefaultStoppingKeepsAccuracy) {
   const auto [scene, model] = noisy_scene(120, 90, 6);
   const double plain = accuracy(infer_node_only(model, scene), scene);
   for (const auto& [method, max_product] : kMethods) {
-    InferenceOptions options;
+    InferenceSettings options;
     options.method = method;
     options.max_product = max_product;
     const InferenceResult quick = infer(model, scene.descriptors, scene.graph, options);
@@ -253,11 +255,10 @@ TEST(CrfInference, PointsWithoutDescriptorGetTheUnknownLabel) {
   const Graph graph = build_graph(points, scene.descriptors, spec.dim);
   const CrfModel model = testing::prototype_model(spec, 3.0f, 1.0f);
   for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
-    InferenceOptions options;
+    InferenceSettings options;
     options.method = method;
-    options.unknown_label = 99;
-    options.compute_marginals = true;
-    const InferenceResult r = infer(model, scene.descriptors, graph, options);
+    const InferenceOutputs outputs{.marginals = true, .unknown_label = 99};
+    const InferenceResult r = infer(model, scene.descriptors, graph, options, outputs);
     for (std::size_t i = 0; i < r.labels.size(); ++i) {
       const bool invalid = i == 0 || i == 57 || i == 222 || i == 300;
       if (invalid) {

@@ -5,7 +5,9 @@
 #include <zlib.h>
 
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/model/label_model.hpp"
@@ -104,6 +106,28 @@ TEST(LabelModel, SavesAtomicallyWithoutASharedTemporaryName) {
     EXPECT_NE(std::string(e.what()).find(dir.file("busy")), std::string::npos) << e.what();
   }
   EXPECT_TRUE(std::filesystem::is_directory(dir.file("busy/inside")));
+}
+
+// A file written before the persisted settings were split from the run state (by
+// write_fixture at commit a9ed7c5, when LabelModel held InferenceOptions / GraphOptions with
+// threads and stop tokens) loads into GraphSettings / InferenceSettings and serialises back to the
+// same bytes: the file format did not change.
+TEST(LabelModel, AFileWrittenBeforeTheRunContextLoadsUnchanged) {
+  const std::string path = test::test_data("models/crf_before_run_context.plm");
+  const LabelModel m = load_model(path);
+  EXPECT_EQ(m.name, "written-before-run-context");
+  EXPECT_EQ(m.graph.neighborhood.radius, 0.03f);
+  EXPECT_EQ(m.graph.neighborhood.max_neighbors, 12);
+  EXPECT_EQ(m.inference.method, crf::InferenceMethod::kMeanField);
+  EXPECT_TRUE(m.inference.max_product);
+  EXPECT_EQ(m.inference.max_iterations, 17);
+  EXPECT_EQ(m.inference.damping, 0.25f);
+  EXPECT_EQ(m.inference.tolerance, 1e-4f);
+  EXPECT_EQ(m.weights.node_weights(1, 2), 0.01f * float((37 + 22) % 23) - 0.1f);
+  EXPECT_EQ(m.weights.edge_weights(2, 4), 0.002f * float((10 + 12) % 7));
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  EXPECT_EQ(serialize_model(m), bytes);
 }
 
 TEST(LabelModel, NodeOnlyAndSvmRoundTrip) {

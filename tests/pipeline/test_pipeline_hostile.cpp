@@ -54,9 +54,8 @@ PointCloud packed_cube_cloud(std::size_t points) {
   return with_points(distinct_table(), cube);
 }
 
-LabelingOptions all_outputs(int threads = 2) {
+LabelingOptions all_outputs() {
   LabelingOptions options;
-  options.threads = threads;
   options.want_probabilities = true;
   options.want_descriptors = true;
   return options;
@@ -81,7 +80,8 @@ TEST(PipelineHostile, FarPointsAmongANormalScanLabelWithoutThrowing) {
     PointCloud cloud = with_points(normal, {Vec3f(far, far, far), Vec3f(-far, 0.0f, 0.0f),
                                             Vec3f(0.0f, far, -far), Vec3f(far, far, far)});
     LabelingResult result;
-    ASSERT_NO_THROW(result = pipeline::label_cloud(model, cloud, all_outputs())) << far;
+    ASSERT_NO_THROW(result = pipeline::label_cloud(model, cloud, all_outputs(), RunContext{2}))
+        << far;
     ASSERT_EQ(result.labels.size(), cloud.size());
     // The scan itself is still labeled; the far points have no neighbours (unknown).
     EXPECT_GE(result.labeled_points, normal.size() * 9 / 10) << far;
@@ -106,7 +106,7 @@ TEST(PipelineHostile, CoincidentPointsLabelInBoundedMemoryAndFanOut) {
   const std::size_t first_copy = cloud.size() - 100000;
   const std::size_t before = peak_rss_bytes();
   const auto start = std::chrono::steady_clock::now();
-  const LabelingResult result = pipeline::label_cloud(model, cloud, all_outputs());
+  const LabelingResult result = pipeline::label_cloud(model, cloud, all_outputs(), RunContext{2});
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::size_t growth = peak_rss_bytes() - before;
@@ -126,7 +126,7 @@ TEST(PipelineHostile, PointsPackedInAMillimetreCubeLabelInBoundedMemory) {
   PointCloud cloud = packed_cube_cloud(20000);
   const std::size_t before = peak_rss_bytes();
   const auto start = std::chrono::steady_clock::now();
-  const LabelingResult result = pipeline::label_cloud(model, cloud, all_outputs());
+  const LabelingResult result = pipeline::label_cloud(model, cloud, all_outputs(), RunContext{2});
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const std::size_t growth = peak_rss_bytes() - before;
@@ -156,8 +156,9 @@ TEST(PipelineHostile, DuplicatesGetTheirFirstCopysResultsAndChangeNothingElse) {
   ASSERT_EQ(map.representatives.size(), n);
   for (std::size_t j = 0; j < n; ++j) ASSERT_EQ(map.representatives[j], j);
 
-  const LabelingResult alone = pipeline::label_cloud(model, plain, all_outputs());
-  const LabelingResult with_copies = pipeline::label_cloud(model, cloud, all_outputs());
+  const LabelingResult alone = pipeline::label_cloud(model, plain, all_outputs(), RunContext{2});
+  const LabelingResult with_copies =
+      pipeline::label_cloud(model, cloud, all_outputs(), RunContext{2});
   ASSERT_EQ(with_copies.labels.size(), cloud.size());
   // Counted per input point, copies included.
   std::size_t labeled = 0;
@@ -182,8 +183,8 @@ TEST(PipelineHostile, HostileMixIsTheSameForOneAndTwoThreads) {
   base = with_points(base, std::vector<Vec3f>(2000, Vec3f(-0.2f, 0.25f, 0.0f)));
   base = with_points(base, {Vec3f(1e30f, 0, 0), Vec3f(FLT_MAX, FLT_MAX, FLT_MAX)});
   PointCloud one = base, two = base;
-  const LabelingResult r1 = pipeline::label_cloud(model, one, all_outputs(1));
-  const LabelingResult r2 = pipeline::label_cloud(model, two, all_outputs(2));
+  const LabelingResult r1 = pipeline::label_cloud(model, one, all_outputs(), RunContext{1});
+  const LabelingResult r2 = pipeline::label_cloud(model, two, all_outputs(), RunContext{2});
   ASSERT_EQ(r1.labels, r2.labels);
   ASSERT_EQ(r1.descriptors.size(), r2.descriptors.size());
   for (std::size_t k = 0; k < r1.descriptors.size(); ++k)
@@ -198,8 +199,7 @@ double worst_stop_latency_ms(const LabelModel& model, const PointCloud& input,
   for (const int delay_ms : {1, 20, 80, 250}) {
     PointCloud cloud = input;
     std::stop_source source;
-    LabelingOptions options = base;
-    options.stop = source.get_token();
+    const RunContext context{2, source.get_token()};
     std::chrono::steady_clock::time_point stopped_at{};
     std::jthread stopper([&] {
       std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
@@ -207,7 +207,7 @@ double worst_stop_latency_ms(const LabelModel& model, const PointCloud& input,
       source.request_stop();
     });
     try {
-      pipeline::label_cloud(model, cloud, options);
+      pipeline::label_cloud(model, cloud, base, context);
     } catch (const Cancelled&) {
     }
     const auto returned = std::chrono::steady_clock::now();

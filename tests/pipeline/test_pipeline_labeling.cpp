@@ -26,7 +26,7 @@ struct Trained {
 };
 
 Trained train_on_two_scenes() {
-  const crf::GraphOptions graph;
+  const crf::GraphSettings graph;
   const FeatureSettings features;
   std::vector<std::uint32_t> every_class;
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
@@ -34,14 +34,14 @@ Trained train_on_two_scenes() {
   for (int i = 0; i < 2; ++i)
     train.push_back(pipeline::prepare_scene(
         synth::synthetic_scene(synth::SceneSet::kTrain, i, synth::SensorKind::kLms400), "train",
-        features, graph, every_class, 2));
+        features, graph, every_class, RunContext{2}));
   const auto class_ids = pipeline::classes_present(train);
   for (SceneData& s : train) pipeline::assign_labels(s, class_ids);
   pipeline::ModelTrainingOptions options;
   options.kind = ModelKind::kNodeOnly;
   options.iterations = 100;
-  options.threads = 2;
-  return {pipeline::train_label_model(train, {}, class_ids, features, graph, options).model,
+  return {pipeline::train_label_model(train, {}, class_ids, features, graph, options, RunContext{2})
+              .model,
           synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400)};
 }
 
@@ -93,9 +93,8 @@ TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRo
   // Node-only, with probabilities: far above chance (the majority class, the table, ~60%).
   PointCloud cloud = trained.test_scene;
   pipeline::LabelingOptions options;
-  options.threads = 2;
   options.want_probabilities = true;
-  const auto result = pipeline::label_cloud(model, cloud, options);
+  const auto result = pipeline::label_cloud(model, cloud, options, RunContext{2});
   ASSERT_EQ(result.labels.size(), cloud.size());
   const double node_accuracy = accuracy(model, trained.test_scene, result.labels);
   EXPECT_GT(node_accuracy, 0.80);
@@ -110,10 +109,8 @@ TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRo
   const LabelModel crf = with_coupling(model, 0.5f);
   PointCloud one = trained.test_scene, two = trained.test_scene;
   options = {};
-  options.threads = 1;
-  const auto with_one = pipeline::label_cloud(crf, one, options);
-  options.threads = 2;
-  const auto with_two = pipeline::label_cloud(crf, two, options);
+  const auto with_one = pipeline::label_cloud(crf, one, options, RunContext{1});
+  const auto with_two = pipeline::label_cloud(crf, two, options, RunContext{2});
   EXPECT_EQ(with_one.labels, with_two.labels);
   EXPECT_GT(accuracy(crf, trained.test_scene, with_two.labels), 0.80);
 
@@ -124,32 +121,31 @@ TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRo
   const LabelModel loaded = load_model(path.string());
   std::filesystem::remove(path);
   PointCloud again = trained.test_scene;
-  EXPECT_EQ(pipeline::label_cloud(loaded, again, options).labels, with_two.labels);
+  EXPECT_EQ(pipeline::label_cloud(loaded, again, options, RunContext{2}).labels, with_two.labels);
 }
 
 // The default CRF training is piecewise: node factors alone, then the one Potts coupling that
 // labels the validation scene best, never worse there than no coupling (node-only).
 TEST(PipelineLabeling, PiecewiseCrfTrainingKeepsTheCouplingThatValidatesBest) {
-  const crf::GraphOptions graph;
+  const crf::GraphSettings graph;
   const FeatureSettings features;
   std::vector<std::uint32_t> every_class;
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
   std::vector<SceneData> train, validation;
   train.push_back(pipeline::prepare_scene(
       synth::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
-      features, graph, every_class, 2));
+      features, graph, every_class, RunContext{2}));
   validation.push_back(pipeline::prepare_scene(
       synth::synthetic_scene(synth::SceneSet::kVal, 0, synth::SensorKind::kLms400), "val",
-      features, graph, every_class, 2));
+      features, graph, every_class, RunContext{2}));
   const auto class_ids = pipeline::classes_present(train);
   pipeline::assign_labels(train[0], class_ids);
   pipeline::assign_labels(validation[0], class_ids);
   pipeline::ModelTrainingOptions options;
   options.iterations = 60;
-  options.threads = 2;
   ASSERT_EQ(options.objective, crf::TrainingObjective::kPiecewise);
-  const auto trained =
-      pipeline::train_label_model(train, validation, class_ids, features, graph, options);
+  const auto trained = pipeline::train_label_model(train, validation, class_ids, features, graph,
+                                                   options, RunContext{2});
   const LabelModel& crf = trained.model;
   EXPECT_EQ(crf.kind, ModelKind::kCrf);
   EXPECT_EQ(crf.training.objective.rfind("piecewise", 0), 0u) << crf.training.objective;
@@ -158,10 +154,14 @@ TEST(PipelineLabeling, PiecewiseCrfTrainingKeepsTheCouplingThatValidatesBest) {
   ASSERT_EQ(v.rows(), crf.weights.node_weights.rows());
   EXPECT_EQ(v.leftCols(v.cols() - 1).cwiseAbs().maxCoeff(), 0.0f);
   EXPECT_TRUE((v.col(v.cols() - 1).array() == trained.potts_coupling).all());
-  const double chosen = pipeline::evaluate_scenes(crf, validation, 2).accuracy();
+  const double chosen = pipeline::evaluate_scenes(crf, validation, RunContext{2}).accuracy();
   EXPECT_DOUBLE_EQ(chosen, crf.validation.accuracy);
-  EXPECT_GE(chosen, pipeline::evaluate_scenes(with_coupling(crf, 0.0f), validation, 2).accuracy());
-  EXPECT_GE(chosen, pipeline::evaluate_scenes(with_coupling(crf, 1.0f), validation, 2).accuracy());
+  EXPECT_GE(
+      chosen,
+      pipeline::evaluate_scenes(with_coupling(crf, 0.0f), validation, RunContext{2}).accuracy());
+  EXPECT_GE(
+      chosen,
+      pipeline::evaluate_scenes(with_coupling(crf, 1.0f), validation, RunContext{2}).accuracy());
 }
 
 TEST(PipelineLabeling, UnlabelablePointsGetUnknown) {
@@ -180,7 +180,7 @@ TEST(PipelineLabeling, UnlabelablePointsGetUnknown) {
 TEST(PipelineLabeling, LabelsOutsideTheModelClassesAreIgnoredInTraining) {
   PointCloud cloud = small_scene();
   const FeatureSettings features;
-  pipeline::DescribedCloud described = pipeline::describe_cloud(cloud, features, 2);
+  pipeline::DescribedCloud described = pipeline::describe_cloud(cloud, features, RunContext{2});
   crf::Graph graph = pipeline::build_scene_graph(cloud, described, {});
   const std::vector<std::uint32_t> only_plane{class_id(PrimitiveClass::kPlane)};
   const crf::LabeledGraph scene =

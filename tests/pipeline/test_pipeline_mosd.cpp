@@ -33,10 +33,8 @@ TEST(PipelineMosd, ReportCountsTablePointsAndDrawsTheScene) {
   const std::string path = mosd("learn0");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
   test::TempDir dir;
-  pipeline::LabelingOptions options;
-  options.threads = 2;
   const research::MosdSceneReport scene =
-      research::report_mosd_scene(zero_model(), path, dir.file("learn0.png"), options);
+      research::report_mosd_scene(zero_model(), path, dir.file("learn0.png"), {}, RunContext{2});
   EXPECT_GT(scene.table_points, 100000u);  // learn0: 153,323 table points
   EXPECT_GT(scene.object_points, 10000u);
   EXPECT_LE(scene.table_points + scene.object_points, scene.points);

@@ -40,7 +40,7 @@ TEST(PipelineServiceOptions, DescriptorsAreReturnedRowMajorAsDescribeComputesThe
   distinct.viewpoint = again.viewpoint;
   for (std::size_t j = 0; j < distinct.size(); ++j)
     distinct.xyz[j] = again.xyz[duplicates.representatives[j]];
-  const auto described = pipeline::describe_cloud(distinct, model.features, 0);
+  const auto described = pipeline::describe_cloud(distinct, model.features);
   for (std::size_t i = 0; i < result.descriptors.size(); ++i) {
     const std::size_t row = duplicates.slot_of[i / kFpfhSize], bin = i % kFpfhSize;
     const float a = result.descriptors[i], b = described.descriptors[row * kFpfhSize + bin];
@@ -103,8 +103,7 @@ TEST(PipelineServiceOptions, VoxelDownsamplingGivesEveryPointItsVoxelsResults) {
   options.voxel_size = 0.005f;
   options.want_descriptors = true;
   options.want_probabilities = true;
-  options.threads = 1;
-  const auto result = pipeline::label_cloud(model, cloud, options);
+  const auto result = pipeline::label_cloud(model, cloud, options, RunContext{1});
   ASSERT_EQ(result.labels.size(), cloud.size());
   ASSERT_EQ(result.probabilities.rows(), Eigen::Index(cloud.size()));
   ASSERT_EQ(result.descriptors.size(), cloud.size() * kFpfhSize);
@@ -131,17 +130,16 @@ TEST(PipelineServiceOptions, VoxelDownsamplingGivesEveryPointItsVoxelsResults) {
   // Same labels for any thread count.
   PointCloud again = table_with_box_cloud(0.0025f);
   again.xyz[3] = cloud.xyz[3];
-  options.threads = 2;
-  EXPECT_EQ(pipeline::label_cloud(model, again, options).labels, result.labels);
+  EXPECT_EQ(pipeline::label_cloud(model, again, options, RunContext{2}).labels, result.labels);
 }
 
 TEST(PipelineServiceOptions, AStoppedTokenCancelsBeforeAnyWork) {
   std::stop_source source;
   source.request_stop();
-  pipeline::LabelingOptions options;
-  options.stop = source.get_token();
+  const RunContext context{0, source.get_token()};
   PointCloud cloud = table_with_box_cloud();
-  EXPECT_THROW(pipeline::label_cloud(random_label_model(), cloud, options), pipeline::Cancelled);
+  EXPECT_THROW(pipeline::label_cloud(random_label_model(), cloud, {}, context),
+               pipeline::Cancelled);
 }
 
 TEST(PipelineServiceOptions, StoppingFromAnotherThreadCancelsInsideTheStages) {
@@ -153,15 +151,14 @@ TEST(PipelineServiceOptions, StoppingFromAnotherThreadCancelsInsideTheStages) {
   int cancelled = 0;
   for (int delay_ms : {0, 10, 40}) {
     std::stop_source source;
-    pipeline::LabelingOptions options;
-    options.stop = source.get_token();
+    const RunContext context{0, source.get_token()};
     PointCloud cloud = table_with_box_cloud(0.003f);
     std::jthread stopper([&source, delay_ms] {
       std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms));
       source.request_stop();
     });
     try {
-      EXPECT_EQ(pipeline::label_cloud(model, cloud, options).labels, reference.labels);
+      EXPECT_EQ(pipeline::label_cloud(model, cloud, {}, context).labels, reference.labels);
     } catch (const pipeline::Cancelled&) {
       ++cancelled;
     }
@@ -172,15 +169,16 @@ TEST(PipelineServiceOptions, StoppingFromAnotherThreadCancelsInsideTheStages) {
 TEST(PipelineServiceOptions, InferenceHonoursItsStopToken) {
   PointCloud cloud = table_with_box_cloud();
   const LabelModel model = random_label_model("crf", "1", 7, 0.5f);
-  const auto described = pipeline::describe_cloud(cloud, model.features, 0);
+  const auto described = pipeline::describe_cloud(cloud, model.features);
   const auto graph = pipeline::build_scene_graph(cloud, described, model.graph);
   std::stop_source source;
   source.request_stop();
-  crf::InferenceOptions options;
-  options.stop = source.get_token();
-  EXPECT_THROW(crf::infer(model.weights, described.descriptors, graph, options), Cancelled);
-  options.stop = {};
-  EXPECT_EQ(crf::infer(model.weights, described.descriptors, graph, options).labels.size(),
+  RunContext stopped;
+  stopped.stop = source.get_token();
+  EXPECT_THROW(
+      crf::infer(model.weights, described.descriptors, graph, model.inference, {}, stopped),
+      Cancelled);
+  EXPECT_EQ(crf::infer(model.weights, described.descriptors, graph, model.inference).labels.size(),
             cloud.size());
 }
 
@@ -189,27 +187,23 @@ TEST(PipelineServiceOptions, StoppedTokensCancelTheIndexAndTheGraph) {
   const LabelModel model = random_label_model("crf", "1", 7, 0.5f);
   std::stop_source source;
   source.request_stop();
-  pipeline::DescribeOptions describe;
-  describe.stop = source.get_token();
-  EXPECT_THROW(pipeline::describe_cloud(cloud, model.features, describe), Cancelled);
-  const auto described = pipeline::describe_cloud(cloud, model.features, 0);
-  crf::GraphOptions graph = model.graph;
-  graph.stop = source.get_token();
-  EXPECT_THROW(pipeline::build_scene_graph(cloud, described, graph), Cancelled);
+  RunContext stopped;
+  stopped.stop = source.get_token();
+  EXPECT_THROW(pipeline::describe_cloud(cloud, model.features, stopped), Cancelled);
+  const auto described = pipeline::describe_cloud(cloud, model.features);
+  EXPECT_THROW(pipeline::build_scene_graph(cloud, described, model.graph, stopped), Cancelled);
 }
 
 TEST(PipelineServiceOptions, ANeverStoppedTokenGivesTheSameResult) {
   const LabelModel model = random_label_model("crf", "1", 7, 0.5f);
   pipeline::LabelingOptions options;
   options.want_probabilities = true;
-  options.threads = 1;
   PointCloud reference_cloud = table_with_box_cloud(0.003f);
-  const auto reference = pipeline::label_cloud(model, reference_cloud, options);
+  const auto reference = pipeline::label_cloud(model, reference_cloud, options, RunContext{1});
   std::stop_source never;
-  options.stop = never.get_token();
-  options.threads = 2;
   PointCloud cloud = table_with_box_cloud(0.003f);
-  const auto result = pipeline::label_cloud(model, cloud, options);
+  const auto result =
+      pipeline::label_cloud(model, cloud, options, RunContext{2, never.get_token()});
   EXPECT_EQ(result.labels, reference.labels);
   ASSERT_EQ(result.probabilities.size(), reference.probabilities.size());
   EXPECT_EQ(std::memcmp(result.probabilities.data(), reference.probabilities.data(),

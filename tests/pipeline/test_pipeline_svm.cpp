@@ -45,9 +45,9 @@ TEST(PipelineSvm, TrainedSvmLabelsASceneIdenticallyAfterAFileRoundTrip) {
 
   PointCloud cloud = scene;
   pipeline::LabelingOptions options;
-  options.threads = 2;
   options.want_probabilities = true;
-  const pipeline::LabelingResult before = pipeline::label_cloud(model, cloud, options);
+  const RunContext context{2};
+  const pipeline::LabelingResult before = pipeline::label_cloud(model, cloud, options, context);
   ASSERT_EQ(before.labels.size(), scene.size());
   EXPECT_GT(before.labeled_points, scene.size() / 2);
   crf::ConfusionMatrix confusion(model.class_ids());
@@ -64,7 +64,7 @@ TEST(PipelineSvm, TrainedSvmLabelsASceneIdenticallyAfterAFileRoundTrip) {
   EXPECT_EQ(pipeline::svm_classifier_of(loaded).gamma(),
             pipeline::svm_classifier_of(model).gamma());
   PointCloud again = scene;
-  const pipeline::LabelingResult after = pipeline::label_cloud(loaded, again, options);
+  const pipeline::LabelingResult after = pipeline::label_cloud(loaded, again, options, context);
   EXPECT_EQ(after.labels, before.labels);
   EXPECT_TRUE(identical(after.probabilities, before.probabilities));
 
@@ -72,7 +72,7 @@ TEST(PipelineSvm, TrainedSvmLabelsASceneIdenticallyAfterAFileRoundTrip) {
   LabelModel broken = loaded;
   broken.svm_model = broken.svm_model.substr(0, broken.svm_model.size() / 2);
   try {
-    pipeline::label_cloud(broken, again, options);
+    pipeline::label_cloud(broken, again, options, context);
     FAIL() << "labeled with a truncated SVM";
   } catch (const ModelError& e) {
     EXPECT_NE(std::string(e.what()).find("SVM model: libsvm model, line"), std::string::npos)

@@ -213,7 +213,9 @@ TEST(HostileStreams, FiveHundredIdleStreamsDoNotTakeFiveHundredThreads) {
 TEST(HostileStreams, DeadlinesAreCountedAsDeadlineExceeded) {
   TestServer server({random_label_model("m", "1")},
                     [](server::ServerConfig& c) { c.max_request_seconds = 0.3; });
-  const PointCloud big = table_with_box_cloud(0.004f);  // ~33k points: seconds of work
+  // ~130k points: about a second of work on an idle machine, several under load, so both
+  // deadlines below (150 ms, 0.3 s) always expire first.
+  const PointCloud big = table_with_box_cloud(0.002f);
   // The client's deadline.
   const LabelAnswer answer =
       label_stream(*server.stub, scan_requests(big, header_for()), std::chrono::milliseconds(150));

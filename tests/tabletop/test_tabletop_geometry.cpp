@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stop_token>
 
 #include "primlabel/tabletop/convex_hull.hpp"
 #include "primlabel/tabletop/euclidean_clusters.hpp"
@@ -55,6 +56,26 @@ TEST(TabletopVoxelGrid, CentroidPerVoxelAndMembership) {
   EXPECT_EQ(grid.member_offsets.back(), 5u);
   EXPECT_THROW(voxel_downsample(points, valid, 0.0f), std::invalid_argument);
   EXPECT_TRUE(voxel_downsample(points, {}, 0.1f).centroids.empty());
+}
+
+// The voxel filter and the plane fit take their stop token from the RunContext.
+TEST(TabletopVoxelGrid, AStoppedRunContextCancelsTheFilterAndTheFit) {
+  std::vector<Vec3f> points;
+  for (int i = 0; i < 5000; ++i)
+    points.emplace_back(0.001f * float(i % 100), 0.001f * float(i / 100), 0.0f);
+  const auto valid = finite_indices(points);
+  std::stop_source stopped, never;
+  stopped.request_stop();
+  EXPECT_THROW(voxel_downsample(points, valid, 0.01f, RunContext{1, stopped.get_token()}),
+               Cancelled);
+  const VoxelGrid plain = voxel_downsample(points, valid, 0.01f);
+  const VoxelGrid kept = voxel_downsample(points, valid, 0.01f, RunContext{1, never.get_token()});
+  EXPECT_EQ(kept.members, plain.members);
+  EXPECT_EQ(kept.voxel_of_point, plain.voxel_of_point);
+  const PlaneFitOptions options;
+  EXPECT_THROW(fit_plane(points, valid, options, RunContext{1, stopped.get_token()}), Cancelled);
+  EXPECT_EQ(fit_plane(points, valid, options, RunContext{1, never.get_token()}).inliers,
+            fit_plane(points, valid, options).inliers);
 }
 
 TEST(TabletopPlaneFit, FindsNoisyPlaneAmongOutliers) {
@@ -137,10 +158,8 @@ TEST(TabletopPlaneFit, SameResultForOneAndTwoThreads) {
   add_blob(points, Vec3f(0.5f, 0.5f, 0.3f), 0.3f, 20000, rng);
   PlaneFitOptions options;
   options.max_scoring_points = 5000;
-  options.threads = 1;
-  const PlaneFit one = fit_plane(points, all_indices(points.size()), options);
-  options.threads = 2;
-  const PlaneFit two = fit_plane(points, all_indices(points.size()), options);
+  const PlaneFit one = fit_plane(points, all_indices(points.size()), options, RunContext{1});
+  const PlaneFit two = fit_plane(points, all_indices(points.size()), options, RunContext{2});
   ASSERT_EQ(one.status, PlaneFitStatus::kOk);
   EXPECT_EQ(one.plane, two.plane);
   EXPECT_EQ(one.inliers, two.inliers);

@@ -19,8 +19,7 @@ std::string mosd(const std::string& name) {
 SegmentationScores score_scene(const std::string& path) {
   const PointCloud cloud = read_pcd(path);
   TabletopOptions options;
-  options.threads = 2;
-  const TabletopResult result = segment_tabletop(cloud, options);
+  const TabletopResult result = segment_tabletop(cloud, options, RunContext{2});
   EXPECT_TRUE(result.ok()) << result.message;
   return evaluate_segmentation(cloud, result);
 }
@@ -62,10 +61,8 @@ TEST(MosdDeterminism, SameResultForOneAndTwoThreads) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
   const PointCloud cloud = read_pcd(path);
   TabletopOptions options;
-  options.threads = 1;
-  const TabletopResult one = segment_tabletop(cloud, options);
-  options.threads = 2;
-  const TabletopResult two = segment_tabletop(cloud, options);
+  const TabletopResult one = segment_tabletop(cloud, options, RunContext{1});
+  const TabletopResult two = segment_tabletop(cloud, options, RunContext{2});
   ASSERT_TRUE(one.ok()) << one.message;
   EXPECT_EQ(one.plane, two.plane);
   EXPECT_EQ(one.table_inliers, two.table_inliers);
@@ -78,8 +75,7 @@ TEST(MosdRobustness, PclMugSceneTableIsFound) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
   const PointCloud cloud = read_pcd(path);
   TabletopOptions options;
-  options.threads = 2;
-  const TabletopResult result = segment_tabletop(cloud, options);
+  const TabletopResult result = segment_tabletop(cloud, options, RunContext{2});
   ASSERT_TRUE(result.ok()) << result.message;
   EXPECT_GT(result.table_inliers.size(), result.valid_points / 4);
   EXPECT_GE(result.clusters.size(), 1u);  // the mug

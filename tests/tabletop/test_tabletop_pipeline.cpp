@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stop_token>
 
 #include "primlabel/tabletop/segmentation_eval.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
@@ -59,7 +60,6 @@ TabletopOptions given_up_options() {
   TabletopOptions options;
   options.up_source = UpAxisSource::kGiven;
   options.up = Vec3f(0, 0, 1);
-  options.threads = 2;
   return options;
 }
 
@@ -100,8 +100,7 @@ TEST(TabletopPipeline, EstimatedUpFindsTheTableFromATiltedSensor) {
   for (Vec3f& p : cloud.xyz) p = to_camera * (p - eye);
   cloud.viewpoint = Viewpoint{};
   TabletopOptions options;
-  options.threads = 2;
-  const TabletopResult result = segment_tabletop(cloud, options);
+  const TabletopResult result = segment_tabletop(cloud, options, RunContext{2});
   ASSERT_TRUE(result.ok()) << result.message;
   EXPECT_TRUE(result.up.isApprox(to_camera * Vec3f::UnitZ(), 1e-3f)) << result.up.transpose();
   EXPECT_NEAR(result.tilt_deg, 40.0f, 1.0f);
@@ -123,8 +122,7 @@ TEST(TabletopPipeline, SensorPoseGivesTheUpAxis) {
   cloud.viewpoint = upright_sensor(cloud.viewpoint.origin);
   TabletopOptions options;
   options.up_source = UpAxisSource::kSensor;
-  options.threads = 2;
-  const TabletopResult result = segment_tabletop(cloud, options);
+  const TabletopResult result = segment_tabletop(cloud, options, RunContext{2});
   ASSERT_TRUE(result.ok()) << result.message;
   EXPECT_GT(result.up.z(), 0.9999f);
   const SegmentationScores scores = evaluate_segmentation(cloud, result);
@@ -148,8 +146,7 @@ TEST(TabletopPipeline, APlaneSlicingThroughWallsIsNotATable) {
   room.viewpoint = upright_sensor(Vec3f(1.0f, 1.0f, 1.5f));
   TabletopOptions options;
   options.up_source = UpAxisSource::kSensor;
-  options.threads = 2;
-  const TabletopResult result = segment_tabletop(room, options);
+  const TabletopResult result = segment_tabletop(room, options, RunContext{2});
   EXPECT_EQ(result.status, TabletopStatus::kPlaneNotHorizontal) << result.message;
   EXPECT_NE(result.message.find("slice"), std::string::npos) << result.message;
   EXPECT_NEAR(result.tilt_deg, 90.0f, 1.0f);  // the dominant plane: a wall
@@ -173,15 +170,32 @@ TEST(TabletopPipeline, VoxelGridGivesTheSameSegmentation) {
 TEST(TabletopPipeline, SameResultForOneAndTwoThreads) {
   const PointCloud cloud = synthetic_scene(0.003f);
   TabletopOptions options = given_up_options();
-  options.threads = 1;
-  const TabletopResult one = segment_tabletop(cloud, options);
-  options.threads = 2;
-  const TabletopResult two = segment_tabletop(cloud, options);
+  const TabletopResult one = segment_tabletop(cloud, options, RunContext{1});
+  const TabletopResult two = segment_tabletop(cloud, options, RunContext{2});
   ASSERT_TRUE(one.ok());
   EXPECT_EQ(one.plane, two.plane);
   EXPECT_EQ(one.table_inliers, two.table_inliers);
   EXPECT_EQ(one.hull, two.hull);
   EXPECT_EQ(one.clusters, two.clusters);
+}
+
+// The stage takes its stop token from the RunContext: stopped, it throws Cancelled (with and
+// without the voxel filter); never stopped, it segments exactly as without a token.
+TEST(TabletopPipeline, HonoursTheRunContextStop) {
+  const PointCloud cloud = synthetic_scene();
+  std::stop_source stopped, never;
+  stopped.request_stop();
+  for (const float leaf : {0.0f, 0.01f}) {
+    TabletopOptions options = given_up_options();
+    options.voxel_leaf = leaf;
+    EXPECT_THROW(segment_tabletop(cloud, options, RunContext{2, stopped.get_token()}), Cancelled)
+        << "leaf " << leaf;
+    const TabletopResult plain = segment_tabletop(cloud, options, RunContext{2});
+    const TabletopResult kept = segment_tabletop(cloud, options, RunContext{2, never.get_token()});
+    ASSERT_TRUE(plain.ok()) << plain.message;
+    EXPECT_EQ(kept.table_inliers, plain.table_inliers);
+    EXPECT_EQ(kept.clusters, plain.clusters);
+  }
 }
 
 TEST(TabletopPipeline, EmptyAndAllNanCloudsGiveNoValidPoints) {

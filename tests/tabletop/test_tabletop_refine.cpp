@@ -167,9 +167,8 @@ TabletopResult segment(const PointCloud& cloud, bool merge = true) {
   TabletopOptions options;
   options.up_source = UpAxisSource::kGiven;
   options.up = Vec3f::UnitZ();
-  options.threads = 2;
   options.merge.enabled = merge;
-  return segment_tabletop(cloud, options);
+  return segment_tabletop(cloud, options, RunContext{2});
 }
 
 const Box kTallFront{{-0.04f, 0.0f, 0.0f}, {0.04f, 0.08f, 0.25f}, 20, 0xE6194B};
@@ -190,8 +189,7 @@ TEST(TabletopOcclusionMerge, ObjectCutByANearerObjectIsJoined) {
   TabletopOptions options;
   options.up_source = UpAxisSource::kGiven;
   options.up = Vec3f::UnitZ();
-  options.threads = 1;
-  EXPECT_EQ(segment_tabletop(cloud, options).clusters, joined.clusters);
+  EXPECT_EQ(segment_tabletop(cloud, options, RunContext{1}).clusters, joined.clusters);
 }
 
 TEST(TabletopOcclusionMerge, ObjectsWithTheTableSeenBetweenThemStaySeparate) {

@@ -193,15 +193,16 @@ std::vector<std::uint8_t> valid_descriptor_mask(std::span<const float> descripto
 }
 
 Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descriptors, int dim,
-                  const GraphOptions& options, const NeighborSearch* search) {
-  if (!options.neighborhood.valid())
+                  const GraphSettings& settings, const RunContext& context,
+                  const NeighborSearch* search) {
+  if (!settings.neighborhood.valid())
     throw std::invalid_argument("build_graph: invalid neighbourhood " +
-                                options.neighborhood.describe());
+                                settings.neighborhood.describe());
   if (dim <= 0 || descriptors.size() != points.size() * static_cast<std::size_t>(dim))
     throw std::invalid_argument("build_graph: descriptors are not points.size() x dim");
   const std::size_t n = points.size();
-  const int threads = primlabel::detail::resolve_threads(options.threads);
-  const std::stop_token& stop = options.stop;
+  const int threads = primlabel::detail::resolve_threads(context.threads);
+  const std::stop_token& stop = context.stop;
   throw_if_stopped(stop, kWhat);
 
   std::vector<std::uint8_t> active(n);
@@ -236,12 +237,12 @@ Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descr
     return own_search ? compact_to_point[found] : found;
   };
 
-  const Neighborhood query = query_with_self(options.neighborhood);
-  const int cap = neighbor_cap(options.neighborhood);
+  const Neighborhood query = query_with_self(settings.neighborhood);
+  const int cap = neighbor_cap(settings.neighborhood);
   BlockLists lists(n);
   const auto blocks = static_cast<std::ptrdiff_t>(lists.num_blocks());
   primlabel::detail::for_each_block(
-      threads, blocks, stop, [] { return NeighborList(); },
+      blocks, context.with_threads(threads), [] { return NeighborList(); },
       [&](NeighborList& found, std::ptrdiff_t b) {
         lists.begin_block(b);
         const std::size_t last = std::min(n, std::size_t(b + 1) * BlockLists::kListBlock);

@@ -235,4 +235,20 @@ void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors
   throw_if_stopped(stop, kWhat);
 }
 
+void node_potentials_padded(const float* theta, std::size_t n, int k_count, int threads,
+                            float* phi) {
+  const int kp = padded_classes(k_count);
+  const long long count = static_cast<long long>(n);
+  primlabel::detail::ExceptionBarrier barrier;
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (long long i = 0; i < count; ++i)
+    barrier.run([&] {
+      const Eigen::Map<const Eigen::ArrayXf> t(theta + i * kp, k_count);
+      Eigen::Map<Eigen::ArrayXf> out(phi + i * kp, kp);
+      out.head(k_count) = (t - t.maxCoeff()).exp();
+      out.tail(kp - k_count).setZero();
+    });
+  barrier.rethrow();
+}
+
 }  // namespace primlabel::crf::detail

@@ -77,6 +77,11 @@ void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors
                        const Graph& graph, const std::uint32_t* block_first_edge, int threads,
                        bool potentials_minus_one, float* out, const std::stop_token& stop = {});
 
+// Loopy BP's node potentials from node_scores_padded's rows: phi_i(k) = exp(theta_i(k) -
+// max_k theta_i(k)) (max 1), pads 0.
+void node_potentials_padded(const float* theta, std::size_t n, int k_count, int threads,
+                            float* phi);
+
 // Products of tiny values would otherwise run into subnormals, which are ~100x slower on x86;
 // flushing them to zero changes nothing that matters next to a maximum of 1.
 class FlushSubnormals {

@@ -55,35 +55,35 @@ bool fit_normal(const std::vector<Vec3f>& xyz, const Vec3f& query, const Neighbo
 }  // namespace
 
 NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
-                             const NeighborSearch* search) {
+                             const RunContext& context, const NeighborSearch* search) {
+  const std::stop_token& stop = context.stop;
   if (!options.neighborhood.valid())
     throw std::invalid_argument("normal estimation: invalid neighbourhood " +
                                 options.neighborhood.describe());
   std::unique_ptr<NeighborSearch> own_search;
   if (!search) {
-    own_search = std::make_unique<NeighborSearch>(cloud.xyz, options.stop);
+    own_search = std::make_unique<NeighborSearch>(cloud.xyz, stop);
     search = own_search.get();
   }
   const Vec3f viewpoint = options.viewpoint.value_or(cloud.viewpoint.origin);
   const std::size_t n = cloud.size();
-  detail::assign_checked(cloud.normals, n, Vec3f(Vec3f::Constant(kNaN)), options.stop,
-                         "normal estimation");
-  detail::assign_checked(cloud.curvature, n, kNaN, options.stop, "normal estimation");
+  detail::assign_checked(cloud.normals, n, Vec3f(Vec3f::Constant(kNaN)), stop, "normal estimation");
+  detail::assign_checked(cloud.curvature, n, kNaN, stop, "normal estimation");
 
   std::atomic<std::size_t> estimated{0}, too_few{0}, invalid_input{0};
-  detail::ProgressCounter progress(options.progress, n);
-  const int threads = detail::resolve_threads(options.threads);
+  detail::ProgressCounter progress(context.progress, n);
+  const int threads = detail::resolve_threads(context.threads);
   constexpr std::size_t kBlock = 256;
   const auto blocks = static_cast<std::ptrdiff_t>((n + kBlock - 1) / kBlock);
   const auto make_scratch = [] { return NeighborList(); };
   detail::for_each_block(
-      threads, blocks, options.stop, make_scratch,
+      blocks, context.with_threads(threads), make_scratch,
       [&](NeighborList& neighbors, std::ptrdiff_t block) {
         std::size_t block_estimated = 0, block_too_few = 0, block_invalid = 0;
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
         for (std::size_t i = first; i < last; ++i) {
           // Checked per point: a stop is then honoured within one (capped) neighbourhood's time.
-          if (options.stop.stop_requested()) return;
+          if (stop.stop_requested()) return;
           const Vec3f& p = cloud.xyz[i];
           if (!is_finite(p)) {
             ++block_invalid;
@@ -105,7 +105,7 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
         estimated += block_estimated, too_few += block_too_few, invalid_input += block_invalid;
         progress.add(last - first);
       });
-  throw_if_stopped(options.stop, "normal estimation");
+  throw_if_stopped(stop, "normal estimation");
   progress.finish();
   return NormalStats{estimated.load(), too_few.load(), invalid_input.load()};
 }

@@ -22,32 +22,32 @@ Neighborhood capped(const Neighborhood& hood) {
   return out;
 }
 
-DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings, int threads) {
-  DescribeOptions options;
-  options.threads = threads;
-  return describe_cloud(cloud, settings, options);
+DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings,
+                              const RunContext& context) {
+  return describe_cloud(cloud, settings, DescribeOptions{}, context);
 }
 
 DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings,
-                              const DescribeOptions& options) {
+                              const DescribeOptions& options, const RunContext& context) {
   if (settings.voxel_size > 0.0f)
     throw std::invalid_argument("describe_cloud does not downsample: label_cloud does");
   if (!settings.normals.valid() || !settings.features.valid())
     throw std::invalid_argument("invalid normal or feature neighbourhood");
   if (options.use_cloud_normals && cloud.normals.size() != cloud.size())
     throw std::invalid_argument("the cloud has no normal per point to keep");
-  throw_if_stopped(options.stop, "describing the cloud");
+  context.throw_if_stopped("describing the cloud");
   DescribedCloud out;
   // The index build checks the token itself (a 5M-point k-d tree takes about a second).
-  out.search = std::make_unique<NeighborSearch>(cloud.xyz, options.stop);
+  out.search = std::make_unique<NeighborSearch>(cloud.xyz, context.stop);
+  // The stages' own progress counts (points, then twice the points for FPFH) would not add up to
+  // one describe call: only threads and stop go down.
+  const RunContext stage{context.threads, context.stop, {}};
 
   if (!options.use_cloud_normals) {
     const auto start = std::chrono::steady_clock::now();
     NormalOptions normal_options;
     normal_options.neighborhood = capped(settings.normals);
-    normal_options.threads = options.threads;
-    normal_options.stop = options.stop;
-    estimate_normals(cloud, normal_options, out.search.get());
+    estimate_normals(cloud, normal_options, stage, out.search.get());
     out.normal_seconds = seconds_since(start);
   }
 
@@ -55,22 +55,20 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   FeatureOptions feature_options;
   feature_options.neighborhood = capped(settings.features);
   feature_options.fpfh_variant = settings.fpfh_variant;
-  feature_options.threads = options.threads;
-  feature_options.stop = options.stop;
   const bool fpfh = settings.descriptor == DescriptorKind::kFpfh;
-  out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, nullptr, out.search.get())
-                         : compute_pfh(cloud, feature_options, nullptr, out.search.get());
+  out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, stage, nullptr, out.search.get())
+                         : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
   out.descriptor_dim = settings.descriptor_dim();
   out.feature_seconds = seconds_since(start);
   return out;
 }
 
 crf::Graph build_scene_graph(const PointCloud& cloud, const DescribedCloud& described,
-                             const crf::GraphOptions& options) {
-  crf::GraphOptions bounded = options;
-  bounded.neighborhood = capped(options.neighborhood);
+                             const crf::GraphSettings& settings, const RunContext& context) {
+  crf::GraphSettings bounded = settings;
+  bounded.neighborhood = capped(settings.neighborhood);
   return crf::build_graph(cloud.xyz, described.descriptors, described.descriptor_dim, bounded,
-                          described.search.get());
+                          context, described.search.get());
 }
 
 crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& described,

@@ -47,38 +47,34 @@ FeatureSettings effective_features(const LabelModel& model, const LabelingOption
 
 // Every point of `cloud` described and labeled (no duplicates expected, see label_all_points).
 LabelingResult label_distinct_points(const LabelModel& model, const FeatureSettings& features,
-                                     PointCloud& cloud, const LabelingOptions& options) {
+                                     PointCloud& cloud, const LabelingOptions& options,
+                                     const RunContext& context) {
   LabelingResult result;
   result.class_ids = model.class_ids();
   DescribeOptions describe_options;
-  describe_options.threads = options.threads;
   describe_options.use_cloud_normals = options.use_cloud_normals;
-  describe_options.stop = options.stop;
-  DescribedCloud described = describe_cloud(cloud, features, describe_options);
+  DescribedCloud described = describe_cloud(cloud, features, describe_options, context);
   result.normal_seconds = described.normal_seconds;
   result.descriptor_seconds = described.feature_seconds;
   result.feature_seconds = described.normal_seconds + described.feature_seconds;
   result.described_points = cloud.size();
-  throw_if_stopped(options.stop, "labeling");
+  context.throw_if_stopped("labeling");
   if (model.kind == ModelKind::kSvm) {  // point by point: no graph
-    classify_with_svm(model, std::move(described), options, result);
+    classify_with_svm(model, std::move(described), options, context, result);
     return result;
   }
 
   const auto start = std::chrono::steady_clock::now();
-  crf::GraphOptions graph_options = model.graph;
-  graph_options.threads = options.threads;
-  graph_options.stop = options.stop;
+  crf::GraphSettings graph_options = model.graph;
   // A node-only model ignores edges, so its graph needs none (only the active mask).
   if (model.kind == ModelKind::kNodeOnly) graph_options.neighborhood = Neighborhood::Knn(1);
-  const crf::Graph graph = build_scene_graph(cloud, described, graph_options);
-  throw_if_stopped(options.stop, "labeling");
-  crf::InferenceOptions inference = model.inference;
-  inference.threads = options.threads;
-  inference.unknown_label = class_id(PrimitiveClass::kUnknown);
-  inference.compute_marginals = options.want_probabilities;
-  inference.stop = options.stop;
-  crf::InferenceResult inferred = infer(model.weights, described.descriptors, graph, inference);
+  const crf::Graph graph = build_scene_graph(cloud, described, graph_options, context);
+  context.throw_if_stopped("labeling");
+  crf::InferenceOutputs outputs;
+  outputs.unknown_label = class_id(PrimitiveClass::kUnknown);
+  outputs.marginals = options.want_probabilities;
+  crf::InferenceResult inferred =
+      infer(model.weights, described.descriptors, graph, model.inference, outputs, context);
   result.inference_seconds = seconds_since(start);
 
   result.labels = std::move(inferred.labels);
@@ -155,9 +151,10 @@ LabelingResult fan_out(const LabelingResult& partial, const PointCloud& part,
 // Exact duplicates are described once, at their lowest index, and every copy gets that copy's
 // results (as voxels fan out to their members below).
 LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& features,
-                                PointCloud& cloud, const LabelingOptions& options) {
-  const DuplicateMap duplicates = find_duplicates(cloud.xyz, options.stop);
-  if (!duplicates.any()) return label_distinct_points(model, features, cloud, options);
+                                PointCloud& cloud, const LabelingOptions& options,
+                                const RunContext& context) {
+  const DuplicateMap duplicates = find_duplicates(cloud.xyz, context.stop);
+  if (!duplicates.any()) return label_distinct_points(model, features, cloud, options, context);
   const std::vector<std::uint32_t>& keep = duplicates.representatives;
   PointCloud distinct;
   distinct.resize_unorganized(keep.size());
@@ -167,18 +164,18 @@ LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& 
     distinct.normals.resize(keep.size());
     for (std::size_t j = 0; j < keep.size(); ++j) distinct.normals[j] = cloud.normals[keep[j]];
   }
-  const LabelingResult partial = label_distinct_points(model, features, distinct, options);
+  const LabelingResult partial = label_distinct_points(model, features, distinct, options, context);
   return fan_out(partial, distinct, duplicates.slot_of, cloud, options);
 }
 
 // Table-top only: label the sub-cloud of table and object points, scatter back.
 LabelingResult label_tabletop(const LabelModel& model, const FeatureSettings& features,
-                              PointCloud& cloud, const LabelingOptions& options) {
+                              PointCloud& cloud, const LabelingOptions& options,
+                              const RunContext& context) {
   const auto start = std::chrono::steady_clock::now();
   tabletop::TabletopOptions tabletop_options;
-  tabletop_options.threads = options.threads;
-  tabletop_options.stop = options.stop;
-  const tabletop::TabletopResult segmented = tabletop::segment_tabletop(cloud, tabletop_options);
+  const tabletop::TabletopResult segmented =
+      tabletop::segment_tabletop(cloud, tabletop_options, context);
   const std::vector<std::uint8_t> mask = tabletop::tabletop_mask(segmented, cloud.size());
   PointCloud sub;
   std::vector<std::size_t> source_index;
@@ -193,9 +190,9 @@ LabelingResult label_tabletop(const LabelModel& model, const FeatureSettings& fe
       sub.normals[j] = cloud.normals[source_index[j]];
   }
   const double prefilter_seconds = seconds_since(start);
-  throw_if_stopped(options.stop, "labeling");
+  context.throw_if_stopped("labeling");
 
-  const LabelingResult partial = label_all_points(model, features, sub, options);
+  const LabelingResult partial = label_all_points(model, features, sub, options, context);
   LabelingResult result = unknown_result(cloud.size(), partial, options);
   result.prefilter_seconds = prefilter_seconds;
   if (!options.use_cloud_normals) {
@@ -214,9 +211,10 @@ LabelingResult label_tabletop(const LabelModel& model, const FeatureSettings& fe
 }
 
 LabelingResult label_points(const LabelModel& model, const FeatureSettings& features,
-                            PointCloud& cloud, const LabelingOptions& options) {
-  return options.tabletop_only ? label_tabletop(model, features, cloud, options)
-                               : label_all_points(model, features, cloud, options);
+                            PointCloud& cloud, const LabelingOptions& options,
+                            const RunContext& context) {
+  return options.tabletop_only ? label_tabletop(model, features, cloud, options, context)
+                               : label_all_points(model, features, cloud, options, context);
 }
 
 // Voxel centroids, with the mean of the members' normals (normalised) when the cloud's own
@@ -241,15 +239,16 @@ PointCloud voxel_cloud(const PointCloud& cloud, const tabletop::VoxelGrid& grid,
 }
 
 LabelingResult label_voxels(const LabelModel& model, const FeatureSettings& features,
-                            PointCloud& cloud, float voxel_size, const LabelingOptions& options) {
+                            PointCloud& cloud, float voxel_size, const LabelingOptions& options,
+                            const RunContext& context) {
   const auto start = std::chrono::steady_clock::now();
   const tabletop::VoxelGrid grid = tabletop::voxel_downsample(
-      cloud.xyz, tabletop::finite_indices(cloud.xyz), voxel_size, options.stop);
+      cloud.xyz, tabletop::finite_indices(cloud.xyz), voxel_size, context);
   PointCloud voxels = voxel_cloud(cloud, grid, options.use_cloud_normals);
   const double voxel_seconds = seconds_since(start);
-  throw_if_stopped(options.stop, "labeling");
+  context.throw_if_stopped("labeling");
 
-  const LabelingResult partial = label_points(model, features, voxels, options);
+  const LabelingResult partial = label_points(model, features, voxels, options, context);
   LabelingResult result = fan_out(partial, voxels, grid.voxel_of_point, cloud, options);
   result.prefilter_seconds = partial.prefilter_seconds + voxel_seconds;
   return result;
@@ -258,7 +257,7 @@ LabelingResult label_voxels(const LabelModel& model, const FeatureSettings& feat
 }  // namespace
 
 LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
-                           const LabelingOptions& options) {
+                           const LabelingOptions& options, const RunContext& context) {
   if (options.use_cloud_normals && cloud.normals.size() != cloud.size())
     throw std::invalid_argument("use_cloud_normals: the cloud has " +
                                 std::to_string(cloud.normals.size()) + " normals for " +
@@ -268,9 +267,9 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
   const FeatureSettings features = effective_features(model, options);
   const float voxel_size =
       options.voxel_size > 0.0f ? options.voxel_size : model.features.voxel_size;
-  throw_if_stopped(options.stop, "labeling");
-  if (voxel_size > 0.0f) return label_voxels(model, features, cloud, voxel_size, options);
-  return label_points(model, features, cloud, options);
+  context.throw_if_stopped("labeling");
+  if (voxel_size > 0.0f) return label_voxels(model, features, cloud, voxel_size, options, context);
+  return label_points(model, features, cloud, options, context);
 }
 
 }  // namespace primlabel::pipeline

@@ -20,8 +20,9 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 ModelTrainingResult train_svm_model(std::span<const SceneData> training,
                                     std::span<const SceneData> validation,
                                     const std::vector<std::uint32_t>& class_ids,
-                                    const FeatureSettings& features, const crf::GraphOptions& graph,
-                                    const crf::SvmOptions& options, int threads) {
+                                    const FeatureSettings& features,
+                                    const crf::GraphSettings& graph, const crf::SvmOptions& options,
+                                    const RunContext& context) {
   if (training.empty()) throw std::invalid_argument("no training scenes");
   std::vector<crf::LabeledGraph> graphs;
   graphs.reserve(training.size());
@@ -38,7 +39,6 @@ ModelTrainingResult train_svm_model(std::span<const SceneData> training,
   m.version = std::string("1");  // not = "1": GCC 12 warns falsely (-Wrestrict)
   m.features = features;
   m.graph = graph;  // unused by the SVM; kept so the file says how scenes were prepared
-  m.graph.threads = 0;
   m.svm_model = svm.to_libsvm_text();
   m.svm_class_ids = class_ids;
   m.weights.class_ids = class_ids;
@@ -55,7 +55,7 @@ ModelTrainingResult train_svm_model(std::span<const SceneData> training,
                 svm.gamma(), svm.training_points(), svm.support_vectors());
   summary.objective = objective;
   summary.seconds = out.seconds;
-  if (!validation.empty()) m.validation = summarize(evaluate_scenes(m, validation, threads));
+  if (!validation.empty()) m.validation = summarize(evaluate_scenes(m, validation, context));
   return out;
 }
 
@@ -71,11 +71,12 @@ crf::SvmClassifier svm_classifier_of(const LabelModel& model) {
 }
 
 void classify_with_svm(const LabelModel& model, DescribedCloud&& described,
-                       const LabelingOptions& options, LabelingResult& result) {
+                       const LabelingOptions& options, const RunContext& context,
+                       LabelingResult& result) {
   const auto start = std::chrono::steady_clock::now();
   const crf::SvmClassifier svm = svm_classifier_of(model);
   crf::SvmPrediction predicted = svm.predict(
-      described.descriptors, class_id(PrimitiveClass::kUnknown), options.threads, options.stop);
+      described.descriptors, class_id(PrimitiveClass::kUnknown), context.threads, context.stop);
   result.class_ids = model.class_ids();
   result.labels = std::move(predicted.labels);
   if (options.want_probabilities) result.probabilities = std::move(predicted.probabilities);

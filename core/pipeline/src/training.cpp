@@ -35,14 +35,14 @@ struct Calibration {
 // label. The couplings are therefore scaled down by the factor (from a short grid) that labels
 // the calibration scenes best.
 Calibration calibrate_edge_scale(LabelModel& model, std::span<const SceneData> scenes,
-                                 int threads) {
+                                 const RunContext& context) {
   static constexpr float kScales[] = {1.0f, 0.3f, 0.1f, 0.03f};
   const Eigen::MatrixXf learnt = model.weights.edge_weights;
   float best_scale = 1.0f;
   double best_accuracy = -1.0;
   for (float scale : kScales) {
     model.weights.edge_weights = learnt * scale;
-    const double accuracy = evaluate_scenes(model, scenes, threads).accuracy();
+    const double accuracy = evaluate_scenes(model, scenes, context).accuracy();
     if (accuracy > best_accuracy) best_accuracy = accuracy, best_scale = scale;
   }
   model.weights.edge_weights = learnt * best_scale;
@@ -52,7 +52,7 @@ Calibration calibrate_edge_scale(LabelModel& model, std::span<const SceneData> s
 // Node terms plus a uniform associative coupling beta (edge bias) for every class, beta picked
 // from a short grid on the calibration scenes.
 Calibration calibrate_potts_coupling(LabelModel& model, std::span<const SceneData> scenes,
-                                     int threads) {
+                                     const RunContext& context) {
   static constexpr float kCouplings[] = {0.0f, 0.05f, 0.1f, 0.25f, 1.0f};
   crf::CrfModel& w = model.weights;
   float best_coupling = 0.0f;
@@ -60,7 +60,7 @@ Calibration calibrate_potts_coupling(LabelModel& model, std::span<const SceneDat
   for (float beta : kCouplings) {
     w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.edge_feature_dim());
     w.edge_weights.col(w.edge_feature_dim() - 1).setConstant(beta);
-    const double accuracy = evaluate_scenes(model, scenes, threads).accuracy();
+    const double accuracy = evaluate_scenes(model, scenes, context).accuracy();
     if (accuracy > best_accuracy) best_accuracy = accuracy, best_coupling = beta;
   }
   w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.edge_feature_dim());
@@ -82,16 +82,14 @@ const char* objective_name(ModelKind kind, crf::TrainingObjective objective) {
 }  // namespace
 
 SceneData prepare_scene(PointCloud cloud, std::string source, const FeatureSettings& features,
-                        const crf::GraphOptions& graph, const std::vector<std::uint32_t>& class_ids,
-                        int threads) {
+                        const crf::GraphSettings& graph,
+                        const std::vector<std::uint32_t>& class_ids, const RunContext& context) {
   SceneData scene;
   scene.source = std::move(source);
-  DescribedCloud described = describe_cloud(cloud, features, threads);
+  DescribedCloud described = describe_cloud(cloud, features, context);
   scene.normal_seconds = described.normal_seconds;
   scene.feature_seconds = described.feature_seconds;
-  crf::GraphOptions graph_options = graph;
-  graph_options.threads = threads;
-  crf::Graph g = build_scene_graph(cloud, described, graph_options);
+  crf::Graph g = build_scene_graph(cloud, described, graph, context);
   scene.graph = to_labeled_graph(cloud, std::move(described), std::move(g), class_ids);
   scene.truth = std::move(cloud.labels);
   return scene;
@@ -117,22 +115,24 @@ std::vector<std::uint32_t> classes_present(std::span<const SceneData> scenes) {
 }
 
 std::vector<std::uint32_t> predict_scene(const LabelModel& model, const SceneData& scene,
-                                         int threads) {
+                                         const RunContext& context) {
   if (model.kind == ModelKind::kSvm)
     return svm_classifier_of(model)
-        .predict(scene.graph.descriptors, class_id(PrimitiveClass::kUnknown), threads)
+        .predict(scene.graph.descriptors, class_id(PrimitiveClass::kUnknown), context.threads,
+                 context.stop)
         .labels;
-  crf::InferenceOptions inference = model.inference;
-  inference.threads = threads;
-  inference.unknown_label = class_id(PrimitiveClass::kUnknown);
-  return crf::infer(model.weights, scene.graph.descriptors, scene.graph.graph, inference).labels;
+  crf::InferenceOutputs outputs;
+  outputs.unknown_label = class_id(PrimitiveClass::kUnknown);
+  return crf::infer(model.weights, scene.graph.descriptors, scene.graph.graph, model.inference,
+                    outputs, context)
+      .labels;
 }
 
 crf::ConfusionMatrix evaluate_scenes(const LabelModel& model, std::span<const SceneData> scenes,
-                                     int threads) {
+                                     const RunContext& context) {
   crf::ConfusionMatrix confusion(model.class_ids());
   for (const SceneData& s : scenes)
-    confusion.add(s.truth, predict_scene(model, s, threads), class_id(PrimitiveClass::kUnknown));
+    confusion.add(s.truth, predict_scene(model, s, context), class_id(PrimitiveClass::kUnknown));
   return confusion;
 }
 
@@ -165,11 +165,11 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
                                       std::span<const SceneData> validation,
                                       const std::vector<std::uint32_t>& class_ids,
                                       const FeatureSettings& features,
-                                      const crf::GraphOptions& graph,
-                                      const ModelTrainingOptions& options) {
+                                      const crf::GraphSettings& graph,
+                                      const ModelTrainingOptions& options,
+                                      const RunContext& context) {
   if (options.kind == ModelKind::kSvm)
-    return train_svm_model(training, validation, class_ids, features, graph, options.svm,
-                           options.threads);
+    return train_svm_model(training, validation, class_ids, features, graph, options.svm, context);
   if (training.empty()) throw std::invalid_argument("no training scenes");
   const std::vector<crf::LabeledGraph> train_graphs = graphs_of(training);
   const std::vector<crf::LabeledGraph> val_graphs = graphs_of(validation);
@@ -179,14 +179,12 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
       options.kind == ModelKind::kNodeOnly ? crf::TrainingObjective::kNodeOnly : options.objective;
   training_options.l2 = options.l2;
   training_options.max_iterations = options.iterations;
-  training_options.threads = options.threads;
   training_options.node_knots = options.node_knots;
-  training_options.inference.threads = options.threads;
   training_options.on_iteration = options.on_iteration;
 
   ModelTrainingResult out;
   const auto start = std::chrono::steady_clock::now();
-  out.details = crf::train_crf(train_graphs, val_graphs, class_ids, training_options);
+  out.details = crf::train_crf(train_graphs, val_graphs, class_ids, training_options, context);
   out.seconds = seconds_since(start);
 
   LabelModel& m = out.model;
@@ -195,11 +193,8 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
   m.kind = options.kind;
   m.features = features;
   m.graph = graph;
-  m.graph.threads = 0;
   m.weights = out.details.model;
   m.inference = training_options.inference;
-  m.inference.threads = 0;
-  m.inference.compute_marginals = false;
   m.created_unix_ms = std::int64_t(std::time(nullptr)) * 1000;
   m.created_by = "primlabel-train";
 
@@ -217,20 +212,20 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
     // With one uniform coupling, mean-field labels like loopy BP (97.92% both on the default test
     // scenes, linear node basis) at about three times the speed, so such models infer with it.
     m.inference.method = crf::InferenceMethod::kMeanField;
-    const Calibration coupling = calibrate_potts_coupling(m, calibration, options.threads);
+    const Calibration coupling = calibrate_potts_coupling(m, calibration, context);
     out.potts_coupling = coupling.value;
     out.edge_scale = 0.0f;
     summary.objective = "piecewise: node-only + Potts coupling " + std::to_string(coupling.value);
   } else if (options.kind == ModelKind::kCrf && options.calibrate_edges) {
-    const Calibration pl = calibrate_edge_scale(m, calibration, options.threads);
+    const Calibration pl = calibrate_edge_scale(m, calibration, context);
     out.edge_scale = pl.value;
     // The alternative: node terms trained alone plus one Potts coupling for every class.
     crf::TrainingOptions node_options = training_options;
     node_options.objective = crf::TrainingObjective::kNodeOnly;
     node_options.on_iteration = nullptr;
     LabelModel potts = m;
-    potts.weights = crf::train_crf(train_graphs, {}, class_ids, node_options).model;
-    const Calibration coupling = calibrate_potts_coupling(potts, calibration, options.threads);
+    potts.weights = crf::train_crf(train_graphs, {}, class_ids, node_options, context).model;
+    const Calibration coupling = calibrate_potts_coupling(potts, calibration, context);
     out.potts_coupling = coupling.value;
     if (coupling.accuracy > pl.accuracy) {
       m.weights = potts.weights;
@@ -243,8 +238,7 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
   }
   out.seconds = seconds_since(start);
   summary.seconds = out.seconds;
-  if (!validation.empty())
-    m.validation = summarize(evaluate_scenes(m, validation, options.threads));
+  if (!validation.empty()) m.validation = summarize(evaluate_scenes(m, validation, context));
   return out;
 }
 

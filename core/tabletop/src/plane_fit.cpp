@@ -123,7 +123,7 @@ float angle_deg(const Vec3f& normal, const Vec3f& axis) {
 }  // namespace
 
 PlaneFit fit_plane(const std::vector<Vec3f>& points, const std::vector<std::uint32_t>& indices,
-                   const PlaneFitOptions& options) {
+                   const PlaneFitOptions& options, const RunContext& context) {
   options.validate();
   PlaneFit fit;
   const std::size_t n = indices.size();
@@ -148,14 +148,14 @@ PlaneFit fit_plane(const std::vector<Vec3f>& points, const std::vector<std::uint
 
   Random random(options.seed);
   constexpr int kBlock = 32;  // hypotheses per parallel round; fixed, so results ignore threads
-  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  const int threads = context.threads > 0 ? context.threads : omp_get_max_threads();
   Hypothesis best;
   best.cost = std::numeric_limits<double>::infinity();
   double needed = options.max_iterations;
   int drawn = 0;
   std::vector<Hypothesis> block;
   while (drawn < needed && drawn < options.max_iterations) {
-    throw_if_stopped(options.stop, "fitting the table plane");
+    context.throw_if_stopped("fitting the table plane");
     const int count = std::min<int>(kBlock, options.max_iterations - drawn);
     block.assign(count, Hypothesis{});
     for (int h = 0; h < count; ++h) {
@@ -202,7 +202,7 @@ PlaneFit fit_plane(const std::vector<Vec3f>& points, const std::vector<std::uint
     if (axis) {  // Is there a plane at all, just not within the angle? Say how far off it is.
       PlaneFitOptions free = options;
       free.axis.reset();
-      const PlaneFit unconstrained = fit_plane(points, indices, free);
+      const PlaneFit unconstrained = fit_plane(points, indices, free, context);
       if (unconstrained.status == PlaneFitStatus::kOk) {
         fit.status = PlaneFitStatus::kNotWithinAngle;
         fit.rejected_plane = unconstrained.plane;

@@ -108,9 +108,10 @@ std::vector<std::vector<std::uint32_t>> expand_voxel_clusters(
 
 }  // namespace
 
-TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& options) {
+TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& options,
+                                const RunContext& context) {
   options.validate();
-  throw_if_stopped(options.stop, kWhat);
+  context.throw_if_stopped(kWhat);
   const auto start = Clock::now();
   TabletopResult result;
   const std::vector<Vec3f>& xyz = cloud.xyz;
@@ -128,7 +129,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   VoxelGrid grid;
   std::vector<std::uint32_t> all_voxels;
   if (voxelized) {
-    grid = voxel_downsample(xyz, valid, options.voxel_leaf, options.stop);
+    grid = voxel_downsample(xyz, valid, options.voxel_leaf, context);
     all_voxels.resize(grid.centroids.size());
     std::iota(all_voxels.begin(), all_voxels.end(), 0u);
   }
@@ -140,8 +141,6 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   const auto plane_start = Clock::now();
   PlaneFitOptions plane_options = options.plane;
   plane_options.seed = options.seed;
-  plane_options.threads = options.threads;
-  plane_options.stop = options.stop;
   Vec3f prior = sensor_up(cloud.viewpoint);
   if (options.up_source == UpAxisSource::kGiven) prior = options.up.normalized();
   plane_options.axis = prior;
@@ -151,7 +150,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   if (voxelized)  // the voxel count, not the point count, is what the fit sees
     plane_options.min_inliers =
         std::max<std::size_t>(3, options.plane.min_inliers * grid.centroids.size() / valid.size());
-  const PlaneFit fit = fit_plane(fit_points, fit_indices, plane_options);
+  const PlaneFit fit = fit_plane(fit_points, fit_indices, plane_options, context);
   result.timings.plane_ms = ms_since(plane_start);
   const auto fail = [&](const PlaneFit& failed) {
     result.status = failed.status == PlaneFitStatus::kNotWithinAngle
@@ -173,7 +172,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   result.up = plane.head<3>();
   result.tilt_deg = angle_between_deg(plane.head<3>(), prior);
 
-  throw_if_stopped(options.stop, kWhat);
+  context.throw_if_stopped(kWhat);
   // 3. The table: points in the band around the plane, in the pieces connected to its bulk.
   const auto table_start = Clock::now();
   std::vector<float> height(xyz.size(), std::numeric_limits<float>::quiet_NaN());
@@ -198,7 +197,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   if (not_a_table) {
     PlaneFitOptions free = plane_options;
     free.axis.reset();
-    PlaneFit dominant = fit_plane(fit_points, fit_indices, free);
+    PlaneFit dominant = fit_plane(fit_points, fit_indices, free, context);
     PlaneFit failed;
     failed.status = PlaneFitStatus::kNoPlane;
     failed.message = "the best plane within " + std::to_string(int(plane_options.max_angle_deg)) +
@@ -235,7 +234,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   for (const Vec2f& q : hull) result.hull.push_back(on_plane + q.x() * u + q.y() * v);
   result.timings.table_ms = ms_since(table_start);
 
-  throw_if_stopped(options.stop, kWhat);
+  context.throw_if_stopped(kWhat);
   // 4. Objects: what stands on the table, inside its boundary, grouped by proximity.
   const auto objects_start = Clock::now();
   const float min_height = options.min_object_height.value_or(-options.table_band);
@@ -247,7 +246,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   }
   if (voxelized) {
     // Cluster the voxels holding candidates, at their candidates' centroid.
-    VoxelGrid object_grid = voxel_downsample(xyz, candidates, options.voxel_leaf, options.stop);
+    VoxelGrid object_grid = voxel_downsample(xyz, candidates, options.voxel_leaf, context);
     std::vector<std::uint32_t> voxels(object_grid.centroids.size());
     std::iota(voxels.begin(), voxels.end(), 0u);
     ClusterOptions unlimited = options.clusters;
@@ -259,14 +258,14 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   } else {
     result.clusters = euclidean_clusters(xyz, candidates, options.clusters);
   }
-  throw_if_stopped(options.stop, kWhat);
+  context.throw_if_stopped(kWhat);
   // 5. Objects as wholes: split stacked objects first, so that the lower object's occluded
   // parts can still be joined to what remains of it.
   const auto refine_start = Clock::now();
   result.clusters = split_stacked(xyz, height, plane, std::move(result.clusters), options.split);
   result.clusters =
       merge_occluded(cloud, height, band_grid, std::move(result.clusters), options.merge);
-  throw_if_stopped(options.stop, kWhat);
+  context.throw_if_stopped(kWhat);
   result.timings.refine_ms = ms_since(refine_start);
   result.timings.objects_ms = ms_since(objects_start);
 

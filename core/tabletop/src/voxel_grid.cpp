@@ -44,7 +44,8 @@ void sort_checked(std::vector<T>& v, const std::stop_token& stop) {
 
 VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
                            const std::vector<std::uint32_t>& indices, float leaf,
-                           const std::stop_token& stop) {
+                           const RunContext& context) {
+  const std::stop_token& stop = context.stop;
   if (!(leaf > 0.0f) || !std::isfinite(leaf))
     throw std::invalid_argument("voxel leaf must be positive, got " + std::to_string(leaf));
   VoxelGrid grid;

@@ -54,7 +54,9 @@ class MeanFieldUpdater {
 };
 
 template <int KP>
-BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, MeanFieldBuffers& buffers) {
+BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, const RunContext& context,
+          MeanFieldBuffers& buffers) {
+  const int threads = primlabel::detail::resolve_threads(context.threads);
   ScratchBuffer<float>& q_buf = buffers.q;
   ScratchBuffer<float>& next_buf = buffers.next;
   const Graph& g = *pr.graph;
@@ -65,7 +67,7 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, MeanFieldBuffe
   // Start from the node-only posterior, in both buffers: rows without neighbours are never
   // rewritten.
   primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(settings.threads)
+#pragma omp parallel num_threads(threads)
   {
     FlushSubnormals flush;  // exp of very negative scores would run into slow subnormals
     MeanFieldUpdater<KP> updater(pr.classes, kp);
@@ -88,10 +90,10 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, MeanFieldBuffe
   std::fill_n(same, g.num_nodes(), std::uint8_t{1});  // both buffers start equal
   BpRun report;
   for (int iteration = 1; iteration <= settings.max_iterations; ++iteration) {
-    if (settings.stop.stop_requested()) break;
+    if (context.stopped()) break;
     float max_change = 0.0f;
     primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(settings.threads) reduction(max : max_change)
+#pragma omp parallel num_threads(threads) reduction(max : max_change)
     {
       FlushSubnormals flush;
       MeanFieldUpdater<KP> updater(pr.classes, kp);
@@ -99,7 +101,7 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, MeanFieldBuffe
 #pragma omp for schedule(dynamic, 1024)
       for (long long i = 0; i < n; ++i)
         barrier.run([&] {
-          if ((i & 1023) == 0) stopped = stopped || settings.stop.stop_requested();
+          if ((i & 1023) == 0) stopped = stopped || context.stopped();
           if (stopped) return;
           if (g.offsets[i] == g.offsets[i + 1]) return;  // no neighbours: q is final
           // Skip a node whose q and neighbours' q all settled last iteration (decided from the
@@ -133,18 +135,18 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, MeanFieldBuffe
 }  // namespace
 
 BpRun run_mean_field(const MeanFieldProblem& problem, const BpSettings& settings,
-                     MeanFieldBuffers& buffers) {
+                     const RunContext& context, MeanFieldBuffers& buffers) {
   switch (padded_classes(problem.classes)) {
     case 4:
-      return run<4>(problem, settings, buffers);
+      return run<4>(problem, settings, context, buffers);
     case 8:
-      return run<8>(problem, settings, buffers);
+      return run<8>(problem, settings, context, buffers);
     case 12:
-      return run<12>(problem, settings, buffers);
+      return run<12>(problem, settings, context, buffers);
     case 16:
-      return run<16>(problem, settings, buffers);
+      return run<16>(problem, settings, context, buffers);
     default:
-      return run<Eigen::Dynamic>(problem, settings, buffers);
+      return run<Eigen::Dynamic>(problem, settings, context, buffers);
   }
 }
 

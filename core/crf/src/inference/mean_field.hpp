@@ -4,7 +4,7 @@
 // thread from the previous iteration's rows, so the result does not depend on the thread count.
 // Float rows on the padded layouts of potentials.hpp; buffers come from the caller's workspace.
 
-#include "inference/loopy_bp.hpp"
+#include "inference/belief_propagation.hpp"
 
 namespace primlabel::crf::detail {
 
@@ -18,13 +18,13 @@ struct MeanFieldProblem {
 
 struct MeanFieldBuffers {
   ScratchBuffer<float> q, next;                         // num_nodes x kp
-  ScratchBuffer<std::uint8_t> moved, moved_next, same;  // per node, as in run_fast_bp
+  ScratchBuffer<std::uint8_t> moved, moved_next, same;  // per node, as in BeliefPropagation
 };
 
 // Starts from the node-only posterior; q ends in buffers.q (num_nodes x kp, rows sum to 1, pads
 // 0; inactive rows zero). Converged when no q value moved more than the tolerance. Nodes whose q
 // and neighbours' q all moved less than the tolerance in the previous iteration are skipped.
 BpRun run_mean_field(const MeanFieldProblem& problem, const BpSettings& settings,
-                     MeanFieldBuffers& buffers);
+                     const RunContext& context, MeanFieldBuffers& buffers);
 
 }  // namespace primlabel::crf::detail

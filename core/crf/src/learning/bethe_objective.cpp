@@ -9,12 +9,17 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <span>
 
 #include "primlabel/geometry/parallel.hpp"
 #include "learning/objectives.hpp"
 
 namespace primlabel::crf::detail {
 namespace {
+
+// theta is capped before exp, as in inference (potentials.cpp): psi stays far from float overflow.
+constexpr double kMaxEdgeScore = 60.0;
 
 // Sum of a_k * (log h_k - theta_k), skipping a_k == 0 (0 log 0 = 0).
 double weighted_log_ratio(const Eigen::ArrayXd& a, const Eigen::ArrayXd& h, const double* theta) {
@@ -24,36 +29,54 @@ double weighted_log_ratio(const Eigen::ArrayXd& a, const Eigen::ArrayXd& h, cons
   return s;
 }
 
+// One scene's BP state, kept between evaluations for warm starts.
+struct SceneBp {
+  BeliefPropagation bp;
+  ScratchBuffer<std::uint32_t> edge_of, block_first_edge;  // fixed: the graph does not change
+  ScratchBuffer<float> phi, psi_minus_one;                 // padded, from the current parameters
+  std::vector<float> saved;                                // the last converged messages
+};
+
 class BetheLikelihood final : public Objective {
  public:
   BetheLikelihood(const std::vector<PreparedScene>& scenes, const ParameterShape& shape,
-                  const BpSettings& bp)
-      : scenes_(scenes), shape_(shape), bp_(bp), blocks_(node_blocks(scenes)) {
+                  const BpSettings& bp, const RunContext& context)
+      : scenes_(scenes), shape_(shape), bp_(bp), context_(context), blocks_(node_blocks(scenes)) {
+    bp_.max_product = false;
+    bp_.fixed_point = true;
     for (const auto& s : scenes_) {
-      bps_.push_back(std::make_unique<LoopyBp>(*s.graph, shape.classes));
+      auto state = std::make_unique<SceneBp>();
+      number_edges(*s.graph, context_.threads, state->edge_of, state->block_first_edge,
+                   context_.stop);
+      bps_.push_back(std::move(state));
       for (int y : s.labels) labelled_ += y >= 0 ? 1 : 0;
     }
   }
 
   double evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) override {
     const int k_count = shape_.classes;
+    const int kp = padded_classes(k_count);
     const int row = shape_.node_row();
     const int edge_row = shape_.edge_row();
     const int d = shape_.edge_dim;
     const Eigen::Index half = shape_.node_size();
     const Eigen::Map<const RowMatrixXd> w(x.data(), k_count, row);
     const Eigen::Map<const RowMatrixXd> v(x.data() + half, k_count, edge_row);
-    const int threads = bp_.threads;
+    const int threads = context_.threads;
 
-    // Log-potentials in double; BP runs on their float images.
+    // Log-potentials in double; BP runs on their float images, in the layout inference uses.
     std::vector<RowMatrixXd> node_theta(scenes_.size()), edge_theta(scenes_.size());
     std::vector<RowMatrixXd> beliefs(scenes_.size());
     for (std::size_t s = 0; s < scenes_.size(); ++s) {
       const PreparedScene& scene = scenes_[s];
       const Graph& g = *scene.graph;
+      SceneBp& state = *bps_[s];
       const long long n = static_cast<long long>(g.num_nodes());
       node_theta[s].resize(n, k_count);
       edge_theta[s].setZero(g.num_slots(), k_count);
+      float* phi = state.phi.resize(std::size_t(n) * kp);
+      float* psi = state.psi_minus_one.resize(g.num_edges() * kp);
+      const std::uint32_t* edge_of = state.edge_of.data();
       primlabel::detail::ExceptionBarrier barrier;
 #pragma omp parallel num_threads(threads)
       {
@@ -62,6 +85,10 @@ class BetheLikelihood final : public Objective {
         for (long long i = 0; i < n; ++i)
           barrier.run([&] {
             node_theta[s].row(i).noalias() = scene.features.row(i) * w.transpose();
+            const auto theta = node_theta[s].row(i);
+            const double mx = theta.maxCoeff();
+            for (int k = 0; k < kp; ++k)
+              phi[i * kp + k] = k < k_count ? static_cast<float>(std::exp(theta(k) - mx)) : 0.0f;
             for (std::uint32_t p = g.offsets[i]; p < g.offsets[i + 1]; ++p) {
               const std::uint32_t j = g.neighbors[p];
               if (j < i) continue;
@@ -70,51 +97,64 @@ class BetheLikelihood final : public Objective {
               e(d) = 1.0;
               edge_theta[s].row(p).noalias() = e * v.transpose();
               edge_theta[s].row(g.reverse[p]) = edge_theta[s].row(p);
+              // psi - 1, with theta capped as inference caps it (far from float overflow).
+              float* out = psi + std::size_t(edge_of[p]) * kp;
+              for (int k = 0; k < kp; ++k)
+                out[k] = k < k_count ? static_cast<float>(
+                                           std::expm1(std::min(edge_theta[s](p, k), kMaxEdgeScore)))
+                                     : 0.0f;
             }
           });
       }
       barrier.rethrow();
-      RowMatrixXd phi(n, k_count);
-#pragma omp parallel for schedule(static) num_threads(threads)
-      for (long long i = 0; i < n; ++i)
-        barrier.run([&] {
-          phi.row(i) = (node_theta[s].row(i).array() - node_theta[s].row(i).maxCoeff()).exp();
-        });
-      barrier.rethrow();
-      RowMatrixXf psi_minus_one = edge_theta[s].cast<float>();
-      edge_scores_to_potentials_minus_one(psi_minus_one, threads);
-      BpSettings settings = bp_;
-      settings.max_product = false;
-      saved_messages_ = bps_[s]->messages();
-      last_run_ = bps_[s]->run(phi, psi_minus_one, settings);
-      if (!last_run_.converged) {
+      const BpPotentials potentials{&g, k_count, phi, psi, edge_of};
+      state.bp.set_potentials(potentials);  // a warm start once a run has converged
+      const BpRun run = state.bp.run(bp_, context_);
+      context_.throw_if_stopped("Bethe training");
+      if (!run.converged) {
         // Away from a BP fixed point the Bethe value and gradient are meaningless: report NaN so
         // the line search steps back, and keep the last converged messages for the next try.
-        bps_[s]->set_messages(saved_messages_);
+        if (state.saved.empty()) {
+          state.bp.reset(potentials);
+        } else {
+          state.bp.set_messages(state.saved);
+        }
         gradient.setZero(x.size());
         return std::numeric_limits<double>::quiet_NaN();
       }
-      beliefs[s] = bps_[s]->beliefs(phi, threads);
+      const std::span<const float> messages = state.bp.messages();
+      state.saved.assign(messages.begin(), messages.end());
+      beliefs[s] = RowMatrixXd::Zero(n, k_count);
+#pragma omp parallel for schedule(static) num_threads(threads)
+      for (long long i = 0; i < n; ++i)
+        barrier.run([&] {
+          if (g.active[i]) state.bp.beliefs(i, {beliefs[s].row(i).data(), std::size_t(k_count)});
+        });
+      barrier.rethrow();
     }
 
-    const long long block_count = static_cast<long long>(blocks_.size());
+    const auto block_count = static_cast<std::ptrdiff_t>(blocks_.size());
     partial_grad_.setZero(x.size(), block_count);
     partial_loss_.setZero(block_count);
-    primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads)
-    {
-      Eigen::ArrayXd hi(k_count), hj(k_count), a(k_count), c(k_count), psi_m1(k_count);
-      Eigen::RowVectorXd e(edge_row);
-#pragma omp for schedule(dynamic, 1)
-      for (long long b = 0; b < block_count; ++b)
-        barrier.run([&] {
+    struct Scratch {
+      Eigen::ArrayXd hi, hj, a, c, psi_m1;
+      Eigen::RowVectorXd e;
+    };
+    const auto make_scratch = [&] {
+      const Eigen::ArrayXd k_values(k_count);
+      return Scratch{k_values, k_values, k_values,
+                     k_values, k_values, Eigen::RowVectorXd(edge_row)};
+    };
+    primlabel::detail::for_each_block(
+        block_count, context_, make_scratch, [&](Scratch& scratch, std::ptrdiff_t b) {
+          auto& [hi, hj, a, c, psi_m1, e] = scratch;
           const NodeBlock& block = blocks_[b];
           const PreparedScene& scene = scenes_[block.scene];
           const Graph& g = *scene.graph;
           const RowMatrixXd& mu = beliefs[block.scene];
           const RowMatrixXd& theta = node_theta[block.scene];
           const RowMatrixXd& theta_e = edge_theta[block.scene];
-          const LoopyBp& bp = *bps_[block.scene];
+          const BeliefPropagation& bp = bps_[block.scene]->bp;
           Eigen::Map<RowMatrixXd> grad_w(partial_grad_.col(b).data(), k_count, row);
           Eigen::Map<RowMatrixXd> grad_v(partial_grad_.col(b).data() + half, k_count, edge_row);
           double loss = 0.0;  // -log-likelihood = -(empirical score) - F
@@ -163,8 +203,7 @@ class BetheLikelihood final : public Objective {
           }
           partial_loss_(b) = loss;
         });
-    }
-    barrier.rethrow();
+    context_.throw_if_stopped("Bethe training");
     return sum_blocks(partial_grad_, partial_loss_, labelled_, gradient);
   }
 
@@ -172,11 +211,10 @@ class BetheLikelihood final : public Objective {
   const std::vector<PreparedScene>& scenes_;
   ParameterShape shape_;
   BpSettings bp_;
+  RunContext context_;
   std::vector<NodeBlock> blocks_;
-  std::vector<std::unique_ptr<LoopyBp>> bps_;  // per scene, kept for warm starts
+  std::vector<std::unique_ptr<SceneBp>> bps_;  // per scene, kept for warm starts
   std::size_t labelled_ = 0;
-  BpRun last_run_;
-  std::vector<float> saved_messages_;
   Eigen::MatrixXd partial_grad_;
   Eigen::VectorXd partial_loss_;
 };
@@ -184,8 +222,9 @@ class BetheLikelihood final : public Objective {
 }  // namespace
 
 std::unique_ptr<Objective> make_bethe(const std::vector<PreparedScene>& scenes,
-                                      const ParameterShape& shape, const BpSettings& bp) {
-  return std::make_unique<BetheLikelihood>(scenes, shape, bp);
+                                      const ParameterShape& shape, const BpSettings& bp,
+                                      const RunContext& context) {
+  return std::make_unique<BetheLikelihood>(scenes, shape, bp, context);
 }
 
 }  // namespace primlabel::crf::detail

@@ -12,7 +12,7 @@
 #include <span>
 #include <vector>
 
-#include "inference/loopy_bp.hpp"
+#include "inference/belief_propagation.hpp"
 #include "node_features.hpp"
 #include "primlabel/crf/training.hpp"
 
@@ -63,10 +63,12 @@ class Objective {
 std::unique_ptr<Objective> make_pseudo_likelihood(const std::vector<PreparedScene>& scenes,
                                                   const ParameterShape& shape, int threads);
 
-// Log-likelihood with the Bethe approximation of log Z from loopy sum-product BP, warm-started
-// from the previous evaluation's messages.
+// Log-likelihood with the Bethe approximation of log Z from loopy sum-product BP (the kernel
+// inference uses), warm-started from the previous evaluation's messages. `context` (threads,
+// stop) serves every evaluation; a stopped one throws Cancelled.
 std::unique_ptr<Objective> make_bethe(const std::vector<PreparedScene>& scenes,
-                                      const ParameterShape& shape, const BpSettings& bp);
+                                      const ParameterShape& shape, const BpSettings& bp,
+                                      const RunContext& context);
 
 // Fixed node blocks over all scenes (the unit of deterministic summation).
 struct NodeBlock {

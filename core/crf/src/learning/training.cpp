@@ -116,8 +116,9 @@ void check_scenes(std::span<const LabeledGraph> scenes, int dim, int classes, co
 // every accepted iterate (see ReportingLineSearch) for the curve and the early-stop fallback.
 class Problem {
  public:
-  Problem(detail::Objective& objective, const detail::ParameterShape& shape, double l2)
-      : objective_(objective), shape_(shape), l2_(l2) {
+  Problem(detail::Objective& objective, const detail::ParameterShape& shape, double l2,
+          std::stop_token stop)
+      : objective_(objective), shape_(shape), l2_(l2), stop_(std::move(stop)) {
     regularised_ = Vector::Ones(shape.size());
     // Biases (the last column of W and of V) are free.
     for (int k = 0; k < shape.classes; ++k) {
@@ -128,6 +129,7 @@ class Problem {
   }
 
   double operator()(const Vector& x, Vector& grad) {
+    throw_if_stopped(stop_, "training");  // per evaluation: each one is a pass over the scenes
     const double loss = objective_.evaluate(x, grad);
     const Vector rx = regularised_.cwiseProduct(x);
     grad += l2_ * rx;
@@ -157,6 +159,7 @@ class Problem {
   detail::Objective& objective_;
   detail::ParameterShape shape_;
   double l2_;
+  std::stop_token stop_;
   Vector regularised_;
   Vector best_x_;
   double best_fx_ = std::numeric_limits<double>::infinity();
@@ -180,10 +183,11 @@ class ReportingLineSearch {
 }  // namespace
 
 double labeled_accuracy(const CrfModel& model, std::span<const LabeledGraph> scenes,
-                        const InferenceOptions& inference) {
+                        const InferenceSettings& inference, const RunContext& context) {
   std::size_t labelled = 0, correct = 0;
   for (const LabeledGraph& scene : scenes) {
-    const InferenceResult result = infer(model, scene.descriptors, scene.graph, inference);
+    const InferenceResult result =
+        infer(model, scene.descriptors, scene.graph, inference, {}, context);
     for (std::size_t i = 0; i < scene.labels.size(); ++i) {
       const int y = scene.labels[i];
       if (y < 0) continue;
@@ -198,7 +202,7 @@ double labeled_accuracy(const CrfModel& model, std::span<const LabeledGraph> sce
 TrainingResult train_crf(std::span<const LabeledGraph> training,
                          std::span<const LabeledGraph> validation,
                          const std::vector<std::uint32_t>& class_ids,
-                         const TrainingOptions& options) {
+                         const TrainingOptions& options, const RunContext& context) {
   if (training.empty()) throw std::invalid_argument("train_crf: no training scenes");
   if (class_ids.empty()) throw std::invalid_argument("train_crf: no classes");
   const int dim = training.front().descriptor_dim;
@@ -210,7 +214,7 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
   if (options.max_iterations < 1) throw std::invalid_argument("train_crf: max_iterations < 1");
   std::size_t total_nodes = 0;
   for (const auto& scene : training) total_nodes += scene.graph.num_nodes();
-  const int threads = detail::useful_threads(options.threads, total_nodes);
+  const int threads = detail::useful_threads(context.threads, total_nodes);
   const auto started = std::chrono::steady_clock::now();
 
   // The zero model fixes the shapes (and checks the scale and knots).
@@ -239,16 +243,14 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
     bp.max_iterations = std::max(options.inference.max_iterations, 100);
     bp.damping = options.inference.damping;
     bp.tolerance = std::min(options.inference.tolerance, 1e-4f);
-    bp.threads = threads;
-    objective = detail::make_bethe(scenes, shape, bp);
+    objective = detail::make_bethe(scenes, shape, bp, context.with_threads(threads));
   } else {
     objective = detail::make_pseudo_likelihood(scenes, shape, threads);
   }
 
   TrainingResult result;
-  Problem problem(*objective, shape, options.l2);
-  InferenceOptions inference = options.inference;
-  inference.threads = options.threads;
+  Problem problem(*objective, shape, options.l2, context.stop);
+  const InferenceSettings& inference = options.inference;
   const auto seconds = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   };
@@ -259,9 +261,9 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
     it.validation_accuracy = std::numeric_limits<double>::quiet_NaN();
     if (options.on_iteration) {
       const CrfModel model = detail::model_from_parameters(x, shape, like);
-      it.train_accuracy = labeled_accuracy(model, training, inference);
+      it.train_accuracy = labeled_accuracy(model, training, inference, context);
       if (!validation.empty())
-        it.validation_accuracy = labeled_accuracy(model, validation, inference);
+        it.validation_accuracy = labeled_accuracy(model, validation, inference, context);
     } else {
       it.train_accuracy = std::numeric_limits<double>::quiet_NaN();
     }

@@ -125,37 +125,39 @@ void weight_spfh(const PointCloud& cloud, std::size_t p, const std::vector<float
 }  // namespace
 
 std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
-                                FeatureStats* stats, const NeighborSearch* search) {
+                                const RunContext& context, FeatureStats* stats,
+                                const NeighborSearch* search) {
+  const std::stop_token& stop = context.stop;
   if (!options.neighborhood.valid())
     throw std::invalid_argument("FPFH: invalid neighbourhood " + options.neighborhood.describe());
   const std::vector<char> usable = detail::usable_points(cloud, "FPFH");
   std::unique_ptr<NeighborSearch> owned;
-  const NeighborSearch& index = detail::ensure_search(cloud, search, owned, options.stop);
+  const NeighborSearch& index = detail::ensure_search(cloud, search, owned, stop);
 
   const std::size_t n = cloud.size();
   const std::ptrdiff_t blocks = static_cast<std::ptrdiff_t>((n + kBlock - 1) / kBlock);
-  const int threads = detail::resolve_threads(options.threads);
+  const int threads = detail::resolve_threads(context.threads);
   // Radius neighbourhoods need no order: every sum below is order-independent up to rounding,
   // and tree order is itself deterministic.
   const bool sorted = false;
 
   std::vector<float> spfh;
   std::vector<double> spfh_sums;  // per sub-histogram, for the normalisation
-  detail::assign_checked(spfh, n * kFpfhSize, 0.0f, options.stop, "FPFH");
-  detail::assign_checked(spfh_sums, n * 3, 0.0, options.stop, "FPFH");
+  detail::assign_checked(spfh, n * kFpfhSize, 0.0f, stop, "FPFH");
+  detail::assign_checked(spfh_sums, n * 3, 0.0, stop, "FPFH");
   NeighborCache cache(n, options.neighbor_cache_bytes);
-  detail::ProgressCounter progress(options.progress, 2 * n);
+  detail::ProgressCounter progress(context.progress, 2 * n);
   struct Pass1Scratch {
     NeighborList neighbors;
     SpfhScratch pairs;
   };
   detail::for_each_block(
-      threads, blocks, options.stop, [] { return Pass1Scratch(); },
+      blocks, context.with_threads(threads), [] { return Pass1Scratch(); },
       [&](Pass1Scratch& scratch, std::ptrdiff_t block) {
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
         for (std::size_t p = first; p < last; ++p) {
           // Per point: a stop is honoured within one (capped) neighbourhood's time.
-          if (options.stop.stop_requested()) return;
+          if (stop.stop_requested()) return;
           if (!usable[p]) continue;
           NeighborList& neighbors = scratch.neighbors;
           detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, sorted,
@@ -169,18 +171,18 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
         progress.add(last - first);
       });
 
-  throw_if_stopped(options.stop, "FPFH");
+  throw_if_stopped(stop, "FPFH");
 
   std::vector<float> fpfh;
-  detail::assign_checked(fpfh, n * kFpfhSize, 0.0f, options.stop, "FPFH");
+  detail::assign_checked(fpfh, n * kFpfhSize, 0.0f, stop, "FPFH");
   std::atomic<std::size_t> computed{0}, isolated{0};
   detail::for_each_block(
-      threads, blocks, options.stop, [] { return NeighborList(); },
+      blocks, context.with_threads(threads), [] { return NeighborList(); },
       [&](NeighborList& neighbors, std::ptrdiff_t block) {
         std::size_t block_computed = 0, block_isolated = 0;
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
         for (std::size_t p = first; p < last; ++p) {
-          if (options.stop.stop_requested()) return;
+          if (stop.stop_requested()) return;
           float* out = &fpfh[p * kFpfhSize];
           if (!usable[p]) {
             std::fill(out, out + kFpfhSize, std::numeric_limits<float>::quiet_NaN());
@@ -201,7 +203,7 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
         computed += block_computed, isolated += block_isolated;
         progress.add(last - first);
       });
-  throw_if_stopped(options.stop, "FPFH");
+  throw_if_stopped(stop, "FPFH");
   progress.finish();
   if (stats) *stats = FeatureStats{computed.load(), isolated.load(), n - computed - isolated};
   return fpfh;

@@ -48,18 +48,20 @@ void compute_point_pfh(const PointCloud& cloud, const NeighborList& neighbors, P
 }  // namespace
 
 std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& options,
-                               FeatureStats* stats, const NeighborSearch* search) {
+                               const RunContext& context, FeatureStats* stats,
+                               const NeighborSearch* search) {
+  const std::stop_token& stop = context.stop;
   if (!options.neighborhood.valid())
     throw std::invalid_argument("PFH: invalid neighbourhood " + options.neighborhood.describe());
   const std::vector<char> usable = detail::usable_points(cloud, "PFH");
   std::unique_ptr<NeighborSearch> owned;
-  const NeighborSearch& index = detail::ensure_search(cloud, search, owned, options.stop);
+  const NeighborSearch& index = detail::ensure_search(cloud, search, owned, stop);
 
   const std::size_t n = cloud.size();
   std::vector<float> pfh;
-  detail::assign_checked(pfh, n * kPfhSize, 0.0f, options.stop, "PFH");
+  detail::assign_checked(pfh, n * kPfhSize, 0.0f, stop, "PFH");
   std::atomic<std::size_t> computed{0}, isolated{0};
-  detail::ProgressCounter progress(options.progress, n);
+  detail::ProgressCounter progress(context.progress, n);
   constexpr std::size_t kBlock = 64;
   const auto blocks = static_cast<std::ptrdiff_t>((n + kBlock - 1) / kBlock);
   struct Scratch {
@@ -68,12 +70,11 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
   };
   const auto make_scratch = [] { return Scratch(); };
   detail::for_each_block(
-      detail::resolve_threads(options.threads), blocks, options.stop, make_scratch,
-      [&](Scratch& scratch, std::ptrdiff_t block) {
+      blocks, context, make_scratch, [&](Scratch& scratch, std::ptrdiff_t block) {
         std::size_t block_computed = 0, block_isolated = 0;
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
         for (std::size_t p = first; p < last; ++p) {
-          if (options.stop.stop_requested()) return;  // per point: O(k^2) each
+          if (stop.stop_requested()) return;  // per point: O(k^2) each
           float* out = &pfh[p * kPfhSize];
           if (!usable[p]) {
             std::fill(out, out + kPfhSize, std::numeric_limits<float>::quiet_NaN());
@@ -93,7 +94,7 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
         computed += block_computed, isolated += block_isolated;
         progress.add(last - first);
       });
-  throw_if_stopped(options.stop, "PFH");
+  throw_if_stopped(stop, "PFH");
   progress.finish();
   if (stats) *stats = FeatureStats{computed.load(), isolated.load(), n - computed - isolated};
   return pfh;

@@ -189,7 +189,8 @@ Fig4 run_fig4(const Fig4Options& options) {
   SignatureAccumulator accumulator(options.features.descriptor_dim());
   for (int i = 0; i < options.scenes; ++i) {
     PointCloud cloud = synth::synthetic_scene(synth::SceneSet::kTrain, i, options.sensor);
-    const pipeline::DescribedCloud described = pipeline::describe_cloud(cloud, options.features, options.threads);
+    const pipeline::DescribedCloud described =
+        pipeline::describe_cloud(cloud, options.features, RunContext{options.threads});
     accumulator.add(cloud.labels, described.descriptors);
     if (options.progress)
       options.progress("fig4: " + std::string(synth::set_name(synth::SceneSet::kTrain)) + " seed " +

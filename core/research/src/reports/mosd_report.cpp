@@ -53,12 +53,13 @@ double MosdSceneReport::object_plane_share() const { return share(object_plane, 
 double MosdReport::plane_share() const { return share(table_plane, table_points); }
 
 MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& path,
-                                  const std::string& png_path, const pipeline::LabelingOptions& options) {
+                                  const std::string& png_path, const pipeline::LabelingOptions& options,
+                                  const RunContext& context) {
   PointCloud cloud = read_cloud(path);
   if (!cloud.has_labels())
     throw std::runtime_error(path + ": no label field (an mOSD scene labels table and objects)");
   const std::vector<std::uint32_t> segments = cloud.labels;
-  const pipeline::LabelingResult result = pipeline::label_cloud(model, cloud, options);
+  const pipeline::LabelingResult result = pipeline::label_cloud(model, cloud, options, context);
 
   MosdSceneReport report;
   report.file = path;

@@ -40,7 +40,7 @@ std::vector<Table1Row> rows_for(const FeatureSettings& features, const std::stri
   auto say = [&](const std::string& line) {
     if (options.progress) options.progress(line);
   };
-  crf::GraphOptions graph;
+  crf::GraphSettings graph;
   const std::vector<std::uint32_t> all_ids = [] {
     std::vector<std::uint32_t> ids;
     for (PrimitiveClass c : all_classes())
@@ -48,6 +48,7 @@ std::vector<Table1Row> rows_for(const FeatureSettings& features, const std::stri
     return ids;
   }();
 
+  const RunContext context{options.threads};  // the report's one thread setting
   std::vector<pipeline::SceneData> train, test;
   double feature_seconds = 0;
   std::size_t described_points = 0;
@@ -55,8 +56,7 @@ std::vector<Table1Row> rows_for(const FeatureSettings& features, const std::stri
     for (int i = 0; i < count; ++i) {
       PointCloud cloud = synth::synthetic_scene(set, i, options.sensor);
       const std::string source = std::string(synth::set_name(set)) + "#" + std::to_string(i);
-      out.push_back(
-          pipeline::prepare_scene(std::move(cloud), source, features, graph, all_ids, options.threads));
+      out.push_back(pipeline::prepare_scene(std::move(cloud), source, features, graph, all_ids, context));
       feature_seconds += out.back().feature_seconds;
       described_points += out.back().truth.size();
       say(format("%s: %s described (%zu points, %.1f s)", descriptor.c_str(), source.c_str(),
@@ -79,13 +79,12 @@ std::vector<Table1Row> rows_for(const FeatureSettings& features, const std::stri
     training.l2 = options.l2;
     training.iterations = options.iterations;
     training.node_knots = options.node_knots;
-    training.threads = options.threads;
     const pipeline::ModelTrainingResult trained =
-        pipeline::train_label_model(train, {}, class_ids, features, graph, training);
+        pipeline::train_label_model(train, {}, class_ids, features, graph, training, context);
     crf::ConfusionMatrix confusion(class_ids);
     const auto start = std::chrono::steady_clock::now();
     for (const pipeline::SceneData& s : test)
-      confusion.add(s.truth, pipeline::predict_scene(trained.model, s, options.threads), 0u);
+      confusion.add(s.truth, pipeline::predict_scene(trained.model, s, context), 0u);
     const double test_seconds = seconds_since(start);
     Table1Row row{kind == ModelKind::kCrf ? "crf" : "node",
                   descriptor,

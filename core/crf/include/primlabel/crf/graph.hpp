@@ -11,12 +11,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
-#include <stop_token>
 #include <utility>
 #include <vector>
 
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/geometry/run_context.hpp"
 
 namespace primlabel::crf {
 
@@ -36,14 +36,11 @@ struct Graph {
   }
 };
 
-struct GraphOptions {
+// What defines a model's graph, stored in model files (how a call runs is a RunContext).
+struct GraphSettings {
   // Neighbours of each point, not counting the point itself: Knn(8) links every point to its 8
   // nearest others; Radius(r) / Hybrid(r, m) to the others within r (the m nearest of them).
   Neighborhood neighborhood = Neighborhood::Knn(8);
-  int threads = 0;  // 0 = OpenMP default; the graph is identical for any value
-  // Checked per block of points while the graph (and its own neighbour index, when one is
-  // needed) is built; build_graph then throws primlabel::Cancelled.
-  std::stop_token stop;
 };
 
 // A row of `dim` values is a valid descriptor when every value is finite (features.hpp marks
@@ -56,9 +53,11 @@ std::vector<std::uint8_t> valid_descriptor_mask(std::span<const float> descripto
 // row-major points.size() x dim. `search` may be passed to reuse an index built on `points`; it
 // is used only when every finite point has a valid descriptor (otherwise an index over the valid
 // points is built), so the graph never depends on whether it was passed. Throws
-// primlabel::Cancelled when options.stop is requested.
+// primlabel::Cancelled when context.stop is requested (checked per block of points, and while
+// the graph's own neighbour index is built). The graph is identical for any context.threads.
 Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descriptors, int dim,
-                  const GraphOptions& options = {}, const NeighborSearch* search = nullptr);
+                  const GraphSettings& settings = {}, const RunContext& context = {},
+                  const NeighborSearch* search = nullptr);
 
 // A graph from an explicit undirected edge list (tests, synthetic data, other sources). Self
 // loops, duplicates and edges touching inactive nodes are dropped. `active` defaults to all.

@@ -13,9 +13,9 @@
 #include <cstdint>
 #include <memory>
 #include <span>
-#include <stop_token>
 #include <vector>
 
+#include "primlabel/geometry/run_context.hpp"
 #include "primlabel/crf/graph.hpp"
 #include "primlabel/crf/model.hpp"
 
@@ -26,7 +26,8 @@ enum class InferenceMethod {
   kMeanField,  // naive mean-field: q_i(k) ∝ exp(theta_i(k) + sum_j q_j(k) theta_ij(k, k))
 };
 
-struct InferenceOptions {
+// How a model labels, stored in model files (how a call runs is a RunContext).
+struct InferenceSettings {
   InferenceMethod method = InferenceMethod::kLoopyBp;
   bool max_product = false;  // BP only: MAP labels from max-marginals instead of marginals
   // BP and mean-field converge on scan-like graphs within ~15 iterations (damping 0.5); nodes
@@ -40,12 +41,12 @@ struct InferenceOptions {
   // whose messages (q) and whose neighbours' moved less than this in the previous iteration is
   // not recomputed.
   float tolerance = 1e-3f;
-  bool compute_marginals = false;
+};
+
+// What one call returns besides the labels.
+struct InferenceOutputs {
+  bool marginals = false;           // InferenceResult::marginals
   std::uint32_t unknown_label = 0;  // label of points without a descriptor
-  int threads = 0;                  // 0 = OpenMP default; results do not depend on it
-  // Checked between iterations and per block of nodes inside them; once stopped, infer throws
-  // primlabel::Cancelled.
-  std::stop_token stop;
 };
 
 struct InferenceResult {
@@ -78,18 +79,22 @@ class InferenceWorkspace {
 
  private:
   friend InferenceResult infer(const CrfModel&, std::span<const float>, const Graph&,
-                               const InferenceOptions&, InferenceWorkspace&);
+                               const InferenceSettings&, const InferenceOutputs&, const RunContext&,
+                               InferenceWorkspace&);
   std::unique_ptr<Buffers> buffers_;
 };
 
 // `descriptors` is row-major graph.num_nodes() x model.descriptor_dim. Nodes the graph marks
-// inactive get options.unknown_label. A model without edge terms (or a graph without edges)
+// inactive get outputs.unknown_label. A model without edge terms (or a graph without edges)
 // reduces to the per-node argmax. Throws std::invalid_argument on shape mismatches and
-// primlabel::Cancelled when options.stop is requested.
+// primlabel::Cancelled when context.stop is requested (checked between iterations and per block
+// of nodes inside them). Results do not depend on context.threads.
 InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
-                      const InferenceOptions& options = {});
+                      const InferenceSettings& settings = {}, const InferenceOutputs& outputs = {},
+                      const RunContext& context = {});
 // The same, with the caller's buffers (bit-identical results).
 InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
-                      const InferenceOptions& options, InferenceWorkspace& workspace);
+                      const InferenceSettings& settings, const InferenceOutputs& outputs,
+                      const RunContext& context, InferenceWorkspace& workspace);
 
 }  // namespace primlabel::crf

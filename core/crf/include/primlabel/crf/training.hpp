@@ -54,12 +54,11 @@ struct TrainingOptions {
   double l2 = 1e-3;
   int max_iterations = 100;
   double epsilon = 1e-5;  // stop when |gradient| <= epsilon * max(1, |weights|)
-  int threads = 0;        // 0 = OpenMP default; the model does not depend on it
   float feature_scale = 0.01f;
   // The node feature basis (crf/model.hpp): tent knots, or empty for the paper's identity.
   std::vector<float> node_knots = default_node_knots();
   // BP used by kBetheBp (sum-product) and to measure accuracies for on_iteration.
-  InferenceOptions inference;
+  InferenceSettings inference;
   // Called after every L-BFGS iteration with accuracies measured by inference; when empty, no
   // accuracy is computed (training is faster).
   std::function<void(const TrainingIteration&)> on_iteration;
@@ -76,15 +75,17 @@ struct TrainingResult {
 };
 
 // class_ids[k] names class index k in the model. Throws std::invalid_argument for inconsistent
-// data (shapes, labels out of range, descriptor dimensions that differ).
+// data (shapes, labels out of range, descriptor dimensions that differ), and Cancelled when
+// context.stop is requested (checked inside every evaluation). The model does not depend on
+// context.threads.
 TrainingResult train_crf(std::span<const LabeledGraph> training,
                          std::span<const LabeledGraph> validation,
                          const std::vector<std::uint32_t>& class_ids,
-                         const TrainingOptions& options = {});
+                         const TrainingOptions& options = {}, const RunContext& context = {});
 
 // Fraction of labelled points (label >= 0) whose predicted class index equals the label.
 double labeled_accuracy(const CrfModel& model, std::span<const LabeledGraph> scenes,
-                        const InferenceOptions& inference);
+                        const InferenceSettings& inference, const RunContext& context = {});
 
 // The training curve as CSV: header
 // "iteration,objective,train_accuracy,validation_accuracy,seconds".

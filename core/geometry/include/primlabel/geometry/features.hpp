@@ -9,12 +9,12 @@
 // bin 0).
 
 #include <cstddef>
-#include <stop_token>
 #include <vector>
 
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/progress.hpp"
+#include "primlabel/geometry/run_context.hpp"
 
 namespace primlabel {
 
@@ -31,13 +31,9 @@ enum class FpfhVariant {
 struct FeatureOptions {
   Neighborhood neighborhood = Neighborhood::Knn(10);
   FpfhVariant fpfh_variant = FpfhVariant::kPcl;
-  int threads = 0;  // 0 = OpenMP default
   // FPFH keeps each point's neighbour list between its two passes up to this many bytes (4 per
   // neighbour); points beyond it are searched twice. Results do not depend on it.
   std::size_t neighbor_cache_bytes = std::size_t(1) << 30;
-  ProgressFn progress;
-  // Once stopped, the remaining blocks of points are skipped and the function throws Cancelled.
-  std::stop_token stop;
 };
 
 struct FeatureStats {
@@ -46,14 +42,16 @@ struct FeatureStats {
   std::size_t nan = 0;       // invalid points or normals: NaN descriptor
 };
 
-// Row-major size() x 33. Requires cloud.normals.
+// Row-major size() x 33. Requires cloud.normals. Once context.stop is requested the remaining
+// blocks of points are skipped and the function throws Cancelled; context.progress counts points
+// (twice: both passes).
 std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
-                                FeatureStats* stats = nullptr,
+                                const RunContext& context = {}, FeatureStats* stats = nullptr,
                                 const NeighborSearch* search = nullptr);
 
-// Row-major size() x 125. Requires cloud.normals.
+// Row-major size() x 125. Requires cloud.normals. context as for compute_fpfh.
 std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& options,
-                               FeatureStats* stats = nullptr,
+                               const RunContext& context = {}, FeatureStats* stats = nullptr,
                                const NeighborSearch* search = nullptr);
 
 // The four pair features of (p1, n1) and (p2, n2) as pcl::computePairFeatures defines them:

@@ -4,11 +4,11 @@
 // lambda0 / (lambda0 + lambda1 + lambda2). Matches PCL's NormalEstimation.
 
 #include <optional>
-#include <stop_token>
 
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/progress.hpp"
+#include "primlabel/geometry/run_context.hpp"
 
 namespace primlabel {
 
@@ -16,10 +16,6 @@ struct NormalOptions {
   Neighborhood neighborhood = Neighborhood::Knn(10);
   // Normals are flipped to face this point; defaults to the cloud's VIEWPOINT origin.
   std::optional<Vec3f> viewpoint;
-  int threads = 0;  // 0 = OpenMP default
-  ProgressFn progress;
-  // Once stopped, the remaining points are skipped and estimate_normals throws Cancelled.
-  std::stop_token stop;
 };
 
 struct NormalStats {
@@ -30,8 +26,10 @@ struct NormalStats {
 
 // Fills cloud.normals and cloud.curvature (one per point). Points that cannot get a normal get NaN
 // normal and NaN curvature and are counted in the returned stats. `search` may be passed to reuse
-// an index built on cloud.xyz.
+// an index built on cloud.xyz. Once context.stop is requested the remaining points are skipped
+// and estimate_normals throws Cancelled; context.progress counts points.
 NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
+                             const RunContext& context = {},
                              const NeighborSearch* search = nullptr);
 
 }  // namespace primlabel

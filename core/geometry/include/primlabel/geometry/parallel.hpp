@@ -15,6 +15,7 @@
 
 #include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/geometry/progress.hpp"
+#include "primlabel/geometry/run_context.hpp"
 
 namespace primlabel::detail {
 
@@ -50,14 +51,17 @@ class ExceptionBarrier {
 };
 
 // body(scratch, block) for every block in [0, blocks), one block at a time per thread (dynamic
-// schedule), with one scratch per thread made by make_scratch(). Blocks are skipped once `stop`
-// is requested (the caller then throws Cancelled) or once a block has thrown; the first
-// exception is rethrown here, after the region.
+// schedule), on context.threads threads (0 = OpenMP default), with one scratch per thread made by
+// make_scratch(). The blocks are the caller's fixed unit of work, so what a block computes never
+// depends on the thread count. Blocks are skipped once context.stop is requested (the caller then
+// throws Cancelled) or once a block has thrown; the first exception is rethrown here, after the
+// region.
 template <typename MakeScratch, typename Body>
-void for_each_block(int threads, std::ptrdiff_t blocks, const std::stop_token& stop,
-                    MakeScratch&& make_scratch, Body&& body) {
+void for_each_block(std::ptrdiff_t blocks, const RunContext& context, MakeScratch&& make_scratch,
+                    Body&& body) {
   ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads)
+  const std::stop_token& stop = context.stop;
+#pragma omp parallel num_threads(resolve_threads(context.threads))
   {
     std::optional<decltype(make_scratch())> scratch;
     barrier.run([&] { scratch.emplace(make_scratch()); });

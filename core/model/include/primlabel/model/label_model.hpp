@@ -68,13 +68,13 @@ struct LabelModel {
   std::string version;
   ModelKind kind = ModelKind::kCrf;
   FeatureSettings features;
-  crf::GraphOptions graph;
+  crf::GraphSettings graph;
   crf::CrfModel weights;  // kCrf, kNodeOnly (class_ids are the model's classes)
   // kSvm: libsvm's text model (crf::SvmClassifier::to_libsvm_text; its labels index
   // svm_class_ids), the classes, and weights.feature_scale as the SVM's feature scale.
   std::string svm_model;
   std::vector<std::uint32_t> svm_class_ids;
-  crf::InferenceOptions inference;
+  crf::InferenceSettings inference;
   TrainingSummary training;
   EvaluationSummary validation;
   std::int64_t created_unix_ms = 0;

@@ -6,12 +6,12 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
-#include <stop_token>
 #include <vector>
 
 #include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/geometry/run_context.hpp"
 #include "primlabel/crf/graph.hpp"
 #include "primlabel/crf/training.hpp"
 #include "primlabel/model/label_model.hpp"
@@ -42,20 +42,20 @@ inline constexpr int kDefaultMaxNeighbors = 1024;
 Neighborhood capped(const Neighborhood& hood);
 
 struct DescribeOptions {
-  int threads = 0;  // 0 = OpenMP default
   // Keep cloud.normals (one per point, e.g. from the sensor) instead of estimating them.
   bool use_cloud_normals = false;
-  std::stop_token stop;  // checked per point and inside the index builds; throws Cancelled
 };
 
 // Throws std::invalid_argument for settings describe_cloud cannot honour (voxel downsampling:
-// label_cloud does it) or a missing normal per point with use_cloud_normals.
+// label_cloud does it) or a missing normal per point with use_cloud_normals, and Cancelled when
+// context.stop is requested (checked per point and inside the index builds).
 DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings,
-                              const DescribeOptions& options);
-DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings, int threads = 0);
+                              const DescribeOptions& options, const RunContext& context = {});
+DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings,
+                              const RunContext& context = {});
 
 crf::Graph build_scene_graph(const PointCloud& cloud, const DescribedCloud& described,
-                             const crf::GraphOptions& options);
+                             const crf::GraphSettings& settings, const RunContext& context = {});
 
 // A training / validation scene: labels become class indices into `class_ids`; taxonomy ids that
 // are not one of the model's classes (kUnknown included) become kIgnoreLabel.
@@ -63,7 +63,6 @@ crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& des
                                    crf::Graph graph, const std::vector<std::uint32_t>& class_ids);
 
 struct LabelingOptions {
-  int threads = 0;  // 0 = OpenMP default; the labels do not depend on it
   bool want_probabilities = false;
   bool want_descriptors = false;  // LabelingResult.descriptors
   bool tabletop_only = false;     // label only the table and the objects on it; the rest is unknown
@@ -76,9 +75,6 @@ struct LabelingOptions {
   // allow it (radii_overridable), else label_cloud throws std::invalid_argument.
   float normal_radius = 0.0f;
   float feature_radius = 0.0f;
-  // Checked between stages and per point inside them (and in the table-top stage, the voxel
-  // filter and the index builds); label_cloud then throws Cancelled, within milliseconds.
-  std::stop_token stop;
 };
 
 struct LabelingResult {
@@ -102,9 +98,11 @@ struct LabelingResult {
 // Exact duplicates are described once (duplicates.hpp): every copy gets the labels,
 // probabilities, descriptor and normal of its lowest-index copy.
 // Throws ModelError when an SVM model's libsvm text does not load, std::invalid_argument for
-// overrides the model does not allow or missing normals, and Cancelled when options.stop is
-// requested.
+// overrides the model does not allow or missing normals, and Cancelled when context.stop is
+// requested (checked between stages and per point inside them, the table-top stage, the voxel
+// filter and the index builds included: within milliseconds). The labels do not depend on
+// context.threads.
 LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
-                           const LabelingOptions& options = {});
+                           const LabelingOptions& options = {}, const RunContext& context = {});
 
 }  // namespace primlabel::pipeline

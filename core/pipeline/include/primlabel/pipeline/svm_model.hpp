@@ -16,8 +16,9 @@ namespace primlabel::pipeline {
 ModelTrainingResult train_svm_model(std::span<const SceneData> training,
                                     std::span<const SceneData> validation,
                                     const std::vector<std::uint32_t>& class_ids,
-                                    const FeatureSettings& features, const crf::GraphOptions& graph,
-                                    const crf::SvmOptions& options, int threads);
+                                    const FeatureSettings& features,
+                                    const crf::GraphSettings& graph, const crf::SvmOptions& options,
+                                    const RunContext& context = {});
 
 // The classifier in an SVM model; throws ModelError when its libsvm text does not load.
 crf::SvmClassifier svm_classifier_of(const LabelModel& model);
@@ -25,6 +26,7 @@ crf::SvmClassifier svm_classifier_of(const LabelModel& model);
 // Labels described points with an SVM model into `result`: labels, probabilities and descriptors
 // when asked, labeled points and inference time (the feature fields are left alone).
 void classify_with_svm(const LabelModel& model, DescribedCloud&& described,
-                       const LabelingOptions& options, LabelingResult& result);
+                       const LabelingOptions& options, const RunContext& context,
+                       LabelingResult& result);
 
 }  // namespace primlabel::pipeline

@@ -27,8 +27,9 @@ struct SceneData {
 
 // Describes a labeled cloud and builds its graph (labels are assigned with `class_ids`).
 SceneData prepare_scene(PointCloud cloud, std::string source, const FeatureSettings& features,
-                        const crf::GraphOptions& graph, const std::vector<std::uint32_t>& class_ids,
-                        int threads);
+                        const crf::GraphSettings& graph,
+                        const std::vector<std::uint32_t>& class_ids,
+                        const RunContext& context = {});
 
 // Relabels the scene's graph for a class list (ids outside it are ignored).
 void assign_labels(SceneData& scene, const std::vector<std::uint32_t>& class_ids);
@@ -41,7 +42,6 @@ struct ModelTrainingOptions {
   crf::TrainingObjective objective = crf::TrainingObjective::kPiecewise;
   double l2 = 1e-6;
   int iterations = 200;
-  int threads = 0;
   // CRF and node-only: the tent basis of the node features (crf/model.hpp); empty = identity.
   std::vector<float> node_knots = crf::default_node_knots();
   // CRF: scale the learnt couplings down to what labels the validation scenes (or, without them,
@@ -70,16 +70,17 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
                                       std::span<const SceneData> validation,
                                       const std::vector<std::uint32_t>& class_ids,
                                       const FeatureSettings& features,
-                                      const crf::GraphOptions& graph,
-                                      const ModelTrainingOptions& options);
+                                      const crf::GraphSettings& graph,
+                                      const ModelTrainingOptions& options,
+                                      const RunContext& context = {});
 
 // Predicted taxonomy ids for a described scene.
 std::vector<std::uint32_t> predict_scene(const LabelModel& model, const SceneData& scene,
-                                         int threads);
+                                         const RunContext& context = {});
 
 // Confusion of predictions against the scene truth over the model's classes (truth 0 skipped).
 crf::ConfusionMatrix evaluate_scenes(const LabelModel& model, std::span<const SceneData> scenes,
-                                     int threads);
+                                     const RunContext& context = {});
 
 EvaluationSummary summarize(const crf::ConfusionMatrix& confusion);
 

@@ -7,11 +7,11 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
-#include <stop_token>
 #include <string>
 #include <vector>
 
 #include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/geometry/run_context.hpp"
 
 namespace primlabel::tabletop {
 
@@ -25,8 +25,6 @@ struct PlaneFitOptions {
   std::size_t min_inliers = 100;           // fewer inliers than this is "no plane"
   int refine_iterations = 5;               // least-squares refit / re-select rounds
   std::uint64_t seed = 1;
-  int threads = 0;       // 0 = OpenMP default
-  std::stop_token stop;  // checked per round of hypotheses; fit_plane then throws Cancelled
 
   void validate() const;  // throws std::invalid_argument naming the bad option
 };
@@ -53,9 +51,10 @@ struct PlaneFit {
 };
 
 // Fits a plane to points[indices] (all finite). Data conditions give a status, never a throw;
-// invalid options throw std::invalid_argument.
+// invalid options throw std::invalid_argument. context.stop is checked per round of hypotheses
+// (fit_plane then throws Cancelled); the fit does not depend on context.threads.
 PlaneFit fit_plane(const std::vector<Vec3f>& points, const std::vector<std::uint32_t>& indices,
-                   const PlaneFitOptions& options);
+                   const PlaneFitOptions& options, const RunContext& context = {});
 
 struct PlaneEstimate {
   Eigen::Vector4f plane;       // NaN for fewer than three points

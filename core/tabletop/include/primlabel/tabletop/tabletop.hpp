@@ -13,11 +13,11 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
-#include <stop_token>
 #include <string>
 #include <vector>
 
 #include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/geometry/run_context.hpp"
 #include "primlabel/tabletop/euclidean_clusters.hpp"
 #include "primlabel/tabletop/occlusion_merge.hpp"
 #include "primlabel/tabletop/plane_fit.hpp"
@@ -65,10 +65,6 @@ struct TabletopOptions {
   OcclusionMergeOptions merge;  // parts of one object cut apart by occlusion (organised clouds)
 
   std::uint64_t seed = 1;  // RANSAC seed (copied into plane.seed)
-  int threads = 0;         // 0 = OpenMP default; results do not depend on it
-  // Checked between the stages, per round of the plane fit and inside the voxel filter;
-  // segment_tabletop then throws Cancelled.
-  std::stop_token stop;
 
   void validate() const;  // throws std::invalid_argument naming the bad option
 };
@@ -103,7 +99,10 @@ struct TabletopResult {
   bool ok() const { return status == TabletopStatus::kOk; }
 };
 
-TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& options);
+// context.stop is checked between the stages, per round of the plane fit and inside the voxel
+// filter (segment_tabletop then throws Cancelled); results do not depend on context.threads.
+TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& options,
+                                const RunContext& context = {});
 
 // Per-point segment: -1 neither table nor object, 0 table, k + 1 for clusters[k].
 std::vector<std::int32_t> segment_ids(const TabletopResult& result, std::size_t num_points);

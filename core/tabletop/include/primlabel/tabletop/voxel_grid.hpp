@@ -5,10 +5,10 @@
 
 #include <cstdint>
 #include <limits>
-#include <stop_token>
 #include <vector>
 
 #include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/geometry/run_context.hpp"
 
 namespace primlabel::tabletop {
 
@@ -29,10 +29,10 @@ struct VoxelGrid {
 // order of `indices`. Throws std::invalid_argument when leaf <= 0 or the extent overflows the
 // 21-bit voxel coordinates.
 // Throws std::invalid_argument when the extent needs more than 2^21 voxels per axis (e.g. one far
-// point), and Cancelled when `stop` is requested (checked every 64k points and between the sort's
-// runs and merges).
+// point), and Cancelled when context.stop is requested (checked every 64k points and between the
+// sort's runs and merges).
 VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
                            const std::vector<std::uint32_t>& indices, float leaf,
-                           const std::stop_token& stop = {});
+                           const RunContext& context = {});
 
 }  // namespace primlabel::tabletop
