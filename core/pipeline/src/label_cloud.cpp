@@ -9,8 +9,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/crf/inference.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/pipeline/duplicates.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/svm_model.hpp"
@@ -148,6 +148,21 @@ LabelingResult fan_out(const LabelingResult& partial, const PointCloud& part,
   return result;
 }
 
+// The points `indices` of `cloud` as a cloud of their own (unorganised, same viewpoint), with
+// their normals when the cloud's own normals are used.
+PointCloud gather(const PointCloud& cloud, const std::vector<std::uint32_t>& indices,
+                  bool with_normals) {
+  PointCloud part;
+  part.resize_unorganized(indices.size());
+  part.viewpoint = cloud.viewpoint;
+  for (std::size_t j = 0; j < indices.size(); ++j) part.xyz[j] = cloud.xyz[indices[j]];
+  if (with_normals) {
+    part.normals.resize(indices.size());
+    for (std::size_t j = 0; j < indices.size(); ++j) part.normals[j] = cloud.normals[indices[j]];
+  }
+  return part;
+}
+
 // Exact duplicates are described once, at their lowest index, and every copy gets that copy's
 // results (as voxels fan out to their members below).
 LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& features,
@@ -155,15 +170,7 @@ LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& 
                                 const RunContext& context) {
   const DuplicateMap duplicates = find_duplicates(cloud.xyz, context.stop);
   if (!duplicates.any()) return label_distinct_points(model, features, cloud, options, context);
-  const std::vector<std::uint32_t>& keep = duplicates.representatives;
-  PointCloud distinct;
-  distinct.resize_unorganized(keep.size());
-  distinct.viewpoint = cloud.viewpoint;
-  for (std::size_t j = 0; j < keep.size(); ++j) distinct.xyz[j] = cloud.xyz[keep[j]];
-  if (options.use_cloud_normals) {
-    distinct.normals.resize(keep.size());
-    for (std::size_t j = 0; j < keep.size(); ++j) distinct.normals[j] = cloud.normals[keep[j]];
-  }
+  PointCloud distinct = gather(cloud, duplicates.representatives, options.use_cloud_normals);
   const LabelingResult partial = label_distinct_points(model, features, distinct, options, context);
   return fan_out(partial, distinct, duplicates.slot_of, cloud, options);
 }
@@ -177,36 +184,22 @@ LabelingResult label_tabletop(const LabelModel& model, const FeatureSettings& fe
   const tabletop::TabletopResult segmented =
       tabletop::segment_tabletop(cloud, tabletop_options, context);
   const std::vector<std::uint8_t> mask = tabletop::tabletop_mask(segmented, cloud.size());
-  PointCloud sub;
-  std::vector<std::size_t> source_index;
+  std::vector<std::uint32_t> members;
+  std::vector<std::uint32_t> slot_of(cloud.size(), tabletop::kNoVoxel);
   for (std::size_t i = 0; i < cloud.size(); ++i)
-    if (mask[i]) source_index.push_back(i);
-  sub.resize_unorganized(source_index.size());
-  sub.viewpoint = cloud.viewpoint;
-  for (std::size_t j = 0; j < source_index.size(); ++j) sub.xyz[j] = cloud.xyz[source_index[j]];
-  if (options.use_cloud_normals) {
-    sub.normals.resize(source_index.size());
-    for (std::size_t j = 0; j < source_index.size(); ++j)
-      sub.normals[j] = cloud.normals[source_index[j]];
-  }
+    if (mask[i]) {
+      slot_of[i] = static_cast<std::uint32_t>(members.size());
+      members.push_back(static_cast<std::uint32_t>(i));
+    }
+  PointCloud sub = gather(cloud, members, options.use_cloud_normals);
   const double prefilter_seconds = seconds_since(start);
   context.throw_if_stopped("labeling");
 
   const LabelingResult partial = label_all_points(model, features, sub, options, context);
-  LabelingResult result = unknown_result(cloud.size(), partial, options);
+  LabelingResult result = fan_out(partial, sub, slot_of, cloud, options);
+  // One point per slot: the sub-cloud's own count stands (fan_out counts copies).
+  result.labeled_points = partial.labeled_points;
   result.prefilter_seconds = prefilter_seconds;
-  if (!options.use_cloud_normals) {
-    cloud.normals.assign(cloud.size(), Vec3f::Constant(kNaN));
-    cloud.curvature.assign(cloud.size(), kNaN);
-  }
-  for (std::size_t j = 0; j < source_index.size(); ++j) {
-    const std::size_t i = source_index[j];
-    copy_point(partial, j, result, i);
-    if (!options.use_cloud_normals) {
-      cloud.normals[i] = sub.normals[j];
-      cloud.curvature[i] = sub.curvature[j];
-    }
-  }
   return result;
 }
 
