@@ -232,5 +232,42 @@ TEST(CrfGraphCancellation, ANeverStoppedTokenGivesTheSameGraph) {
   }
 }
 
+// Points without a descriptor are filtered out of the one index's answers: the graph is the one
+// a search over the valid points alone gives (how it was built before), with the caller's index
+// or without.
+TEST(CrfGraph, MissingDescriptorsGiveTheGraphOfTheValidPointsAlone) {
+  const Patch patch = noisy_patch();
+  std::vector<Vec3f> valid_points;
+  std::vector<float> valid_descriptors;
+  std::vector<std::uint32_t> to_patch;
+  for (std::size_t i = 0; i < patch.points.size(); ++i) {
+    if (!is_finite(patch.points[i]) || !descriptor_is_valid(&patch.descriptors[2 * i], 2)) continue;
+    valid_points.push_back(patch.points[i]);
+    valid_descriptors.insert(valid_descriptors.end(),
+                             {patch.descriptors[2 * i], patch.descriptors[2 * i + 1]});
+    to_patch.push_back(static_cast<std::uint32_t>(i));
+  }
+  ASSERT_LT(to_patch.size(), patch.points.size() - 10);  // some finite points lack a descriptor
+  const NeighborSearch search(patch.points);
+  for (const Neighborhood& hood :
+       {Neighborhood::Knn(8), Neighborhood::Radius(0.05f), Neighborhood::Hybrid(0.05f, 6)}) {
+    GraphOptions options;
+    options.neighborhood = hood;
+    const Graph compact = build_graph(valid_points, valid_descriptors, 2, options);
+    const Graph own = build_graph(patch.points, patch.descriptors, 2, options);
+    const Graph shared = build_graph(patch.points, patch.descriptors, 2, options, &search);
+    EXPECT_EQ(own.neighbors, shared.neighbors) << hood.describe();
+    EXPECT_EQ(own.reverse, shared.reverse) << hood.describe();
+    ASSERT_EQ(own.num_slots(), compact.num_slots()) << hood.describe();
+    for (std::size_t c = 0; c < to_patch.size(); ++c) {
+      std::vector<std::uint32_t> expected;
+      for (std::uint32_t j : compact.neighbors_of(c)) expected.push_back(to_patch[j]);
+      const auto row = own.neighbors_of(to_patch[c]);
+      ASSERT_EQ(std::vector<std::uint32_t>(row.begin(), row.end()), expected)
+          << hood.describe() << " node " << to_patch[c];
+    }
+  }
+}
+
 }  // namespace
 }  // namespace primlabel::crf

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "../parallel.hpp"
@@ -217,23 +218,18 @@ Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descr
     if (finite && !active[i]) every_finite_point_active = false;
   }
 
-  // Search over exactly the active points; compact index -> point index when it is a subset.
-  std::vector<Vec3f> compact_points;
-  std::vector<std::uint32_t> compact_to_point;
+  // One index over the cloud's finite points (the caller's, or one built here). When some of
+  // them lack a descriptor, the queries filter them out rather than a second index being built
+  // over the active points: the same neighbours, without a copy of the cloud and a second tree.
   std::unique_ptr<NeighborSearch> own_search;
-  const NeighborSearch* index = search;
-  if (!search || !every_finite_point_active) {
-    for (std::size_t i = 0; i < n; ++i) {
-      check_every(i, stop);
-      if (!active[i]) continue;
-      compact_points.push_back(points[i]);
-      compact_to_point.push_back(static_cast<std::uint32_t>(i));
-    }
-    own_search = std::make_unique<NeighborSearch>(compact_points, stop);
-    index = own_search.get();
-  }
-  const auto to_point = [&](std::uint32_t found) {
-    return own_search ? compact_to_point[found] : found;
+  if (!search) own_search = std::make_unique<NeighborSearch>(points, stop);
+  const NeighborSearch& index = search ? *search : *own_search;
+  const auto find = [&](const Vec3f& q, const Neighborhood& hood, NeighborList& found,
+                        bool sorted) {
+    if (every_finite_point_active)
+      index.find(q, hood, found, sorted);
+    else
+      index.find(q, hood, active, found, sorted);
   };
 
   const Neighborhood query = query_with_self(options.neighborhood);
@@ -248,9 +244,8 @@ Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descr
         for (std::size_t i = b * BlockLists::kListBlock; i < last; ++i) {
           if (stop.stop_requested()) return;  // per node: within one neighbourhood's time
           if (active[i]) {
-            index->find(points[i], query, found, /*sorted=*/cap >= 0);
-            for (std::uint32_t f : found.indices) {
-              const std::uint32_t j = to_point(f);
+            find(points[i], query, found, /*sorted=*/cap >= 0);
+            for (std::uint32_t j : found.indices) {
               if (j == static_cast<std::uint32_t>(i)) continue;
               if (cap >= 0 && static_cast<int>(lists.list_size(b)) >= cap) break;
               lists.push_back(b, j);

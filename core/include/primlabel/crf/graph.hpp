@@ -53,10 +53,10 @@ std::vector<std::uint8_t> valid_descriptor_mask(std::span<const float> descripto
 
 // Links every point with a valid descriptor to its neighbours among the points with a valid
 // descriptor, then symmetrises (union: i~j when either finds the other). `descriptors` is
-// row-major points.size() x dim. `search` may be passed to reuse an index built on `points`; it
-// is used only when every finite point has a valid descriptor (otherwise an index over the valid
-// points is built), so the graph never depends on whether it was passed. Throws
-// primlabel::Cancelled when options.stop is requested.
+// row-major points.size() x dim. `search` may be passed to reuse an index built on `points`
+// (otherwise one is built); points without a valid descriptor are filtered out of its answers,
+// so the graph never depends on whether it was passed. Throws primlabel::Cancelled when
+// options.stop is requested.
 Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descriptors, int dim,
                   const GraphOptions& options = {}, const NeighborSearch* search = nullptr);
 
