@@ -124,8 +124,8 @@ void weight_spfh(const PointCloud& cloud, std::size_t p, const std::vector<float
 
 }  // namespace
 
-std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
-                                FeatureStats* stats, const NeighborSearch* search) {
+Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
+                         FeatureStats* stats, const NeighborSearch* search) {
   if (!options.neighborhood.valid())
     throw std::invalid_argument("FPFH: invalid neighbourhood " + options.neighborhood.describe());
   const std::vector<char> usable = detail::usable_points(cloud, "FPFH");
@@ -204,7 +204,7 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
   throw_if_stopped(options.stop, "FPFH");
   progress.finish();
   if (stats) *stats = FeatureStats{computed.load(), isolated.load(), n - computed - isolated};
-  return fpfh;
+  return Descriptors(kFpfhSize, std::move(fpfh));
 }
 
 }  // namespace primlabel

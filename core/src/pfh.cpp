@@ -47,8 +47,8 @@ void compute_point_pfh(const PointCloud& cloud, const NeighborList& neighbors, P
 
 }  // namespace
 
-std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& options,
-                               FeatureStats* stats, const NeighborSearch* search) {
+Descriptors compute_pfh(const PointCloud& cloud, const FeatureOptions& options, FeatureStats* stats,
+                        const NeighborSearch* search) {
   if (!options.neighborhood.valid())
     throw std::invalid_argument("PFH: invalid neighbourhood " + options.neighborhood.describe());
   const std::vector<char> usable = detail::usable_points(cloud, "PFH");
@@ -96,7 +96,7 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
   throw_if_stopped(options.stop, "PFH");
   progress.finish();
   if (stats) *stats = FeatureStats{computed.load(), isolated.load(), n - computed - isolated};
-  return pfh;
+  return Descriptors(kPfhSize, std::move(pfh));
 }
 
 }  // namespace primlabel

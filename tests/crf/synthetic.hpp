@@ -60,7 +60,7 @@ inline LabeledGraph make_grid_scene(const SceneSpec& spec,
   }
   GraphOptions options;
   options.neighborhood = Neighborhood::Knn(spec.neighbors);
-  scene.graph = build_graph(points, scene.descriptors, spec.dim, options);
+  scene.graph = build_graph(points, Descriptors(spec.dim, scene.descriptors), options);
   if (points_out) *points_out = std::move(points);
   return scene;
 }

@@ -45,7 +45,7 @@ TEST(CrfGraph, KnnIsSymmetricWithoutSelfLoops) {
   const std::vector<float> descriptors(50 * 2, 1.0f);
   GraphOptions options;
   options.neighborhood = Neighborhood::Knn(4);
-  const Graph g = build_graph(points, descriptors, 2, options);
+  const Graph g = build_graph(points, Descriptors(2, descriptors), options);
   expect_well_formed(g);
   EXPECT_EQ(g.num_active(), 50u);
   for (std::size_t i = 0; i < 50; ++i) EXPECT_GE(g.degree(i), 4u);
@@ -59,12 +59,12 @@ TEST(CrfGraph, RadiusAndHybrid) {
   const std::vector<float> descriptors(30, 0.0f);  // all-zero descriptors are valid
   GraphOptions options;
   options.neighborhood = Neighborhood::Radius(1.5f);
-  const Graph g = build_graph(points, descriptors, 1, options);
+  const Graph g = build_graph(points, Descriptors(1, descriptors), options);
   expect_well_formed(g);
   EXPECT_EQ(g.degree(0), 1u);
   EXPECT_EQ(g.degree(15), 2u);
   options.neighborhood = Neighborhood::Hybrid(10.0f, 2);
-  const Graph h = build_graph(points, descriptors, 1, options);
+  const Graph h = build_graph(points, Descriptors(1, descriptors), options);
   expect_well_formed(h);
   for (std::size_t i = 0; i < 30; ++i) EXPECT_GE(h.degree(i), 2u);
 }
@@ -76,7 +76,7 @@ TEST(CrfGraph, InvalidPointsAreInactiveAndIsolated) {
   points[9] = Vec3f::Constant(std::nanf(""));
   GraphOptions options;
   options.neighborhood = Neighborhood::Knn(2);
-  const Graph g = build_graph(points, descriptors, 3, options);
+  const Graph g = build_graph(points, Descriptors(3, descriptors), options);
   expect_well_formed(g);
   EXPECT_FALSE(g.active[4]);
   EXPECT_FALSE(g.active[9]);
@@ -92,11 +92,11 @@ TEST(CrfGraph, DeterministicForAnyThreadsAndWithOrWithoutSearch) {
   const std::vector<float> descriptors(points.size() * 2, 1.0f);
   GraphOptions options;
   options.threads = 1;
-  const Graph one = build_graph(points, descriptors, 2, options);
+  const Graph one = build_graph(points, Descriptors(2, descriptors), options);
   options.threads = 2;
-  const Graph two = build_graph(points, descriptors, 2, options);
+  const Graph two = build_graph(points, Descriptors(2, descriptors), options);
   const NeighborSearch search(points);
-  const Graph reused = build_graph(points, descriptors, 2, options, &search);
+  const Graph reused = build_graph(points, Descriptors(2, descriptors), options, &search);
   expect_well_formed(one);
   EXPECT_EQ(one.offsets, two.offsets);
   EXPECT_EQ(one.neighbors, two.neighbors);
@@ -120,7 +120,7 @@ TEST(CrfGraph, FromEdgesAndRestrict) {
 }
 
 TEST(CrfGraph, Empty) {
-  const Graph g = build_graph({}, {}, 33);
+  const Graph g = build_graph({}, Descriptors(33, {}));
   EXPECT_EQ(g.num_nodes(), 0u);
   EXPECT_EQ(g.num_slots(), 0u);
   EXPECT_EQ(g.offsets.size(), 1u);
@@ -156,7 +156,8 @@ std::vector<std::vector<std::uint32_t>> brute_force_rows(const Patch& patch,
   const std::size_t n = patch.points.size();
   std::vector<std::uint8_t> valid(n);
   for (std::size_t i = 0; i < n; ++i)
-    valid[i] = is_finite(patch.points[i]) && descriptor_is_valid(&patch.descriptors[2 * i], 2);
+    valid[i] = is_finite(patch.points[i]) &&
+               descriptor_is_valid(std::span<const float>(&patch.descriptors[2 * i], 2));
   std::vector<std::vector<std::uint32_t>> rows(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (!valid[i]) continue;
@@ -198,8 +199,8 @@ TEST(CrfGraphCancellation, AStoppedTokenCancelsTheBuild) {
   for (const Neighborhood& hood : {Neighborhood::Knn(8), Neighborhood::Radius(0.05f)}) {
     options.neighborhood = hood;
     // Its own index over the valid points, and the shared index.
-    EXPECT_THROW(build_graph(patch.points, patch.descriptors, 2, options), Cancelled);
-    EXPECT_THROW(build_graph(finite, all_valid, 2, options, &search), Cancelled);
+    EXPECT_THROW(build_graph(patch.points, Descriptors(2, patch.descriptors), options), Cancelled);
+    EXPECT_THROW(build_graph(finite, Descriptors(2, all_valid), options, &search), Cancelled);
   }
 }
 
@@ -212,12 +213,12 @@ TEST(CrfGraphCancellation, ANeverStoppedTokenGivesTheSameGraph) {
     GraphOptions plain;
     plain.neighborhood = hood;
     plain.threads = 1;
-    const Graph reference = build_graph(patch.points, patch.descriptors, 2, plain);
+    const Graph reference = build_graph(patch.points, Descriptors(2, patch.descriptors), plain);
     for (int threads : {1, 3}) {
       GraphOptions options = plain;
       options.threads = threads;
       options.stop = never.get_token();
-      const Graph g = build_graph(patch.points, patch.descriptors, 2, options);
+      const Graph g = build_graph(patch.points, Descriptors(2, patch.descriptors), options);
       expect_well_formed(g);
       ASSERT_EQ(g.num_nodes(), expected.size());
       for (std::size_t i = 0; i < expected.size(); ++i)
@@ -241,7 +242,9 @@ TEST(CrfGraph, MissingDescriptorsGiveTheGraphOfTheValidPointsAlone) {
   std::vector<float> valid_descriptors;
   std::vector<std::uint32_t> to_patch;
   for (std::size_t i = 0; i < patch.points.size(); ++i) {
-    if (!is_finite(patch.points[i]) || !descriptor_is_valid(&patch.descriptors[2 * i], 2)) continue;
+    if (!is_finite(patch.points[i]) ||
+        !descriptor_is_valid(std::span<const float>(&patch.descriptors[2 * i], 2)))
+      continue;
     valid_points.push_back(patch.points[i]);
     valid_descriptors.insert(valid_descriptors.end(),
                              {patch.descriptors[2 * i], patch.descriptors[2 * i + 1]});
@@ -253,9 +256,10 @@ TEST(CrfGraph, MissingDescriptorsGiveTheGraphOfTheValidPointsAlone) {
        {Neighborhood::Knn(8), Neighborhood::Radius(0.05f), Neighborhood::Hybrid(0.05f, 6)}) {
     GraphOptions options;
     options.neighborhood = hood;
-    const Graph compact = build_graph(valid_points, valid_descriptors, 2, options);
-    const Graph own = build_graph(patch.points, patch.descriptors, 2, options);
-    const Graph shared = build_graph(patch.points, patch.descriptors, 2, options, &search);
+    const Graph compact = build_graph(valid_points, Descriptors(2, valid_descriptors), options);
+    const Graph own = build_graph(patch.points, Descriptors(2, patch.descriptors), options);
+    const Graph shared =
+        build_graph(patch.points, Descriptors(2, patch.descriptors), options, &search);
     EXPECT_EQ(own.neighbors, shared.neighbors) << hood.describe();
     EXPECT_EQ(own.reverse, shared.reverse) << hood.describe();
     ASSERT_EQ(own.num_slots(), compact.num_slots()) << hood.describe();

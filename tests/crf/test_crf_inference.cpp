@@ -250,7 +250,7 @@ TEST(CrfInference, PointsWithoutDescriptorGetTheUnknownLabel) {
   LabeledGraph scene = testing::make_grid_scene(spec, &points);
   for (std::size_t i : {0u, 57u, 222u}) scene.descriptors[i * spec.dim + 3] = std::nanf("");
   points[300] = Vec3f::Constant(std::nanf(""));
-  const Graph graph = build_graph(points, scene.descriptors, spec.dim);
+  const Graph graph = build_graph(points, Descriptors(spec.dim, scene.descriptors));
   const CrfModel model = testing::prototype_model(spec, 3.0f, 1.0f);
   for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
     InferenceOptions options;

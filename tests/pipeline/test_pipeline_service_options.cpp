@@ -43,7 +43,7 @@ TEST(PipelineServiceOptions, DescriptorsAreReturnedRowMajorAsDescribeComputesThe
   const auto described = pipeline::describe_cloud(distinct, model.features, 0);
   for (std::size_t i = 0; i < result.descriptors.size(); ++i) {
     const std::size_t row = duplicates.slot_of[i / kFpfhSize], bin = i % kFpfhSize;
-    const float a = result.descriptors[i], b = described.descriptors[row * kFpfhSize + bin];
+    const float a = result.descriptors[i], b = described.descriptors.row(row)[bin];
     ASSERT_TRUE((std::isnan(a) && std::isnan(b)) || a == b) << "value " << i;
   }
   EXPECT_TRUE(pipeline::label_cloud(model, again, {}).descriptors.empty());
@@ -178,9 +178,9 @@ TEST(PipelineServiceOptions, InferenceHonoursItsStopToken) {
   source.request_stop();
   crf::InferenceOptions options;
   options.stop = source.get_token();
-  EXPECT_THROW(crf::infer(model.weights, described.descriptors, graph, options), Cancelled);
+  EXPECT_THROW(crf::infer(model.weights, described.descriptors.values, graph, options), Cancelled);
   options.stop = {};
-  EXPECT_EQ(crf::infer(model.weights, described.descriptors, graph, options).labels.size(),
+  EXPECT_EQ(crf::infer(model.weights, described.descriptors.values, graph, options).labels.size(),
             cloud.size());
 }
 

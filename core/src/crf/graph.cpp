@@ -178,28 +178,29 @@ std::size_t Graph::num_active() const {
   return static_cast<std::size_t>(std::count(active.begin(), active.end(), std::uint8_t{1}));
 }
 
-bool descriptor_is_valid(const float* row, int dim) {
-  for (int f = 0; f < dim; ++f)
-    if (!std::isfinite(row[f])) return false;
+bool descriptor_is_valid(std::span<const float> row) {
+  for (float v : row)
+    if (!std::isfinite(v)) return false;
   return true;
 }
 
-std::vector<std::uint8_t> valid_descriptor_mask(std::span<const float> descriptors, int dim) {
-  if (dim <= 0) throw std::invalid_argument("valid_descriptor_mask: descriptor dimension <= 0");
-  const std::size_t n = descriptors.size() / static_cast<std::size_t>(dim);
+std::vector<std::uint8_t> valid_descriptor_mask(const Descriptors& descriptors) {
+  if (descriptors.dim <= 0)
+    throw std::invalid_argument("valid_descriptor_mask: descriptor dimension <= 0");
+  const std::size_t n = descriptors.size();
   std::vector<std::uint8_t> mask(n);
-  for (std::size_t i = 0; i < n; ++i)
-    mask[i] = descriptor_is_valid(descriptors.data() + i * dim, dim) ? 1 : 0;
+  for (std::size_t i = 0; i < n; ++i) mask[i] = descriptor_is_valid(descriptors.row(i)) ? 1 : 0;
   return mask;
 }
 
-Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descriptors, int dim,
+Graph build_graph(const std::vector<Vec3f>& points, const Descriptors& descriptors,
                   const GraphOptions& options, const NeighborSearch* search) {
   if (!options.neighborhood.valid())
     throw std::invalid_argument("build_graph: invalid neighbourhood " +
                                 options.neighborhood.describe());
-  if (dim <= 0 || descriptors.size() != points.size() * static_cast<std::size_t>(dim))
-    throw std::invalid_argument("build_graph: descriptors are not points.size() x dim");
+  if (descriptors.dim <= 0 ||
+      descriptors.values.size() != points.size() * static_cast<std::size_t>(descriptors.dim))
+    throw std::invalid_argument("build_graph: descriptors are not one row per point");
   const std::size_t n = points.size();
   const int threads = primlabel::detail::resolve_threads(options.threads);
   const std::stop_token& stop = options.stop;
@@ -208,7 +209,7 @@ Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descr
   std::vector<std::uint8_t> active(n);
   for (std::size_t i = 0; i < n; ++i) {
     check_every(i, stop);
-    active[i] = descriptor_is_valid(descriptors.data() + i * dim, dim) ? 1 : 0;
+    active[i] = descriptor_is_valid(descriptors.row(i)) ? 1 : 0;
   }
   bool every_finite_point_active = true;
   for (std::size_t i = 0; i < n; ++i) {

@@ -60,7 +60,6 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   const bool fpfh = settings.descriptor == DescriptorKind::kFpfh;
   out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, nullptr, out.search.get())
                          : compute_pfh(cloud, feature_options, nullptr, out.search.get());
-  out.descriptor_dim = settings.descriptor_dim();
   out.feature_seconds = seconds_since(start);
   return out;
 }
@@ -69,8 +68,7 @@ crf::Graph build_scene_graph(const PointCloud& cloud, const DescribedCloud& desc
                              const crf::GraphOptions& options) {
   crf::GraphOptions bounded = options;
   bounded.neighborhood = capped(options.neighborhood);
-  return crf::build_graph(cloud.xyz, described.descriptors, described.descriptor_dim, bounded,
-                          described.search.get());
+  return crf::build_graph(cloud.xyz, described.descriptors, bounded, described.search.get());
 }
 
 crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& described,
@@ -78,8 +76,8 @@ crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& des
   if (cloud.labels.size() != cloud.size())
     throw std::invalid_argument("the cloud has no label per point");
   crf::LabeledGraph scene;
-  scene.descriptor_dim = described.descriptor_dim;
-  scene.descriptors = std::move(described.descriptors);
+  scene.descriptor_dim = described.descriptors.dim;
+  scene.descriptors = std::move(described.descriptors.values);
   scene.graph = std::move(graph);
   scene.labels.assign(cloud.size(), crf::kIgnoreLabel);
   for (std::size_t i = 0; i < cloud.size(); ++i) {

@@ -78,14 +78,15 @@ LabelingResult label_distinct_points(const LabelModel& model, const FeatureSetti
   inference.unknown_label = class_id(PrimitiveClass::kUnknown);
   inference.compute_marginals = options.want_probabilities;
   inference.stop = options.stop;
-  crf::InferenceResult inferred = infer(model.weights, described.descriptors, graph, inference);
+  crf::InferenceResult inferred =
+      infer(model.weights, described.descriptors.values, graph, inference);
   result.inference_seconds = seconds_since(start);
 
   result.labels = std::move(inferred.labels);
   if (options.want_probabilities) result.probabilities = std::move(inferred.marginals);
   if (options.want_descriptors) {
-    result.descriptors = std::move(described.descriptors);
-    result.descriptor_dim = described.descriptor_dim;
+    result.descriptor_dim = described.descriptors.dim;
+    result.descriptors = std::move(described.descriptors.values);
   }
   result.labeled_points = graph.num_active();
   return result;

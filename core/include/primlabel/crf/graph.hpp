@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "primlabel/core/descriptors.hpp"
 #include "primlabel/core/neighbor_search.hpp"
 #include "primlabel/core/point_cloud.hpp"
 
@@ -48,16 +49,16 @@ struct GraphOptions {
 
 // A row of `dim` values is a valid descriptor when every value is finite (features.hpp marks
 // invalid points with NaN rows; all-zero rows of isolated points are valid).
-bool descriptor_is_valid(const float* row, int dim);
-std::vector<std::uint8_t> valid_descriptor_mask(std::span<const float> descriptors, int dim);
+bool descriptor_is_valid(std::span<const float> row);
+std::vector<std::uint8_t> valid_descriptor_mask(const Descriptors& descriptors);
 
 // Links every point with a valid descriptor to its neighbours among the points with a valid
-// descriptor, then symmetrises (union: i~j when either finds the other). `descriptors` is
-// row-major points.size() x dim. `search` may be passed to reuse an index built on `points`
+// descriptor, then symmetrises (union: i~j when either finds the other). `descriptors` has one
+// row per point. `search` may be passed to reuse an index built on `points`
 // (otherwise one is built); points without a valid descriptor are filtered out of its answers,
 // so the graph never depends on whether it was passed. Throws primlabel::Cancelled when
 // options.stop is requested.
-Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descriptors, int dim,
+Graph build_graph(const std::vector<Vec3f>& points, const Descriptors& descriptors,
                   const GraphOptions& options = {}, const NeighborSearch* search = nullptr);
 
 // A graph from an explicit undirected edge list (tests, synthetic data, other sources). Self

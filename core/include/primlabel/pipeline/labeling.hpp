@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "primlabel/core/cancellation.hpp"
+#include "primlabel/core/descriptors.hpp"
 #include "primlabel/core/neighbor_search.hpp"
 #include "primlabel/core/point_cloud.hpp"
 #include "primlabel/crf/graph.hpp"
@@ -22,8 +23,7 @@ namespace primlabel::pipeline {
 // computed them so the graph can reuse it. `search` indexes cloud.xyz: keep the cloud alive and
 // unmoved while it is used.
 struct DescribedCloud {
-  std::vector<float> descriptors;  // row-major cloud.size() x descriptor_dim; NaN rows = invalid
-  int descriptor_dim = 0;
+  Descriptors descriptors;  // one row per point; NaN rows = invalid
   std::unique_ptr<NeighborSearch> search;
   double normal_seconds = 0, feature_seconds = 0;
 };
