@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "../parallel.hpp"
 #include "loopy_bp.hpp"
@@ -93,6 +94,27 @@ void node_potentials_padded(const float* theta, std::size_t n, int k_count, int 
 }
 
 }  // namespace
+
+namespace {
+void check_dim(const CrfModel& model, const Descriptors& descriptors) {
+  if (descriptors.dim != model.descriptor_dim)
+    throw std::invalid_argument("infer: descriptors have dimension " +
+                                std::to_string(descriptors.dim) + ", the model " +
+                                std::to_string(model.descriptor_dim));
+}
+}  // namespace
+
+InferenceResult infer(const CrfModel& model, const Descriptors& descriptors, const Graph& graph,
+                      const InferenceOptions& options) {
+  check_dim(model, descriptors);
+  return infer(model, std::span<const float>(descriptors.values), graph, options);
+}
+
+InferenceResult infer(const CrfModel& model, const Descriptors& descriptors, const Graph& graph,
+                      const InferenceOptions& options, InferenceWorkspace& workspace) {
+  check_dim(model, descriptors);
+  return infer(model, std::span<const float>(descriptors.values), graph, options, workspace);
+}
 
 InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
                       const InferenceOptions& options) {

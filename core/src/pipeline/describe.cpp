@@ -76,8 +76,7 @@ crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& des
   if (cloud.labels.size() != cloud.size())
     throw std::invalid_argument("the cloud has no label per point");
   crf::LabeledGraph scene;
-  scene.descriptor_dim = described.descriptors.dim;
-  scene.descriptors = std::move(described.descriptors.values);
+  scene.descriptors = std::move(described.descriptors);
   scene.graph = std::move(graph);
   scene.labels.assign(cloud.size(), crf::kIgnoreLabel);
   for (std::size_t i = 0; i < cloud.size(); ++i) {

@@ -78,15 +78,13 @@ LabelingResult label_distinct_points(const LabelModel& model, const FeatureSetti
   inference.unknown_label = class_id(PrimitiveClass::kUnknown);
   inference.compute_marginals = options.want_probabilities;
   inference.stop = options.stop;
-  crf::InferenceResult inferred =
-      infer(model.weights, described.descriptors.values, graph, inference);
+  crf::InferenceResult inferred = infer(model.weights, described.descriptors, graph, inference);
   result.inference_seconds = seconds_since(start);
 
   result.labels = std::move(inferred.labels);
   if (options.want_probabilities) result.probabilities = std::move(inferred.marginals);
   if (options.want_descriptors) {
-    result.descriptor_dim = described.descriptors.dim;
-    result.descriptors = std::move(described.descriptors.values);
+    result.descriptors = std::move(described.descriptors);
   }
   result.labeled_points = graph.num_active();
   return result;
@@ -109,8 +107,7 @@ LabelingResult unknown_result(std::size_t points, const LabelingResult& like,
     result.probabilities =
         Eigen::MatrixXf::Constant(Eigen::Index(points), Eigen::Index(like.class_ids.size()), kNaN);
   if (options.want_descriptors) {
-    result.descriptor_dim = like.descriptor_dim;
-    result.descriptors.assign(points * std::size_t(like.descriptor_dim), kNaN);
+    result.descriptors = Descriptors::filled(points, like.descriptors.dim, kNaN);
   }
   return result;
 }
@@ -122,8 +119,8 @@ void copy_point(const LabelingResult& part, std::size_t from, LabelingResult& wh
   if (part.probabilities.size() > 0)
     whole.probabilities.row(Eigen::Index(to)) = part.probabilities.row(Eigen::Index(from));
   if (!part.descriptors.empty()) {
-    const std::size_t d = std::size_t(part.descriptor_dim);
-    std::copy_n(part.descriptors.begin() + from * d, d, whole.descriptors.begin() + to * d);
+    const std::span<const float> row = part.descriptors.row(from);
+    std::copy(row.begin(), row.end(), whole.descriptors.row(to).begin());
   }
 }
 

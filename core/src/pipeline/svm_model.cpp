@@ -74,19 +74,16 @@ void classify_with_svm(const LabelModel& model, DescribedCloud&& described,
                        const LabelingOptions& options, LabelingResult& result) {
   const auto start = std::chrono::steady_clock::now();
   const crf::SvmClassifier svm = svm_classifier_of(model);
-  crf::SvmPrediction predicted =
-      svm.predict(described.descriptors.values, class_id(PrimitiveClass::kUnknown), options.threads,
-                  options.stop);
+  crf::SvmPrediction predicted = svm.predict(
+      described.descriptors, class_id(PrimitiveClass::kUnknown), options.threads, options.stop);
   result.class_ids = model.class_ids();
   result.labels = std::move(predicted.labels);
   if (options.want_probabilities) result.probabilities = std::move(predicted.probabilities);
-  const std::size_t dim = std::size_t(described.descriptors.dim);
   result.labeled_points = 0;
   for (std::size_t i = 0; i < described.descriptors.size(); ++i)
     result.labeled_points += std::isfinite(described.descriptors.row(i)[0]) ? 1 : 0;
   if (options.want_descriptors) {
-    result.descriptor_dim = described.descriptors.dim;
-    result.descriptors = std::move(described.descriptors.values);
+    result.descriptors = std::move(described.descriptors);
   }
   result.inference_seconds = seconds_since(start);
 }

@@ -16,6 +16,7 @@
 #include <stop_token>
 #include <vector>
 
+#include "primlabel/core/descriptors.hpp"
 #include "primlabel/crf/graph.hpp"
 #include "primlabel/crf/model.hpp"
 
@@ -90,6 +91,11 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
                       const InferenceOptions& options = {});
 // The same, with the caller's buffers (bit-identical results).
 InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
+                      const InferenceOptions& options, InferenceWorkspace& workspace);
+// The same for typed descriptors, whose dimension must be the model's.
+InferenceResult infer(const CrfModel& model, const Descriptors& descriptors, const Graph& graph,
+                      const InferenceOptions& options = {});
+InferenceResult infer(const CrfModel& model, const Descriptors& descriptors, const Graph& graph,
                       const InferenceOptions& options, InferenceWorkspace& workspace);
 
 }  // namespace primlabel::crf

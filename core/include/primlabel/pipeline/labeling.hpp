@@ -85,9 +85,8 @@ struct LabelingResult {
   std::vector<std::uint32_t> labels;  // taxonomy class id per point; 0 (unknown) when unlabeled
   Eigen::MatrixXf probabilities;      // points x K (model class order) when asked; NaN rows
   std::vector<std::uint32_t> class_ids;
-  // points x descriptor_dim, row-major, when asked; NaN rows = the point had no descriptor.
-  std::vector<float> descriptors;
-  int descriptor_dim = 0;
+  // One row per point when asked (else empty, dim 0); NaN rows = the point had no descriptor.
+  Descriptors descriptors;
   std::size_t labeled_points = 0;    // input points that got a descriptor (through their voxel)
   std::size_t described_points = 0;  // points described: voxels when downsampling
   double prefilter_seconds = 0;      // table-top segmentation and voxel downsampling
