@@ -50,9 +50,9 @@ constexpr std::size_t kCandidatesPerNeighbor = 8;
 static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be three packed floats");
 struct TreePoints {
   explicit TreePoints(const FinitePoints& finite)
-      : points(finite), xyz(finite.cloud()->data()), map(finite.map()) {}
+      : points(finite), xyz(reinterpret_cast<const float*>(finite.cloud())), map(finite.map()) {}
   const FinitePoints& points;
-  // The same points as raw arrays: the build reads them billions of times for 5M points.
+  // The same points as raw arrays: a 5M-point build reads coordinates ~10^8 times.
   const float* xyz;          // cloud index * 3 + dim
   const std::uint32_t* map;  // tree index -> cloud index, or nullptr: the identity
   const std::stop_token* build_stop = nullptr;  // set only while buildIndex() runs
