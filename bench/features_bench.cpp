@@ -405,7 +405,7 @@ int run_features_bench(const FeaturesBenchOptions& options) {
   FeatureOptions feature_options;
   feature_options.neighborhood = *feature_hood;
 
-  std::vector<float> fpfh;
+  Descriptors fpfh;
   FeatureStats fpfh_stats;
   double fpfh_seconds = std::numeric_limits<double>::quiet_NaN();
   if (run_fpfh) {
@@ -469,18 +469,19 @@ int run_features_bench(const FeaturesBenchOptions& options) {
       std::cerr << "  FPFHEstimationOMP on primlabel's normals: " << rate(n, pcl_fpfh.seconds)
                 << "\n";
       const RowComparison fpfh_cmp =
-          compare_rows(fpfh.data(), pcl_fpfh.descriptors.data(), n, kFpfhSize);
-      print_comparison("FPFH", fpfh_cmp, fpfh.data(), pcl_fpfh.descriptors.data(), kFpfhSize);
+          compare_rows(fpfh.values.data(), pcl_fpfh.descriptors.data(), n, kFpfhSize);
+      print_comparison("FPFH", fpfh_cmp, fpfh.values.data(), pcl_fpfh.descriptors.data(),
+                       kFpfhSize);
       const std::vector<char> near_missing =
           near_missing_normals(cloud, search, *feature_hood, threads);
       const auto near_missing_count =
           static_cast<std::size_t>(std::count(near_missing.begin(), near_missing.end(), 1));
-      const RowComparison clean_cmp =
-          compare_rows(fpfh.data(), pcl_fpfh.descriptors.data(), n, kFpfhSize, &near_missing);
+      const RowComparison clean_cmp = compare_rows(fpfh.values.data(), pcl_fpfh.descriptors.data(),
+                                                   n, kFpfhSize, &near_missing);
       if (near_missing_count > 0)
         print_comparison("FPFH without the " + std::to_string(near_missing_count) +
                              " points within two hops of a missing normal",
-                         clean_cmp, fpfh.data(), pcl_fpfh.descriptors.data(), kFpfhSize);
+                         clean_cmp, fpfh.values.data(), pcl_fpfh.descriptors.data(), kFpfhSize);
       std::cerr << "  speedup (PCL time / primlabel time): normals "
                 << pcl_normals.seconds / normals_seconds << "x, FPFH "
                 << pcl_fpfh.seconds / fpfh_seconds << "x\n";

@@ -3,7 +3,9 @@
 #include <cstring>
 #include <filesystem>
 #include <numeric>
+#include <random>
 
+#include "pair_features_inline.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/normals.hpp"
@@ -15,46 +17,86 @@ namespace {
 // ---- pair features -----------------------------------------------------------------------------
 
 TEST(PairFeatures, ParallelNormalsOnAPlane) {
-  float f1, f2, f3, f4;
-  ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {2, 0, 0}, {0, 0, 1}, f1, f2, f3, f4));
-  EXPECT_FLOAT_EQ(f4, 2.0f);
-  EXPECT_FLOAT_EQ(f1, 0.0f);
-  EXPECT_FLOAT_EQ(f2, 0.0f);
-  EXPECT_FLOAT_EQ(f3, 0.0f);
+  const PairFeatures f = compute_pair_features({0, 0, 0}, {0, 0, 1}, {2, 0, 0}, {0, 0, 1});
+  ASSERT_TRUE(f.valid);
+  EXPECT_FLOAT_EQ(f.f4, 2.0f);
+  EXPECT_FLOAT_EQ(f.f1, 0.0f);
+  EXPECT_FLOAT_EQ(f.f2, 0.0f);
+  EXPECT_FLOAT_EQ(f.f3, 0.0f);
 }
 
 TEST(PairFeatures, AlphaIsTheNormalsAngleInTheDarbouxFrame) {
   const float a = 0.3f;
-  float f1, f2, f3, f4;
   // n2 = (sin a, 0, cos a) is closer to the line than n1 = z, so p2 is the source: u = n2,
   // delta = -x, v = delta x u / |..| = y, w = u x v = (-cos a, 0, sin a); alpha = atan2(w.n1,
   // u.n1).
-  ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {std::sin(a), 0, std::cos(a)},
-                                    f1, f2, f3, f4));
-  EXPECT_NEAR(f1, a, 1e-6f);
-  EXPECT_NEAR(f2, 0.0f, 1e-7f);
-  EXPECT_NEAR(f3, -std::sin(a), 1e-7f);
+  const PairFeatures f =
+      compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {std::sin(a), 0, std::cos(a)});
+  ASSERT_TRUE(f.valid);
+  EXPECT_NEAR(f.f1, a, 1e-6f);
+  EXPECT_NEAR(f.f2, 0.0f, 1e-7f);
+  EXPECT_NEAR(f.f3, -std::sin(a), 1e-7f);
 }
 
 TEST(PairFeatures, SourceIsThePointWhoseNormalIsCloserToTheLine) {
-  float f1, f2, f3, f4;
   // n2 is nearly along the connecting line, n1 perpendicular to it: swapped, theta = -n2.x.
   const Vec3f n2 = Vec3f(1, 0, 0.5f).normalized();
-  ASSERT_TRUE(compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, n2, f1, f2, f3, f4));
-  EXPECT_FLOAT_EQ(f3, -n2.x());
-  float g1, g2, g3, g4;  // and the features do not depend on the order of the points
-  ASSERT_TRUE(compute_pair_features({1, 0, 0}, n2, {0, 0, 0}, {0, 0, 1}, g1, g2, g3, g4));
-  EXPECT_FLOAT_EQ(f1, g1);
-  EXPECT_FLOAT_EQ(f2, g2);
-  EXPECT_FLOAT_EQ(f3, g3);
+  const PairFeatures f = compute_pair_features({0, 0, 0}, {0, 0, 1}, {1, 0, 0}, n2);
+  ASSERT_TRUE(f.valid);
+  EXPECT_FLOAT_EQ(f.f3, -n2.x());
+  // and the features do not depend on the order of the points
+  const PairFeatures g = compute_pair_features({1, 0, 0}, n2, {0, 0, 0}, {0, 0, 1});
+  ASSERT_TRUE(g.valid);
+  EXPECT_FLOAT_EQ(f.f1, g.f1);
+  EXPECT_FLOAT_EQ(f.f2, g.f2);
+  EXPECT_FLOAT_EQ(f.f3, g.f3);
 }
 
 TEST(PairFeatures, DegeneratePairsAreZero) {
-  float f1 = 1, f2 = 1, f3 = 1, f4 = 1;
-  EXPECT_FALSE(compute_pair_features({1, 1, 1}, {0, 0, 1}, {1, 1, 1}, {0, 1, 0}, f1, f2, f3, f4));
-  EXPECT_EQ(f1 + f2 + f3 + f4, 0.0f);
+  const PairFeatures f = compute_pair_features({1, 1, 1}, {0, 0, 1}, {1, 1, 1}, {0, 1, 0});
+  EXPECT_FALSE(f.valid);
+  EXPECT_EQ(f.f1 + f.f2 + f.f3 + f.f4, 0.0f);
   // Normal parallel to the connecting line: no Darboux frame.
-  EXPECT_FALSE(compute_pair_features({0, 0, 0}, {1, 0, 0}, {1, 0, 0}, {1, 0, 0}, f1, f2, f3, f4));
+  const PairFeatures g = compute_pair_features({0, 0, 0}, {1, 0, 0}, {1, 0, 0}, {1, 0, 0});
+  EXPECT_FALSE(g.valid);
+  EXPECT_EQ(g.f1 + g.f2 + g.f3 + g.f4, 0.0f);
+}
+
+// The public struct carries exactly the features the histogram kernels bin (same arithmetic).
+TEST(PairFeatures, TheStructHoldsTheKernelsFeaturesBitForBit) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (int t = 0; t < 1000; ++t) {
+    const Vec3f p1(u(rng), u(rng), u(rng)), p2(u(rng), u(rng), u(rng));
+    const Vec3f n1 = Vec3f(u(rng), u(rng), u(rng)).normalized();
+    const Vec3f n2 = Vec3f(u(rng), u(rng), u(rng)).normalized();
+    detail::PairFeatures expected;
+    const bool ok = detail::pair_features(p1, n1, p2, n2, expected);
+    const PairFeatures f = compute_pair_features(p1, n1, p2, n2);
+    EXPECT_EQ(f.valid, ok);
+    EXPECT_EQ(std::memcmp(&f.f1, &expected.alpha, 4), 0);
+    EXPECT_EQ(std::memcmp(&f.f2, &expected.phi, 4), 0);
+    EXPECT_EQ(std::memcmp(&f.f3, &expected.theta, 4), 0);
+    EXPECT_EQ(std::memcmp(&f.f4, &expected.dist, 4), 0);
+  }
+}
+
+// ---- descriptors
+// ---------------------------------------------------------------------------------
+
+TEST(Descriptors, RowsSizeAndShapeChecks) {
+  Descriptors d(3, {1, 2, 3, 4, 5, 6});
+  EXPECT_EQ(d.size(), 2u);
+  EXPECT_EQ(d.row(1)[0], 4.0f);
+  EXPECT_EQ(d.row(1).size(), 3u);
+  d.row(0)[2] = 9.0f;
+  EXPECT_EQ(d.values[2], 9.0f);
+  EXPECT_THROW(Descriptors(3, {1, 2}), std::invalid_argument);
+  EXPECT_THROW(Descriptors(0, {}), std::invalid_argument);
+  const Descriptors nan = Descriptors::filled(4, 33, NAN);
+  EXPECT_EQ(nan.size(), 4u);
+  EXPECT_TRUE(std::isnan(nan.row(3)[32]));
+  EXPECT_EQ(Descriptors().size(), 0u);
 }
 
 // ---- conformance with PCL 1.13 on the Stanford bunny (reference fixtures made by PCL) ----------
@@ -70,14 +112,15 @@ class BunnyConformance : public ::testing::Test {
   }
 
   // Largest |ours - PCL| over every bin of every point; NaN must match NaN.
-  float max_difference(const std::vector<float>& ours, int bins, const std::string& fixture) {
+  float max_difference(const Descriptors& ours, int bins, const std::string& fixture) {
+    EXPECT_EQ(ours.dim, bins);
     const auto reference = test::read_csv(test::test_data("reference/" + fixture));
     EXPECT_EQ(reference.size(), cloud_.size());
     float worst = 0.0f;
     for (std::size_t i = 0; i < reference.size(); ++i) {
       EXPECT_EQ(reference[i].size(), static_cast<std::size_t>(bins));
       for (int b = 0; b < bins; ++b) {
-        const float mine = ours[i * bins + b], theirs = reference[i][b];
+        const float mine = ours.row(i)[b], theirs = reference[i][b];
         if (std::isnan(mine) || std::isnan(theirs)) {
           EXPECT_EQ(std::isnan(mine), std::isnan(theirs)) << "point " << i << " bin " << b;
           continue;
@@ -131,8 +174,8 @@ PointCloud sphere_with_normals(int n, unsigned seed) {
   return cloud;
 }
 
-float sub_sum(const std::vector<float>& h, std::size_t point, int sub) {
-  const float* row = h.data() + point * kFpfhSize + sub * kFpfhBinsPerFeature;
+float sub_sum(const Descriptors& h, std::size_t point, int sub) {
+  const float* row = h.row(point).data() + sub * kFpfhBinsPerFeature;
   return std::accumulate(row, row + kFpfhBinsPerFeature, 0.0f);
 }
 
@@ -165,13 +208,13 @@ TEST(Fpfh, PlaneAndSphereDiffer) {
   options.neighborhood = Neighborhood::Radius(0.02f);
   const auto h = compute_fpfh(plane, options);
   const std::size_t center = plane.size() / 2;
-  EXPECT_NEAR(h[center * kFpfhSize + 5], 100.0f, 1e-3f);
-  EXPECT_NEAR(h[center * kFpfhSize + 11 + 5], 100.0f, 1e-3f);
-  EXPECT_NEAR(h[center * kFpfhSize + 22 + 5], 100.0f, 1e-3f);
+  EXPECT_NEAR(h.row(center)[5], 100.0f, 1e-3f);
+  EXPECT_NEAR(h.row(center)[11 + 5], 100.0f, 1e-3f);
+  EXPECT_NEAR(h.row(center)[22 + 5], 100.0f, 1e-3f);
 
   PointCloud ball = sphere_with_normals(3000, 9);
   const auto hb = compute_fpfh(ball, options);
-  EXPECT_LT(hb[0 * kFpfhSize + 22 + 5], 95.0f);
+  EXPECT_LT(hb.row(0)[22 + 5], 95.0f);
 }
 
 TEST(Features, InvalidPointsAndNormalsAreNaNAndLeftOutOfNeighbourhoods) {
@@ -189,9 +232,9 @@ TEST(Features, InvalidPointsAndNormalsAreNaNAndLeftOutOfNeighbourhoods) {
   EXPECT_EQ(stats.isolated, 1u);
   EXPECT_EQ(stats.computed, cloud.size() - 3);
   for (std::size_t p : {broken_normal, broken_point})
-    for (int b = 0; b < kFpfhSize; ++b) EXPECT_TRUE(std::isnan(with_gaps[p * kFpfhSize + b])) << p;
+    for (int b = 0; b < kFpfhSize; ++b) EXPECT_TRUE(std::isnan(with_gaps.row(p)[b])) << p;
   const std::size_t lonely = cloud.size() - 1;  // like PCL: all zero
-  for (int b = 0; b < kFpfhSize; ++b) EXPECT_EQ(with_gaps[lonely * kFpfhSize + b], 0.0f);
+  for (int b = 0; b < kFpfhSize; ++b) EXPECT_EQ(with_gaps.row(lonely)[b], 0.0f);
 
   // A neighbour without a normal counts as absent: same descriptors as with it removed.
   PointCloud without = cloud;
@@ -199,15 +242,14 @@ TEST(Features, InvalidPointsAndNormalsAreNaNAndLeftOutOfNeighbourhoods) {
   const auto removed = compute_fpfh(without, options);
   for (std::size_t i = 0; i < cloud.size() - 1; ++i) {
     if (i == broken_normal || i == broken_point) continue;
-    for (int b = 0; b < kFpfhSize; ++b)
-      ASSERT_NEAR(with_gaps[i * kFpfhSize + b], removed[i * kFpfhSize + b], 1e-4f);
+    for (int b = 0; b < kFpfhSize; ++b) ASSERT_NEAR(with_gaps.row(i)[b], removed.row(i)[b], 1e-4f);
   }
   FeatureStats pfh_stats;
   const auto pfh = compute_pfh(cloud, options, {}, &pfh_stats);
   EXPECT_EQ(pfh_stats.nan, 2u);
   EXPECT_EQ(pfh_stats.isolated, 1u);
-  EXPECT_TRUE(std::isnan(pfh[broken_normal * kPfhSize]));
-  for (int b = 0; b < kPfhSize; ++b) EXPECT_EQ(pfh[(cloud.size() - 1) * kPfhSize + b], 0.0f);
+  EXPECT_TRUE(std::isnan(pfh.row(broken_normal)[0]));
+  for (int b = 0; b < kPfhSize; ++b) EXPECT_EQ(pfh.row(cloud.size() - 1)[b], 0.0f);
 }
 
 TEST(Features, RejectCloudsWithoutNormalsAndBadNeighbourhoods) {
@@ -225,7 +267,7 @@ TEST(Features, RejectCloudsWithoutNormalsAndBadNeighbourhoods) {
 
 TEST(Features, IdenticalForAnyThreadCount) {
   PointCloud cloud = sphere_with_normals(20000, 13);
-  std::vector<float> fpfh_reference, pfh_reference;
+  Descriptors fpfh_reference, pfh_reference;
   for (int threads : {1, 2, 3}) {
     FeatureOptions options;
     options.neighborhood = Neighborhood::Radius(0.012f);
@@ -238,8 +280,11 @@ TEST(Features, IdenticalForAnyThreadCount) {
       pfh_reference = pfh;
       continue;
     }
-    ASSERT_EQ(0, std::memcmp(fpfh.data(), fpfh_reference.data(), fpfh.size() * sizeof(float)));
-    ASSERT_EQ(0, std::memcmp(pfh.data(), pfh_reference.data(), pfh.size() * sizeof(float)));
+    ASSERT_EQ(fpfh.values.size(), fpfh_reference.values.size());
+    ASSERT_EQ(0, std::memcmp(fpfh.values.data(), fpfh_reference.values.data(),
+                             fpfh.values.size() * sizeof(float)));
+    ASSERT_EQ(0, std::memcmp(pfh.values.data(), pfh_reference.values.data(),
+                             pfh.values.size() * sizeof(float)));
   }
 }
 

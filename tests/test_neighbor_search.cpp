@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <limits>
+#include <random>
 #include <stop_token>
+#include <thread>
 
 #include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
@@ -307,6 +310,96 @@ TEST(NeighborSearch, CappedRadiusIsTheNearestWithinTheRadiusOnDenseClusters) {
       EXPECT_EQ(a, b) << "cap " << cap;
     }
   }
+}
+
+// The tree indexes the caller's points in place, skipping the non-finite ones: its structure is
+// nanoflann's tree over the finite points alone (the unsorted order of radius lists shows it).
+TEST(NeighborSearch, ACloudWithNaNsGetsNanoflannsTreeOverItsFinitePoints) {
+  PointCloud cloud = test::random_box(120000, 1.0f, 23);
+  cloud.xyz[0] = Vec3f::Constant(100.0f);  // no grid: the tree answers radius queries
+  cloud.xyz[1] = Vec3f::Constant(-100.0f);
+  for (std::size_t i = 5; i < cloud.size(); i += 7) cloud.xyz[i] = Vec3f::Constant(NAN);
+  Points finite;
+  std::vector<std::uint32_t> to_cloud;
+  for (std::uint32_t i = 0; i < cloud.size(); ++i)
+    if (is_finite(cloud.xyz[i])) finite.points.push_back(cloud.xyz[i]), to_cloud.push_back(i);
+  const ReferenceTree reference(3, finite, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  const NeighborSearch search(cloud.xyz);
+  EXPECT_EQ(search.indexed_points(), finite.points.size());
+  NeighborList got;
+  std::size_t found = 0;
+  for (std::size_t i = 2; i < cloud.size(); i += 1009) {
+    std::vector<std::uint32_t> expected;
+    for (std::uint32_t c : tree_order(reference, cloud.xyz[i], 0.08f))
+      expected.push_back(to_cloud[c]);
+    search.find(cloud.xyz[i], Neighborhood::Radius(0.08f), got, /*sorted=*/false);
+    EXPECT_EQ(got.indices, expected) << i;
+    found += got.size();
+  }
+  EXPECT_GT(found, 1000u);
+}
+
+// A filtered query answers as a search built on the allowed points alone would (random points:
+// no ties), for every kind of neighbourhood, on the grid and on the tree.
+TEST(NeighborSearch, FilteredQueriesEqualASearchOnTheAllowedPointsAlone) {
+  PointCloud cloud = test::random_box(20000, 1.0f, 29);
+  for (std::size_t i = 3; i < cloud.size(); i += 53) cloud.xyz[i] = Vec3f::Constant(NAN);
+  std::mt19937 rng(5);
+  std::vector<std::uint8_t> allowed(cloud.size());
+  std::vector<Vec3f> subset;
+  std::vector<std::uint32_t> to_cloud;
+  for (std::uint32_t i = 0; i < cloud.size(); ++i) {
+    allowed[i] = rng() % 10 < 7;
+    if (allowed[i]) subset.push_back(cloud.xyz[i]), to_cloud.push_back(i);
+  }
+  const NeighborSearch search(cloud.xyz);
+  const NeighborSearch alone(subset);
+  NeighborList got, expected;
+  for (const Neighborhood& hood :
+       {Neighborhood::Knn(10), Neighborhood::Radius(0.1f), Neighborhood::Hybrid(0.1f, 5),
+        Neighborhood::Hybrid(0.5f, 40), Neighborhood::Radius(0.5f)}) {
+    for (std::size_t i = 0; i < cloud.size(); i += 211) {
+      for (const bool sorted : {true, false}) {
+        search.find(cloud.xyz[i], hood, allowed, got, sorted);
+        alone.find(cloud.xyz[i], hood, expected, sorted);
+        for (std::uint32_t& j : expected.indices) j = to_cloud[j];
+        if (!sorted) {  // the same set; the order is each tree's own
+          std::sort(got.indices.begin(), got.indices.end());
+          std::sort(expected.indices.begin(), expected.indices.end());
+        } else {
+          EXPECT_EQ(got.sq_dists, expected.sq_dists) << hood.describe() << " " << i;
+        }
+        ASSERT_EQ(got.indices, expected.indices) << hood.describe() << " " << i;
+        for (std::uint32_t j : got.indices) EXPECT_TRUE(allowed[j]);
+      }
+    }
+  }
+  std::vector<std::uint8_t> short_mask(cloud.size() - 1, 1);
+  EXPECT_THROW(search.find(cloud.xyz[0], Neighborhood::Knn(3), short_mask, got),
+               std::invalid_argument);
+}
+
+// nanoflann's build has no stop check of its own; the search checks the token from inside it
+// (the dataset adaptor), so a stop in the middle of a large build ends it within a few
+// milliseconds instead of at its end.
+TEST(NeighborSearchCancellation, AStopDuringTheBuildEndsItEarly) {
+  const PointCloud cloud = test::random_box(2000000, 1.0f, 31);
+  const auto start = std::chrono::steady_clock::now();
+  { const NeighborSearch full(cloud.xyz); }
+  const auto build = std::chrono::steady_clock::now() - start;
+  std::stop_source source;
+  std::chrono::steady_clock::time_point requested;
+  std::jthread stopper([&] {
+    std::this_thread::sleep_for(build / 4);
+    requested = std::chrono::steady_clock::now();
+    source.request_stop();
+  });
+  EXPECT_THROW(NeighborSearch(cloud.xyz, source.get_token()), Cancelled);
+  const auto returned = std::chrono::steady_clock::now();
+  stopper.join();
+  // Without checks inside the build the rest of it (about 3/4 of `build`) would run first.
+  EXPECT_LT(returned - requested, build / 4)
+      << std::chrono::duration<double, std::milli>(build).count() << " ms build";
 }
 
 }  // namespace

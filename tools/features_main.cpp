@@ -78,12 +78,12 @@ int run(const Arguments& args) {
   const auto features_start = std::chrono::steady_clock::now();
   FeatureStats stats;
   const bool fpfh = args.descriptor == "fpfh";
-  std::vector<float> values = fpfh ? compute_fpfh(cloud, options, context, &stats, &search)
-                                   : compute_pfh(cloud, options, context, &stats, &search);
+  Descriptors descriptors = fpfh ? compute_fpfh(cloud, options, context, &stats, &search)
+                                 : compute_pfh(cloud, options, context, &stats, &search);
   progress.done();
   const double feature_seconds = seconds_since(features_start);
-  FloatField& field = cloud.set_field(args.descriptor, fpfh ? kFpfhSize : kPfhSize);
-  field.values = std::move(values);
+  FloatField& field = cloud.set_field(args.descriptor, descriptors.dim);
+  field.values = std::move(descriptors.values);
 
   write_cloud(args.output, cloud);
   if (!args.quiet)

@@ -16,7 +16,7 @@ LabelResponder::LabelResponder(const pipeline::LabelingResult& result,
       classes_(std::uint64_t(result.probabilities.cols())) {
   bytes_per_point_ =
       wire::kLabelBytesPerPoint +
-      sizeof(float) * std::uint64_t(result.descriptor_dim) * (result.descriptors.empty() ? 0 : 1) +
+      sizeof(float) * std::uint64_t(result.descriptors.dim) * (result.descriptors.empty() ? 0 : 1) +
       sizeof(float) * classes_;
   const std::uint64_t fitting = std::max<std::uint64_t>(1, max_bytes / bytes_per_point_);
   chunk_points_ =
@@ -39,9 +39,9 @@ void LabelResponder::fill_range(std::uint64_t first, std::uint64_t count,
   wire::append_le(*chunk.mutable_labels(),
                   std::span<const std::uint32_t>(result_.labels.data() + first, count));
   if (!result_.descriptors.empty()) {
-    const std::size_t d = std::size_t(result_.descriptor_dim);
+    const std::size_t d = std::size_t(result_.descriptors.dim);
     wire::append_le(*chunk.mutable_descriptors(),
-                    std::span<const float>(result_.descriptors.data() + first * d, count * d));
+                    std::span<const float>(result_.descriptors.row(first).data(), count * d));
   }
   if (classes_ > 0) {
     // Eigen is column-major: gather each point's row.
@@ -95,7 +95,7 @@ void fill_summary(const RequestRecord& record, const ModelEntry& entry,
     timing->set_stage(name);
     timing->set_seconds(seconds);
   }
-  summary.set_descriptor_dim(static_cast<std::uint32_t>(result.descriptor_dim));
+  summary.set_descriptor_dim(static_cast<std::uint32_t>(result.descriptors.dim));
   *summary.mutable_classes() = entry.metadata.classes();
 }
 

@@ -44,8 +44,7 @@ inline LabeledGraph make_grid_scene(const SceneSpec& spec,
   const std::size_t n = std::size_t(spec.width) * spec.height;
   std::vector<Vec3f> points(n);
   LabeledGraph scene;
-  scene.descriptor_dim = spec.dim;
-  scene.descriptors.resize(n * spec.dim);
+  scene.descriptors = Descriptors::filled(n, spec.dim, 0.0f);
   scene.labels.resize(n);
   for (int y = 0; y < spec.height; ++y) {
     for (int x = 0; x < spec.width; ++x) {
@@ -54,13 +53,13 @@ inline LabeledGraph make_grid_scene(const SceneSpec& spec,
       const int label = (x / spec.region + 2 * (y / spec.region)) % spec.num_classes;
       scene.labels[i] = label;
       for (int f = 0; f < spec.dim; ++f)
-        scene.descriptors[i * spec.dim + f] =
+        scene.descriptors.row(i)[f] =
             std::max(0.0f, prototypes[std::size_t(label) * spec.dim + f] + noise(rng));
     }
   }
   GraphSettings options;
   options.neighborhood = Neighborhood::Knn(spec.neighbors);
-  scene.graph = build_graph(points, scene.descriptors, spec.dim, options);
+  scene.graph = build_graph(points, scene.descriptors, options);
   if (points_out) *points_out = std::move(points);
   return scene;
 }

@@ -27,9 +27,9 @@ struct Potentials {
     const std::size_t n = scene.graph.num_nodes();
     const int kp = detail::padded_classes(model.num_classes());
     float* t = theta.resize(n * kp);
-    detail::node_scores_padded(model, scene.descriptors, scene.graph, threads, t);
+    detail::node_scores_padded(model, scene.descriptors.values, scene.graph, threads, t);
     const std::size_t edges = detail::number_edges(scene.graph, threads, edge_of, block_first_edge);
-    detail::edge_terms_padded(model, scene.descriptors, scene.graph, block_first_edge.data(),
+    detail::edge_terms_padded(model, scene.descriptors.values, scene.graph, block_first_edge.data(),
                               threads, true, psi_minus_one.resize(edges * kp));
     detail::node_potentials_padded(t, n, model.num_classes(), threads, phi.resize(n * kp));
   }

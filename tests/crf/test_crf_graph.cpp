@@ -45,7 +45,7 @@ TEST(CrfGraph, KnnIsSymmetricWithoutSelfLoops) {
   const std::vector<float> descriptors(50 * 2, 1.0f);
   GraphSettings options;
   options.neighborhood = Neighborhood::Knn(4);
-  const Graph g = build_graph(points, descriptors, 2, options);
+  const Graph g = build_graph(points, Descriptors(2, descriptors), options);
   expect_well_formed(g);
   EXPECT_EQ(g.num_active(), 50u);
   for (std::size_t i = 0; i < 50; ++i) EXPECT_GE(g.degree(i), 4u);
@@ -59,12 +59,12 @@ TEST(CrfGraph, RadiusAndHybrid) {
   const std::vector<float> descriptors(30, 0.0f);  // all-zero descriptors are valid
   GraphSettings options;
   options.neighborhood = Neighborhood::Radius(1.5f);
-  const Graph g = build_graph(points, descriptors, 1, options);
+  const Graph g = build_graph(points, Descriptors(1, descriptors), options);
   expect_well_formed(g);
   EXPECT_EQ(g.degree(0), 1u);
   EXPECT_EQ(g.degree(15), 2u);
   options.neighborhood = Neighborhood::Hybrid(10.0f, 2);
-  const Graph h = build_graph(points, descriptors, 1, options);
+  const Graph h = build_graph(points, Descriptors(1, descriptors), options);
   expect_well_formed(h);
   for (std::size_t i = 0; i < 30; ++i) EXPECT_GE(h.degree(i), 2u);
 }
@@ -76,7 +76,7 @@ TEST(CrfGraph, InvalidPointsAreInactiveAndIsolated) {
   points[9] = Vec3f::Constant(std::nanf(""));
   GraphSettings options;
   options.neighborhood = Neighborhood::Knn(2);
-  const Graph g = build_graph(points, descriptors, 3, options);
+  const Graph g = build_graph(points, Descriptors(3, descriptors), options);
   expect_well_formed(g);
   EXPECT_FALSE(g.active[4]);
   EXPECT_FALSE(g.active[9]);
@@ -91,10 +91,11 @@ TEST(CrfGraph, DeterministicForAnyThreadsAndWithOrWithoutSearch) {
     points.emplace_back(std::sin(0.37f * i) * 3.0f, std::cos(0.11f * i) * 2.0f, 0.001f * i);
   const std::vector<float> descriptors(points.size() * 2, 1.0f);
   const GraphSettings options;
-  const Graph one = build_graph(points, descriptors, 2, options, RunContext{1});
-  const Graph two = build_graph(points, descriptors, 2, options, RunContext{2});
+  const Graph one = build_graph(points, Descriptors(2, descriptors), options, RunContext{1});
+  const Graph two = build_graph(points, Descriptors(2, descriptors), options, RunContext{2});
   const NeighborSearch search(points);
-  const Graph reused = build_graph(points, descriptors, 2, options, RunContext{2}, &search);
+  const Graph reused =
+      build_graph(points, Descriptors(2, descriptors), options, RunContext{2}, &search);
   expect_well_formed(one);
   EXPECT_EQ(one.offsets, two.offsets);
   EXPECT_EQ(one.neighbors, two.neighbors);
@@ -118,7 +119,7 @@ TEST(CrfGraph, FromEdgesAndRestrict) {
 }
 
 TEST(CrfGraph, Empty) {
-  const Graph g = build_graph({}, {}, 33);
+  const Graph g = build_graph({}, Descriptors(33, {}));
   EXPECT_EQ(g.num_nodes(), 0u);
   EXPECT_EQ(g.num_slots(), 0u);
   EXPECT_EQ(g.offsets.size(), 1u);
@@ -154,7 +155,8 @@ std::vector<std::vector<std::uint32_t>> brute_force_rows(const Patch& patch,
   const std::size_t n = patch.points.size();
   std::vector<std::uint8_t> valid(n);
   for (std::size_t i = 0; i < n; ++i)
-    valid[i] = is_finite(patch.points[i]) && descriptor_is_valid(&patch.descriptors[2 * i], 2);
+    valid[i] = is_finite(patch.points[i]) &&
+               descriptor_is_valid(std::span<const float>(&patch.descriptors[2 * i], 2));
   std::vector<std::vector<std::uint32_t>> rows(n);
   for (std::size_t i = 0; i < n; ++i) {
     if (!valid[i]) continue;
@@ -197,8 +199,10 @@ TEST(CrfGraphCancellation, AStoppedTokenCancelsTheBuild) {
   for (const Neighborhood& hood : {Neighborhood::Knn(8), Neighborhood::Radius(0.05f)}) {
     options.neighborhood = hood;
     // Its own index over the valid points, and the shared index.
-    EXPECT_THROW(build_graph(patch.points, patch.descriptors, 2, options, context), Cancelled);
-    EXPECT_THROW(build_graph(finite, all_valid, 2, options, context, &search), Cancelled);
+    EXPECT_THROW(build_graph(patch.points, Descriptors(2, patch.descriptors), options, context),
+                 Cancelled);
+    EXPECT_THROW(build_graph(finite, Descriptors(2, all_valid), options, context, &search),
+                 Cancelled);
   }
 }
 
@@ -210,10 +214,11 @@ TEST(CrfGraphCancellation, ANeverStoppedTokenGivesTheSameGraph) {
     const auto expected = brute_force_rows(patch, hood);
     GraphSettings plain;
     plain.neighborhood = hood;
-    const Graph reference = build_graph(patch.points, patch.descriptors, 2, plain, RunContext{1});
+    const Graph reference =
+        build_graph(patch.points, Descriptors(2, patch.descriptors), plain, RunContext{1});
     for (int threads : {1, 3}) {
       const RunContext context{threads, never.get_token()};
-      const Graph g = build_graph(patch.points, patch.descriptors, 2, plain, context);
+      const Graph g = build_graph(patch.points, Descriptors(2, patch.descriptors), plain, context);
       expect_well_formed(g);
       ASSERT_EQ(g.num_nodes(), expected.size());
       for (std::size_t i = 0; i < expected.size(); ++i)
@@ -224,6 +229,46 @@ TEST(CrfGraphCancellation, ANeverStoppedTokenGivesTheSameGraph) {
       EXPECT_EQ(g.neighbors, reference.neighbors);
       EXPECT_EQ(g.reverse, reference.reverse);
       EXPECT_EQ(g.active, reference.active);
+    }
+  }
+}
+
+// Points without a descriptor are filtered out of the one index's answers: the graph is the one
+// a search over the valid points alone gives (how it was built before), with the caller's index
+// or without.
+TEST(CrfGraph, MissingDescriptorsGiveTheGraphOfTheValidPointsAlone) {
+  const Patch patch = noisy_patch();
+  std::vector<Vec3f> valid_points;
+  std::vector<float> valid_descriptors;
+  std::vector<std::uint32_t> to_patch;
+  for (std::size_t i = 0; i < patch.points.size(); ++i) {
+    if (!is_finite(patch.points[i]) ||
+        !descriptor_is_valid(std::span<const float>(&patch.descriptors[2 * i], 2)))
+      continue;
+    valid_points.push_back(patch.points[i]);
+    valid_descriptors.insert(valid_descriptors.end(),
+                             {patch.descriptors[2 * i], patch.descriptors[2 * i + 1]});
+    to_patch.push_back(static_cast<std::uint32_t>(i));
+  }
+  ASSERT_LT(to_patch.size(), patch.points.size() - 10);  // some finite points lack a descriptor
+  const NeighborSearch search(patch.points);
+  for (const Neighborhood& hood :
+       {Neighborhood::Knn(8), Neighborhood::Radius(0.05f), Neighborhood::Hybrid(0.05f, 6)}) {
+    GraphSettings settings;
+    settings.neighborhood = hood;
+    const Graph compact = build_graph(valid_points, Descriptors(2, valid_descriptors), settings);
+    const Graph own = build_graph(patch.points, Descriptors(2, patch.descriptors), settings);
+    const Graph shared =
+        build_graph(patch.points, Descriptors(2, patch.descriptors), settings, {}, &search);
+    EXPECT_EQ(own.neighbors, shared.neighbors) << hood.describe();
+    EXPECT_EQ(own.reverse, shared.reverse) << hood.describe();
+    ASSERT_EQ(own.num_slots(), compact.num_slots()) << hood.describe();
+    for (std::size_t c = 0; c < to_patch.size(); ++c) {
+      std::vector<std::uint32_t> expected;
+      for (std::uint32_t j : compact.neighbors_of(c)) expected.push_back(to_patch[j]);
+      const auto row = own.neighbors_of(to_patch[c]);
+      ASSERT_EQ(std::vector<std::uint32_t>(row.begin(), row.end()), expected)
+          << hood.describe() << " node " << to_patch[c];
     }
   }
 }

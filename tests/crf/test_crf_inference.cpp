@@ -250,9 +250,9 @@ TEST(CrfInference, PointsWithoutDescriptorGetTheUnknownLabel) {
   spec.height = 20;
   std::vector<Vec3f> points;
   LabeledGraph scene = testing::make_grid_scene(spec, &points);
-  for (std::size_t i : {0u, 57u, 222u}) scene.descriptors[i * spec.dim + 3] = std::nanf("");
+  for (std::size_t i : {0u, 57u, 222u}) scene.descriptors.row(i)[3] = std::nanf("");
   points[300] = Vec3f::Constant(std::nanf(""));
-  const Graph graph = build_graph(points, scene.descriptors, spec.dim);
+  const Graph graph = build_graph(points, scene.descriptors);
   const CrfModel model = testing::prototype_model(spec, 3.0f, 1.0f);
   for (const auto method : {InferenceMethod::kLoopyBp, InferenceMethod::kMeanField}) {
     InferenceSettings options;
@@ -275,8 +275,10 @@ TEST(CrfInference, PointsWithoutDescriptorGetTheUnknownLabel) {
 TEST(CrfInference, EmptyGraphAndNodeOnlyModels) {
   const CrfModel model = CrfModel::zeros({1, 2}, 4);
   const Graph empty = graph_from_edges(0, {});
-  const InferenceResult r = infer(model, {}, empty, {});
+  const InferenceResult r = infer(model, Descriptors(4, {}), empty, {});
   EXPECT_TRUE(r.labels.empty());
+  // Typed descriptors must have the model's dimension.
+  EXPECT_THROW(infer(model, Descriptors(3, {}), empty, {}), std::invalid_argument);
 
   // Without edge weights, inference is the per-node argmax.
   SceneSpec spec;

@@ -44,7 +44,7 @@ bool same_bits(const float* a, const float* b, std::size_t n) {
 TEST(CrfScoreCancellation, AStoppedTokenCancelsEveryScoreLoop) {
   const Fixture f;
   const Graph& graph = f.scene.graph;
-  const auto& x = f.scene.descriptors;
+  const auto& x = f.scene.descriptors.values;
   const std::stop_token stop = stopped();
   ScratchBuffer<std::uint32_t> edge_of, block_first;
   EXPECT_THROW(detail::number_edges(graph, 2, edge_of, block_first, stop), Cancelled);
@@ -62,7 +62,7 @@ TEST(CrfScoreCancellation, AStoppedTokenCancelsEveryScoreLoop) {
 TEST(CrfScoreCancellation, ANeverStoppedTokenGivesTheSameScores) {
   const Fixture f;
   const Graph& graph = f.scene.graph;
-  const auto& x = f.scene.descriptors;
+  const auto& x = f.scene.descriptors.values;
   std::stop_source never;
   const std::stop_token token = never.get_token();
   for (int threads : {1, 3}) {

@@ -24,13 +24,15 @@ TEST(CrfSvm, LearnsASeparableProblem) {
   const std::vector<LabeledGraph> train = {testing::make_grid_scene(spec)};
   spec.seed = 2;
   LabeledGraph test = testing::make_grid_scene(spec);
-  test.descriptors[5 * spec.dim] = std::nanf("");
+  test.descriptors.row(5)[0] = std::nanf("");
 
   SvmOptions options;
   options.max_training_points = 300;  // exercises the subsample
   const SvmClassifier svm = SvmClassifier::train(train, {11, 12, 13}, options);
   EXPECT_EQ(svm.training_points(), 300u);
   EXPECT_GT(svm.gamma(), 0.0);
+  // Typed descriptors must have the classifier's dimension.
+  EXPECT_THROW(svm.predict(Descriptors(spec.dim + 1, {}), 0, 1), std::invalid_argument);
   const SvmPrediction one = svm.predict(test.descriptors, 0, 1);
   const SvmPrediction two = svm.predict(test.descriptors, 0, 2);
   EXPECT_EQ(one.labels, two.labels);
@@ -118,7 +120,7 @@ TEST(CrfSvm, LibsvmReadsOurTextAndWeReadLibsvms) {
   for (std::size_t i = 0; i < p.test.labels.size(); ++i) {
     row.clear();
     for (int f = 0; f < p.spec.dim; ++f) {
-      const float v = p.test.descriptors[i * p.spec.dim + f];
+      const float v = p.test.descriptors.row(i)[f];
       if (v != 0.0f) row.push_back({f + 1, 0.01 * v});
     }
     row.push_back({-1, 0.0});

@@ -89,9 +89,8 @@ TEST(CrfTraining, BetheObjectiveIsExactOnATree) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> value(0.0f, 100.0f);
   LabeledGraph scene;
-  scene.descriptor_dim = 3;
-  scene.descriptors.resize(7 * 3);
-  for (float& v : scene.descriptors) v = value(rng);
+  scene.descriptors = Descriptors::filled(7, 3, 0.0f);
+  for (float& v : scene.descriptors.values) v = value(rng);
   scene.graph = graph_from_edges(7, tree);
   scene.labels = {0, 0, 1, 2, 2, 1, 0};
   const std::vector<LabeledGraph> scenes = {scene};
@@ -108,7 +107,7 @@ TEST(CrfTraining, BetheObjectiveIsExactOnATree) {
     const double value_bethe = objective->evaluate(x, grad);
 
     const CrfModel model = detail::model_from_parameters(x, shape, like);
-    const testing::Exact exact = testing::brute_force(model, scene.descriptors, scene.graph);
+    const testing::Exact exact = testing::brute_force(model, scene.descriptors.values, scene.graph);
     const double exact_nll = (exact.log_z - exact.score(scene.labels)) / 7.0;
     EXPECT_NEAR(value_bethe, exact_nll, 1e-4) << knots.size() << " knots";
     EXPECT_LT(gradient_error(*objective, x, 1e-4), 2e-3) << knots.size() << " knots";
@@ -234,11 +233,11 @@ LabeledGraph band_scene(std::uint32_t seed, std::size_t n) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> value(0.0f, 100.0f);
   LabeledGraph scene;
-  scene.descriptor_dim = 1;
+  scene.descriptors.dim = 1;
   scene.graph = graph_from_edges(n, {});
   for (std::size_t i = 0; i < n; ++i) {
     const float v = value(rng);
-    scene.descriptors.push_back(v);
+    scene.descriptors.values.push_back(v);
     scene.labels.push_back(v > 30.0f && v < 60.0f ? 1 : 0);
   }
   return scene;

@@ -66,9 +66,9 @@ void expect_same_point(const LabelingResult& r, std::size_t a, std::size_t b) {
   const auto pa = r.probabilities.row(Eigen::Index(a)), pb = r.probabilities.row(Eigen::Index(b));
   for (Eigen::Index k = 0; k < pa.size(); ++k)
     if (!(std::isnan(pa(k)) && std::isnan(pb(k)))) EXPECT_EQ(pa(k), pb(k));
-  const std::size_t d = std::size_t(r.descriptor_dim);
+  const std::size_t d = std::size_t(r.descriptors.dim);
   for (std::size_t f = 0; f < d; ++f) {
-    const float x = r.descriptors[a * d + f], y = r.descriptors[b * d + f];
+    const float x = r.descriptors.values[a * d + f], y = r.descriptors.values[b * d + f];
     if (!(std::isnan(x) && std::isnan(y))) ASSERT_EQ(x, y) << a << " vs " << b << " bin " << f;
   }
 }
@@ -88,7 +88,7 @@ TEST(PipelineHostile, FarPointsAmongANormalScanLabelWithoutThrowing) {
     for (std::size_t i = normal.size(); i < cloud.size(); ++i)
       EXPECT_EQ(result.labels[i], class_id(PrimitiveClass::kUnknown))
           << far << " point " << i - normal.size() << " normal " << cloud.normals[i].transpose()
-          << " fpfh[0] " << result.descriptors[i * 33];
+          << " fpfh[0] " << result.descriptors.row(i)[0];
   }
 }
 
@@ -186,10 +186,10 @@ TEST(PipelineHostile, HostileMixIsTheSameForOneAndTwoThreads) {
   const LabelingResult r1 = pipeline::label_cloud(model, one, all_outputs(), RunContext{1});
   const LabelingResult r2 = pipeline::label_cloud(model, two, all_outputs(), RunContext{2});
   ASSERT_EQ(r1.labels, r2.labels);
-  ASSERT_EQ(r1.descriptors.size(), r2.descriptors.size());
-  for (std::size_t k = 0; k < r1.descriptors.size(); ++k)
-    if (!(std::isnan(r1.descriptors[k]) && std::isnan(r2.descriptors[k])))
-      ASSERT_EQ(r1.descriptors[k], r2.descriptors[k]) << k;
+  ASSERT_EQ(r1.descriptors.values.size(), r2.descriptors.values.size());
+  for (std::size_t k = 0; k < r1.descriptors.values.size(); ++k)
+    if (!(std::isnan(r1.descriptors.values[k]) && std::isnan(r2.descriptors.values[k])))
+      ASSERT_EQ(r1.descriptors.values[k], r2.descriptors.values[k]) << k;
 }
 
 // Stops label_cloud at a few moments and returns the worst latency from the stop to the return.

@@ -27,8 +27,8 @@ TEST(PipelineServiceOptions, DescriptorsAreReturnedRowMajorAsDescribeComputesThe
   pipeline::LabelingOptions options;
   options.want_descriptors = true;
   const auto result = pipeline::label_cloud(model, cloud, options);
-  ASSERT_EQ(result.descriptor_dim, kFpfhSize);
-  ASSERT_EQ(result.descriptors.size(), cloud.size() * kFpfhSize);
+  ASSERT_EQ(result.descriptors.dim, kFpfhSize);
+  ASSERT_EQ(result.descriptors.size(), cloud.size());
   // The fixture samples the box's edges twice: label_cloud describes each position once (at its
   // lowest index) and gives every copy that row, so compare with describe_cloud on the distinct
   // points.
@@ -41,9 +41,9 @@ TEST(PipelineServiceOptions, DescriptorsAreReturnedRowMajorAsDescribeComputesThe
   for (std::size_t j = 0; j < distinct.size(); ++j)
     distinct.xyz[j] = again.xyz[duplicates.representatives[j]];
   const auto described = pipeline::describe_cloud(distinct, model.features);
-  for (std::size_t i = 0; i < result.descriptors.size(); ++i) {
+  for (std::size_t i = 0; i < result.descriptors.values.size(); ++i) {
     const std::size_t row = duplicates.slot_of[i / kFpfhSize], bin = i % kFpfhSize;
-    const float a = result.descriptors[i], b = described.descriptors[row * kFpfhSize + bin];
+    const float a = result.descriptors.values[i], b = described.descriptors.row(row)[bin];
     ASSERT_TRUE((std::isnan(a) && std::isnan(b)) || a == b) << "value " << i;
   }
   EXPECT_TRUE(pipeline::label_cloud(model, again, {}).descriptors.empty());
@@ -106,7 +106,7 @@ TEST(PipelineServiceOptions, VoxelDownsamplingGivesEveryPointItsVoxelsResults) {
   const auto result = pipeline::label_cloud(model, cloud, options, RunContext{1});
   ASSERT_EQ(result.labels.size(), cloud.size());
   ASSERT_EQ(result.probabilities.rows(), Eigen::Index(cloud.size()));
-  ASSERT_EQ(result.descriptors.size(), cloud.size() * kFpfhSize);
+  ASSERT_EQ(result.descriptors.values.size(), cloud.size() * kFpfhSize);
   EXPECT_LT(result.described_points, cloud.size() / 2);
   EXPECT_EQ(result.labels[3], 0u);
   EXPECT_TRUE(std::isnan(result.probabilities(3, 0)));

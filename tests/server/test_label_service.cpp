@@ -75,7 +75,7 @@ TEST(LabelService, DescriptorsProbabilitiesAndSmallResponseChunks) {
   const auto expected = pipeline::label_cloud(model, local, options);
   EXPECT_EQ(answer.labels, expected.labels);
   for (std::size_t i = 0; i < answer.descriptors.size(); i += 101) {
-    const float a = answer.descriptors[i], b = expected.descriptors[i];
+    const float a = answer.descriptors[i], b = expected.descriptors.values[i];
     ASSERT_TRUE((std::isnan(a) && std::isnan(b)) || a == b) << i;
   }
   for (std::size_t i = 0; i < cloud.size(); i += 97)

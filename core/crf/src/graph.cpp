@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "primlabel/geometry/parallel.hpp"
@@ -177,29 +178,30 @@ std::size_t Graph::num_active() const {
   return static_cast<std::size_t>(std::count(active.begin(), active.end(), std::uint8_t{1}));
 }
 
-bool descriptor_is_valid(const float* row, int dim) {
-  for (int f = 0; f < dim; ++f)
-    if (!std::isfinite(row[f])) return false;
+bool descriptor_is_valid(std::span<const float> row) {
+  for (float v : row)
+    if (!std::isfinite(v)) return false;
   return true;
 }
 
-std::vector<std::uint8_t> valid_descriptor_mask(std::span<const float> descriptors, int dim) {
-  if (dim <= 0) throw std::invalid_argument("valid_descriptor_mask: descriptor dimension <= 0");
-  const std::size_t n = descriptors.size() / static_cast<std::size_t>(dim);
+std::vector<std::uint8_t> valid_descriptor_mask(const Descriptors& descriptors) {
+  if (descriptors.dim <= 0)
+    throw std::invalid_argument("valid_descriptor_mask: descriptor dimension <= 0");
+  const std::size_t n = descriptors.size();
   std::vector<std::uint8_t> mask(n);
-  for (std::size_t i = 0; i < n; ++i)
-    mask[i] = descriptor_is_valid(descriptors.data() + i * dim, dim) ? 1 : 0;
+  for (std::size_t i = 0; i < n; ++i) mask[i] = descriptor_is_valid(descriptors.row(i)) ? 1 : 0;
   return mask;
 }
 
-Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descriptors, int dim,
+Graph build_graph(const std::vector<Vec3f>& points, const Descriptors& descriptors,
                   const GraphSettings& settings, const RunContext& context,
                   const NeighborSearch* search) {
   if (!settings.neighborhood.valid())
     throw std::invalid_argument("build_graph: invalid neighbourhood " +
                                 settings.neighborhood.describe());
-  if (dim <= 0 || descriptors.size() != points.size() * static_cast<std::size_t>(dim))
-    throw std::invalid_argument("build_graph: descriptors are not points.size() x dim");
+  if (descriptors.dim <= 0 ||
+      descriptors.values.size() != points.size() * static_cast<std::size_t>(descriptors.dim))
+    throw std::invalid_argument("build_graph: descriptors are not one row per point");
   const std::size_t n = points.size();
   const int threads = primlabel::detail::resolve_threads(context.threads);
   const std::stop_token& stop = context.stop;
@@ -208,7 +210,7 @@ Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descr
   std::vector<std::uint8_t> active(n);
   for (std::size_t i = 0; i < n; ++i) {
     check_every(i, stop);
-    active[i] = descriptor_is_valid(descriptors.data() + i * dim, dim) ? 1 : 0;
+    active[i] = descriptor_is_valid(descriptors.row(i)) ? 1 : 0;
   }
   bool every_finite_point_active = true;
   for (std::size_t i = 0; i < n; ++i) {
@@ -218,23 +220,18 @@ Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descr
     if (finite && !active[i]) every_finite_point_active = false;
   }
 
-  // Search over exactly the active points; compact index -> point index when it is a subset.
-  std::vector<Vec3f> compact_points;
-  std::vector<std::uint32_t> compact_to_point;
+  // One index over the cloud's finite points (the caller's, or one built here). When some of
+  // them lack a descriptor, the queries filter them out rather than a second index being built
+  // over the active points: the same neighbours, without a copy of the cloud and a second tree.
   std::unique_ptr<NeighborSearch> own_search;
-  const NeighborSearch* index = search;
-  if (!search || !every_finite_point_active) {
-    for (std::size_t i = 0; i < n; ++i) {
-      check_every(i, stop);
-      if (!active[i]) continue;
-      compact_points.push_back(points[i]);
-      compact_to_point.push_back(static_cast<std::uint32_t>(i));
-    }
-    own_search = std::make_unique<NeighborSearch>(compact_points, stop);
-    index = own_search.get();
-  }
-  const auto to_point = [&](std::uint32_t found) {
-    return own_search ? compact_to_point[found] : found;
+  if (!search) own_search = std::make_unique<NeighborSearch>(points, stop);
+  const NeighborSearch& index = search ? *search : *own_search;
+  const auto find = [&](const Vec3f& q, const Neighborhood& hood, NeighborList& found,
+                        bool sorted) {
+    if (every_finite_point_active)
+      index.find(q, hood, found, sorted);
+    else
+      index.find(q, hood, active, found, sorted);
   };
 
   const Neighborhood query = query_with_self(settings.neighborhood);
@@ -249,9 +246,8 @@ Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descr
         for (std::size_t i = b * BlockLists::kListBlock; i < last; ++i) {
           if (stop.stop_requested()) return;  // per node: within one neighbourhood's time
           if (active[i]) {
-            index->find(points[i], query, found, /*sorted=*/cap >= 0);
-            for (std::uint32_t f : found.indices) {
-              const std::uint32_t j = to_point(f);
+            find(points[i], query, found, /*sorted=*/cap >= 0);
+            for (std::uint32_t j : found.indices) {
               if (j == static_cast<std::uint32_t>(i)) continue;
               if (cap >= 0 && static_cast<int>(lists.list_size(b)) >= cap) break;
               lists.push_back(b, j);

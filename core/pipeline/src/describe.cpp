@@ -58,7 +58,6 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   const bool fpfh = settings.descriptor == DescriptorKind::kFpfh;
   out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, stage, nullptr, out.search.get())
                          : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
-  out.descriptor_dim = settings.descriptor_dim();
   out.feature_seconds = seconds_since(start);
   return out;
 }
@@ -67,8 +66,8 @@ crf::Graph build_scene_graph(const PointCloud& cloud, const DescribedCloud& desc
                              const crf::GraphSettings& settings, const RunContext& context) {
   crf::GraphSettings bounded = settings;
   bounded.neighborhood = capped(settings.neighborhood);
-  return crf::build_graph(cloud.xyz, described.descriptors, described.descriptor_dim, bounded,
-                          context, described.search.get());
+  return crf::build_graph(cloud.xyz, described.descriptors, bounded, context,
+                          described.search.get());
 }
 
 crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& described,
@@ -76,7 +75,6 @@ crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& des
   if (cloud.labels.size() != cloud.size())
     throw std::invalid_argument("the cloud has no label per point");
   crf::LabeledGraph scene;
-  scene.descriptor_dim = described.descriptor_dim;
   scene.descriptors = std::move(described.descriptors);
   scene.graph = std::move(graph);
   scene.labels.assign(cloud.size(), crf::kIgnoreLabel);

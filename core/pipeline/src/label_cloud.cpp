@@ -81,7 +81,6 @@ LabelingResult label_distinct_points(const LabelModel& model, const FeatureSetti
   if (options.want_probabilities) result.probabilities = std::move(inferred.marginals);
   if (options.want_descriptors) {
     result.descriptors = std::move(described.descriptors);
-    result.descriptor_dim = described.descriptor_dim;
   }
   result.labeled_points = graph.num_active();
   return result;
@@ -104,8 +103,7 @@ LabelingResult unknown_result(std::size_t points, const LabelingResult& like,
     result.probabilities =
         Eigen::MatrixXf::Constant(Eigen::Index(points), Eigen::Index(like.class_ids.size()), kNaN);
   if (options.want_descriptors) {
-    result.descriptor_dim = like.descriptor_dim;
-    result.descriptors.assign(points * std::size_t(like.descriptor_dim), kNaN);
+    result.descriptors = Descriptors::filled(points, like.descriptors.dim, kNaN);
   }
   return result;
 }
@@ -117,8 +115,8 @@ void copy_point(const LabelingResult& part, std::size_t from, LabelingResult& wh
   if (part.probabilities.size() > 0)
     whole.probabilities.row(Eigen::Index(to)) = part.probabilities.row(Eigen::Index(from));
   if (!part.descriptors.empty()) {
-    const std::size_t d = std::size_t(part.descriptor_dim);
-    std::copy_n(part.descriptors.begin() + from * d, d, whole.descriptors.begin() + to * d);
+    const std::span<const float> row = part.descriptors.row(from);
+    std::copy(row.begin(), row.end(), whole.descriptors.row(to).begin());
   }
 }
 

@@ -80,13 +80,11 @@ void classify_with_svm(const LabelModel& model, DescribedCloud&& described,
   result.class_ids = model.class_ids();
   result.labels = std::move(predicted.labels);
   if (options.want_probabilities) result.probabilities = std::move(predicted.probabilities);
-  const std::size_t dim = std::size_t(described.descriptor_dim);
   result.labeled_points = 0;
-  for (std::size_t i = 0; i * dim < described.descriptors.size(); ++i)
-    result.labeled_points += std::isfinite(described.descriptors[i * dim]) ? 1 : 0;
+  for (std::size_t i = 0; i < described.descriptors.size(); ++i)
+    result.labeled_points += std::isfinite(described.descriptors.row(i)[0]) ? 1 : 0;
   if (options.want_descriptors) {
     result.descriptors = std::move(described.descriptors);
-    result.descriptor_dim = described.descriptor_dim;
   }
   result.inference_seconds = seconds_since(start);
 }

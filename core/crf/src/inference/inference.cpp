@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "primlabel/geometry/parallel.hpp"
 #include "inference/belief_propagation.hpp"
@@ -78,6 +79,31 @@ void outputs_from_rows(const float* rows, bool log_scores, const CrfModel& model
 }
 
 }  // namespace
+
+namespace {
+void check_dim(const CrfModel& model, const Descriptors& descriptors) {
+  if (descriptors.dim != model.descriptor_dim)
+    throw std::invalid_argument("infer: descriptors have dimension " +
+                                std::to_string(descriptors.dim) + ", the model " +
+                                std::to_string(model.descriptor_dim));
+}
+}  // namespace
+
+InferenceResult infer(const CrfModel& model, const Descriptors& descriptors, const Graph& graph,
+                      const InferenceSettings& settings, const InferenceOutputs& outputs,
+                      const RunContext& context) {
+  check_dim(model, descriptors);
+  return infer(model, std::span<const float>(descriptors.values), graph, settings, outputs,
+               context);
+}
+
+InferenceResult infer(const CrfModel& model, const Descriptors& descriptors, const Graph& graph,
+                      const InferenceSettings& settings, const InferenceOutputs& outputs,
+                      const RunContext& context, InferenceWorkspace& workspace) {
+  check_dim(model, descriptors);
+  return infer(model, std::span<const float>(descriptors.values), graph, settings, outputs,
+               context, workspace);
+}
 
 InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
                       const InferenceSettings& settings, const InferenceOutputs& outputs,

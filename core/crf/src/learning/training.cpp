@@ -53,7 +53,7 @@ std::vector<PreparedScene> prepare_scenes(std::span<const LabeledGraph> scenes,
     out.labels.assign(n, kIgnoreLabel);
     for (long long i = 0; i < n; ++i) {
       if (!in.graph.active[i]) continue;
-      const float* descriptor = in.descriptors.data() + i * d;
+      const float* descriptor = in.descriptors.row(std::size_t(i)).data();
       if (compact)
         tent_pairs(descriptor, d, like.feature_scale, like.node_knots,
                    &out.tents[std::size_t(i) * d]);
@@ -100,10 +100,10 @@ void check_scenes(std::span<const LabeledGraph> scenes, int dim, int classes, co
   for (std::size_t s = 0; s < scenes.size(); ++s) {
     const LabeledGraph& g = scenes[s];
     const std::string where = std::string(what) + " scene " + std::to_string(s) + ": ";
-    if (g.descriptor_dim != dim)
+    if (g.descriptors.dim != dim)
       throw std::invalid_argument(where + "descriptor dimension differs from the first scene");
-    if (g.descriptors.size() != g.graph.num_nodes() * std::size_t(dim))
-      throw std::invalid_argument(where + "descriptors are not num_nodes x descriptor_dim");
+    if (g.descriptors.size() != g.graph.num_nodes())
+      throw std::invalid_argument(where + "descriptors are not one row per node");
     if (g.labels.size() != g.graph.num_nodes())
       throw std::invalid_argument(where + "labels are not one per node");
     for (int y : g.labels)
@@ -205,7 +205,7 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
                          const TrainingOptions& options, const RunContext& context) {
   if (training.empty()) throw std::invalid_argument("train_crf: no training scenes");
   if (class_ids.empty()) throw std::invalid_argument("train_crf: no classes");
-  const int dim = training.front().descriptor_dim;
+  const int dim = training.front().descriptors.dim;
   if (dim <= 0) throw std::invalid_argument("train_crf: descriptor dimension <= 0");
   const int classes = static_cast<int>(class_ids.size());
   check_scenes(training, dim, classes, "training");

@@ -124,9 +124,9 @@ void weight_spfh(const PointCloud& cloud, std::size_t p, const std::vector<float
 
 }  // namespace
 
-std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
-                                const RunContext& context, FeatureStats* stats,
-                                const NeighborSearch* search) {
+Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
+                         const RunContext& context, FeatureStats* stats,
+                         const NeighborSearch* search) {
   const std::stop_token& stop = context.stop;
   if (!options.neighborhood.valid())
     throw std::invalid_argument("FPFH: invalid neighbourhood " + options.neighborhood.describe());
@@ -206,7 +206,7 @@ std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& o
   throw_if_stopped(stop, "FPFH");
   progress.finish();
   if (stats) *stats = FeatureStats{computed.load(), isolated.load(), n - computed - isolated};
-  return fpfh;
+  return Descriptors(kFpfhSize, std::move(fpfh));
 }
 
 }  // namespace primlabel

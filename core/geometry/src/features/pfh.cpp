@@ -47,9 +47,9 @@ void compute_point_pfh(const PointCloud& cloud, const NeighborList& neighbors, P
 
 }  // namespace
 
-std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& options,
-                               const RunContext& context, FeatureStats* stats,
-                               const NeighborSearch* search) {
+Descriptors compute_pfh(const PointCloud& cloud, const FeatureOptions& options,
+                        const RunContext& context, FeatureStats* stats,
+                        const NeighborSearch* search) {
   const std::stop_token& stop = context.stop;
   if (!options.neighborhood.valid())
     throw std::invalid_argument("PFH: invalid neighbourhood " + options.neighborhood.describe());
@@ -97,7 +97,7 @@ std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& op
   throw_if_stopped(stop, "PFH");
   progress.finish();
   if (stats) *stats = FeatureStats{computed.load(), isolated.load(), n - computed - isolated};
-  return pfh;
+  return Descriptors(kPfhSize, std::move(pfh));
 }
 
 }  // namespace primlabel

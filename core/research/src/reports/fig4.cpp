@@ -136,14 +136,15 @@ SignatureAccumulator::SignatureAccumulator(int descriptor_dim)
 }
 
 void SignatureAccumulator::add(std::span<const std::uint32_t> labels,
-                               std::span<const float> descriptors) {
-  if (descriptors.size() != labels.size() * std::size_t(dim_))
-    throw std::invalid_argument("signatures: one descriptor row per label expected");
+                               const Descriptors& descriptors) {
+  if (descriptors.dim != dim_ || descriptors.size() != labels.size())
+    throw std::invalid_argument(
+        "signatures: one descriptor row of the dimension per label expected");
   for (std::size_t i = 0; i < labels.size(); ++i) {
     const std::uint32_t id = labels[i];
     if (id == class_id(PrimitiveClass::kUnknown) || id >= kPrimitiveClassCount) continue;
-    const float* row = descriptors.data() + i * std::size_t(dim_);
-    if (!std::all_of(row, row + dim_, [](float v) { return std::isfinite(v); })) continue;
+    const std::span<const float> row = descriptors.row(i);
+    if (!std::all_of(row.begin(), row.end(), [](float v) { return std::isfinite(v); })) continue;
     for (int b = 0; b < dim_; ++b) sums_(id, b) += row[b];
     ++counts_[id];
   }

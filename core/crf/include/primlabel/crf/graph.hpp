@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "primlabel/geometry/descriptors.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/run_context.hpp"
@@ -45,17 +46,17 @@ struct GraphSettings {
 
 // A row of `dim` values is a valid descriptor when every value is finite (features.hpp marks
 // invalid points with NaN rows; all-zero rows of isolated points are valid).
-bool descriptor_is_valid(const float* row, int dim);
-std::vector<std::uint8_t> valid_descriptor_mask(std::span<const float> descriptors, int dim);
+bool descriptor_is_valid(std::span<const float> row);
+std::vector<std::uint8_t> valid_descriptor_mask(const Descriptors& descriptors);
 
 // Links every point with a valid descriptor to its neighbours among the points with a valid
-// descriptor, then symmetrises (union: i~j when either finds the other). `descriptors` is
-// row-major points.size() x dim. `search` may be passed to reuse an index built on `points`; it
-// is used only when every finite point has a valid descriptor (otherwise an index over the valid
-// points is built), so the graph never depends on whether it was passed. Throws
-// primlabel::Cancelled when context.stop is requested (checked per block of points, and while
-// the graph's own neighbour index is built). The graph is identical for any context.threads.
-Graph build_graph(const std::vector<Vec3f>& points, std::span<const float> descriptors, int dim,
+// descriptor, then symmetrises (union: i~j when either finds the other). `descriptors` has one
+// row per point. `search` may be passed to reuse an index built on `points` (otherwise one is
+// built); points without a valid descriptor are filtered out of its answers, so the graph never
+// depends on whether it was passed. Throws primlabel::Cancelled when context.stop is requested
+// (checked per block of points, and while the graph's own neighbour index is built). The graph
+// is identical for any context.threads.
+Graph build_graph(const std::vector<Vec3f>& points, const Descriptors& descriptors,
                   const GraphSettings& settings = {}, const RunContext& context = {},
                   const NeighborSearch* search = nullptr);
 

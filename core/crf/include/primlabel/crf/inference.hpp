@@ -15,6 +15,7 @@
 #include <span>
 #include <vector>
 
+#include "primlabel/geometry/descriptors.hpp"
 #include "primlabel/geometry/run_context.hpp"
 #include "primlabel/crf/graph.hpp"
 #include "primlabel/crf/model.hpp"
@@ -94,6 +95,13 @@ InferenceResult infer(const CrfModel& model, std::span<const float> descriptors,
                       const RunContext& context = {});
 // The same, with the caller's buffers (bit-identical results).
 InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,
+                      const InferenceSettings& settings, const InferenceOutputs& outputs,
+                      const RunContext& context, InferenceWorkspace& workspace);
+// The same for typed descriptors, whose dimension must be the model's.
+InferenceResult infer(const CrfModel& model, const Descriptors& descriptors, const Graph& graph,
+                      const InferenceSettings& settings = {}, const InferenceOutputs& outputs = {},
+                      const RunContext& context = {});
+InferenceResult infer(const CrfModel& model, const Descriptors& descriptors, const Graph& graph,
                       const InferenceSettings& settings, const InferenceOutputs& outputs,
                       const RunContext& context, InferenceWorkspace& workspace);
 

@@ -32,8 +32,7 @@ inline constexpr int kIgnoreLabel = -1;
 // or kIgnoreLabel. Ignored points are left out of every objective: they are no target, and for
 // pseudo-likelihood no neighbour either; kBetheBp removes them (and their edges) from the graph.
 struct LabeledGraph {
-  std::vector<float> descriptors;  // row-major num_nodes x descriptor_dim
-  int descriptor_dim = 0;
+  Descriptors descriptors;  // one row per node
   Graph graph;
   std::vector<int> labels;  // one per node
 };

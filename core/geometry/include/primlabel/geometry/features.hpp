@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "primlabel/geometry/descriptors.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/progress.hpp"
@@ -42,22 +43,29 @@ struct FeatureStats {
   std::size_t nan = 0;       // invalid points or normals: NaN descriptor
 };
 
-// Row-major size() x 33. Requires cloud.normals. Once context.stop is requested the remaining
-// blocks of points are skipped and the function throws Cancelled; context.progress counts points
-// (twice: both passes).
-std::vector<float> compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
-                                const RunContext& context = {}, FeatureStats* stats = nullptr,
-                                const NeighborSearch* search = nullptr);
+// cloud.size() x 33. Requires cloud.normals. Once context.stop is requested the remaining blocks
+// of points are skipped and the function throws Cancelled; context.progress counts points (twice:
+// both passes).
+Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
+                         const RunContext& context = {}, FeatureStats* stats = nullptr,
+                         const NeighborSearch* search = nullptr);
 
-// Row-major size() x 125. Requires cloud.normals. context as for compute_fpfh.
-std::vector<float> compute_pfh(const PointCloud& cloud, const FeatureOptions& options,
-                               const RunContext& context = {}, FeatureStats* stats = nullptr,
-                               const NeighborSearch* search = nullptr);
+// cloud.size() x 125. Requires cloud.normals. context as for compute_fpfh.
+Descriptors compute_pfh(const PointCloud& cloud, const FeatureOptions& options,
+                        const RunContext& context = {}, FeatureStats* stats = nullptr,
+                        const NeighborSearch* search = nullptr);
 
-// The four pair features of (p1, n1) and (p2, n2) as pcl::computePairFeatures defines them:
-// f1 = alpha (theta in the Darboux frame, atan2), f2 = phi, f3 = theta (cosines), f4 = distance.
-// Returns false (all zero) for coincident points or a degenerate frame.
-bool compute_pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2,
-                           float& f1, float& f2, float& f3, float& f4);
+// The four pair features of (p1, n1) and (p2, n2) as pcl::computePairFeatures defines them.
+// `valid` is false (and the features all zero, which is what PCL bins) for coincident points or a
+// degenerate frame.
+struct PairFeatures {
+  float f1 = 0.0f;  // alpha: theta in the Darboux frame (atan2), [-pi, pi]
+  float f2 = 0.0f;  // phi: cosine, v . n2
+  float f3 = 0.0f;  // theta: cosine, u . (p2 - p1) / |p2 - p1|
+  float f4 = 0.0f;  // distance |p2 - p1|
+  bool valid = false;
+};
+PairFeatures compute_pair_features(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2,
+                                   const Vec3f& n2);
 
 }  // namespace primlabel

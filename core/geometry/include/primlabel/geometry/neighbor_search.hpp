@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <stop_token>
 #include <string>
 #include <vector>
@@ -45,12 +46,13 @@ struct NeighborList {
 
 class NeighborSearch {
  public:
-  // Indexes the finite points of `points`; the vector must outlive the search object.
-  // `stop` is checked while the k-d tree is built (between subtrees of at most 64k points; the
-  // tree is the same as an unchecked build) and the constructor then throws primlabel::Cancelled.
-  // It is also checked while a radius grid is built on first use of a radius: a build cut short
-  // is not kept and the k-d tree answers instead (the same neighbours; unsorted lists may come
-  // in another order), since the caller is about to give up anyway.
+  // Indexes the finite points of `points` in place (nothing is copied); the vector must outlive
+  // the search object and not change while it lives. The k-d tree is nanoflann's, built through
+  // its public API; `stop` is checked before, during (every few hundred microseconds of the
+  // build; the tree is the same as an unchecked build) and after it, and the constructor then
+  // throws primlabel::Cancelled. It is also checked while a radius grid is built on first use of
+  // a radius: a build cut short is not kept and the k-d tree answers instead (the same
+  // neighbours; unsorted lists may come in another order), since the caller is about to give up.
   explicit NeighborSearch(const std::vector<Vec3f>& points, std::stop_token stop = {});
   ~NeighborSearch();
   NeighborSearch(const NeighborSearch&) = delete;
@@ -67,12 +69,16 @@ class NeighborSearch {
   void find(const Vec3f& query, const Neighborhood& hood, NeighborList& out,
             bool sorted = true) const;
 
+  // The same query among the points with allowed[i] != 0 only (`allowed` has one entry per
+  // point of the cloud): the neighbours a search built on those points alone would return, but
+  // on this one index. Ties at the last place of a k-nearest or capped list are broken by the
+  // tree's visiting order, as always, which a smaller tree may visit differently.
+  void find(const Vec3f& query, const Neighborhood& hood, std::span<const std::uint8_t> allowed,
+            NeighborList& out, bool sorted = true) const;
+
   std::size_t indexed_points() const;
 
  private:
-  // The `capacity` nearest points strictly closer than sq_bound, sorted.
-  void nearest(const Vec3f& query, std::size_t capacity, float sq_bound, NeighborList& out) const;
-
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

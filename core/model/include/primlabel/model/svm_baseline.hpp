@@ -60,6 +60,9 @@ class SvmClassifier {
   // labels only ~35k points/s, so a large cloud would otherwise run on for minutes).
   SvmPrediction predict(std::span<const float> descriptors, std::uint32_t unknown_label = 0,
                         int threads = 0, const std::stop_token& stop = {}) const;
+  // The same for typed descriptors, whose dimension must be descriptor_dim().
+  SvmPrediction predict(const Descriptors& descriptors, std::uint32_t unknown_label = 0,
+                        int threads = 0, const std::stop_token& stop = {}) const;
 
   double gamma() const;
   float feature_scale() const;

@@ -55,7 +55,7 @@ SvmClassifier SvmClassifier::train(std::span<const LabeledGraph> scenes,
                                    const SvmOptions& options) {
   if (scenes.empty() || class_ids.empty())
     throw std::invalid_argument("SVM: no training scenes or no classes");
-  const int dim = scenes.front().descriptor_dim;
+  const int dim = scenes.front().descriptors.dim;
   auto impl = std::make_unique<Impl>();
   impl->class_ids = class_ids;
   impl->dim = dim;
@@ -65,8 +65,8 @@ SvmClassifier SvmClassifier::train(std::span<const LabeledGraph> scenes,
   std::vector<std::pair<std::uint32_t, std::uint32_t>> samples;  // (scene, point)
   for (std::size_t s = 0; s < scenes.size(); ++s) {
     const LabeledGraph& g = scenes[s];
-    if (g.descriptor_dim != dim || g.labels.size() != g.graph.num_nodes() ||
-        g.descriptors.size() != g.labels.size() * std::size_t(dim))
+    if (g.descriptors.dim != dim || g.labels.size() != g.graph.num_nodes() ||
+        g.descriptors.size() != g.labels.size())
       throw std::invalid_argument("SVM: scene " + std::to_string(s) + " has inconsistent shapes");
     for (std::size_t i = 0; i < g.labels.size(); ++i) {
       if (g.labels[i] >= static_cast<int>(class_ids.size()))
@@ -93,7 +93,7 @@ SvmClassifier SvmClassifier::train(std::span<const LabeledGraph> scenes,
   std::vector<std::size_t> starts;
   std::vector<svm_node> row;
   for (const auto& [s, i] : samples) {
-    to_nodes(scenes[s].descriptors.data() + std::size_t(i) * dim, dim, options.feature_scale, row);
+    to_nodes(scenes[s].descriptors.row(i).data(), dim, options.feature_scale, row);
     starts.push_back(nodes.size());
     nodes.insert(nodes.end(), row.begin(), row.end());
     targets.push_back(scenes[s].labels[i]);
@@ -111,8 +111,8 @@ SvmClassifier SvmClassifier::train(std::span<const LabeledGraph> scenes,
     for (int p = 0; p < pairs; ++p) {
       const auto& [sa, ia] = samples[pick(rng)];
       const auto& [sb, ib] = samples[pick(rng)];
-      const float* a = scenes[sa].descriptors.data() + std::size_t(ia) * dim;
-      const float* b = scenes[sb].descriptors.data() + std::size_t(ib) * dim;
+      const float* a = scenes[sa].descriptors.row(ia).data();
+      const float* b = scenes[sb].descriptors.row(ib).data();
       for (int f = 0; f < dim; ++f) {
         const double diff = double(options.feature_scale) * (a[f] - b[f]);
         sum += diff * diff;
@@ -174,6 +174,15 @@ SvmClassifier SvmClassifier::from_libsvm_text(const std::string& text,
 }
 
 std::string SvmClassifier::to_libsvm_text() const { return impl_->model->to_text(); }
+
+SvmPrediction SvmClassifier::predict(const Descriptors& descriptors, std::uint32_t unknown_label,
+                                     int threads, const std::stop_token& stop) const {
+  if (descriptors.dim != impl_->dim)
+    throw std::invalid_argument("SVM: descriptors have dimension " +
+                                std::to_string(descriptors.dim) + ", the classifier " +
+                                std::to_string(impl_->dim));
+  return predict(std::span<const float>(descriptors.values), unknown_label, threads, stop);
+}
 
 SvmPrediction SvmClassifier::predict(std::span<const float> descriptors,
                                      std::uint32_t unknown_label, int threads,

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/geometry/descriptors.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/run_context.hpp"
@@ -22,8 +23,7 @@ namespace primlabel::pipeline {
 // computed them so the graph can reuse it. `search` indexes cloud.xyz: keep the cloud alive and
 // unmoved while it is used.
 struct DescribedCloud {
-  std::vector<float> descriptors;  // row-major cloud.size() x descriptor_dim; NaN rows = invalid
-  int descriptor_dim = 0;
+  Descriptors descriptors;  // one row per point; NaN rows = invalid
   std::unique_ptr<NeighborSearch> search;
   double normal_seconds = 0, feature_seconds = 0;
 };
@@ -81,9 +81,8 @@ struct LabelingResult {
   std::vector<std::uint32_t> labels;  // taxonomy class id per point; 0 (unknown) when unlabeled
   Eigen::MatrixXf probabilities;      // points x K (model class order) when asked; NaN rows
   std::vector<std::uint32_t> class_ids;
-  // points x descriptor_dim, row-major, when asked; NaN rows = the point had no descriptor.
-  std::vector<float> descriptors;
-  int descriptor_dim = 0;
+  // One row per point when asked (else empty, dim 0); NaN rows = the point had no descriptor.
+  Descriptors descriptors;
   std::size_t labeled_points = 0;    // input points that got a descriptor (through their voxel)
   std::size_t described_points = 0;  // points described: voxels when downsampling
   double prefilter_seconds = 0;      // table-top segmentation and voxel downsampling

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "primlabel/geometry/descriptors.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/synth/generate.hpp"
 
@@ -31,7 +32,7 @@ class SignatureAccumulator {
  public:
   explicit SignatureAccumulator(int descriptor_dim);
   // `labels` are taxonomy ids per point; unknown points and rows that are not finite are skipped.
-  void add(std::span<const std::uint32_t> labels, std::span<const float> descriptors);
+  void add(std::span<const std::uint32_t> labels, const Descriptors& descriptors);
   ClassSignatures result() const;
 
  private:

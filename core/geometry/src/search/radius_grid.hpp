@@ -1,0 +1,80 @@
+#pragma once
+// Fixed-radius queries on dense scans return hundreds of points; walking the k-d tree for them
+// costs more than scanning the few grid cells that can hold them. Cells are as wide as the
+// radius and ordered x-fastest, so the <= 3 cells along x of each (y, z) row are one contiguous
+// run: at most 9 runs per query. The grid keeps only cloud indices in cell order and reads the
+// caller's points through them. Distances are computed in nanoflann's order, so a grid query
+// returns exactly the set the k-d tree would.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <stop_token>
+#include <vector>
+
+#include "finite_points.hpp"
+#include "primlabel/geometry/neighbor_search.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
+
+namespace primlabel::detail {
+
+class RadiusGrid {
+ public:
+  // Returns nullptr when the cloud is too sparse for a grid of this cell size to pay off, and
+  // sets `stopped` (and returns nullptr) when `stop` is requested during the build. `points`
+  // must outlive the grid.
+  static std::unique_ptr<RadiusGrid> build(const FinitePoints& points, float radius,
+                                           const std::stop_token& stop, bool& stopped);
+
+  // How many points a query of this radius would compare (its <= 9 runs), without reading them.
+  std::size_t candidates(const Vec3f& q, float radius) const;
+
+  // Appends the points strictly within `radius` (sq_radius = radius^2) whose cloud index passes
+  // `accept`, cell by cell, in cloud order within a cell.
+  template <class Accept>
+  void find(const Vec3f& q, float sq_radius, float radius, const Accept& accept,
+            NeighborList& out) const {
+    std::int64_t lo[3], hi[3];
+    if (!cell_range(q, radius, lo, hi)) return;
+    for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+      for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
+        const std::size_t first = starts_[cell_index({lo[0], y, z})];
+        const std::size_t last = starts_[cell_index({hi[0], y, z}) + 1];
+        std::size_t count = out.indices.size();
+        out.indices.resize(count + (last - first));
+        out.sq_dists.resize(count + (last - first));
+        for (std::size_t i = first; i < last; ++i) {
+          const std::uint32_t index = index_[i];
+          const Vec3f& p = cloud_[index];
+          // nanoflann's L2_Simple_Adaptor: ((0 + dx^2) + dy^2) + dz^2.
+          const float dx = q.x() - p.x(), dy = q.y() - p.y(), dz = q.z() - p.z();
+          const float sq = (dx * dx + dy * dy) + dz * dz;
+          out.indices[count] = index;
+          out.sq_dists[count] = sq;
+          count += (sq < sq_radius) & accept(index);  // branch-free: write always, keep if inside
+        }
+        out.indices.resize(count);
+        out.sq_dists.resize(count);
+      }
+  }
+
+ private:
+  RadiusGrid() = default;
+  // The cells a query of this radius reads, as [lo, hi] per axis; false when there are none.
+  bool cell_range(const Vec3f& q, float radius, std::int64_t lo[3], std::int64_t hi[3]) const;
+  std::int64_t cell_coord(float v, int d) const;
+  std::array<std::int64_t, 3> cell_coords(const Vec3f& p) const;
+  std::size_t cell_index(const std::array<std::int64_t, 3>& c) const {
+    return static_cast<std::size_t>((c[2] * dims_[1] + c[1]) * dims_[0] + c[0]);
+  }
+
+  const Vec3f* cloud_ = nullptr;  // the caller's points, by cloud index
+  Vec3f origin_;
+  float inv_cell_ = 1.0f;
+  std::int64_t dims_[3] = {1, 1, 1};
+  std::vector<std::size_t> starts_;   // per cell, into index_; one extra at the end
+  std::vector<std::uint32_t> index_;  // cloud index of each grid slot, in cell order
+};
+
+}  // namespace primlabel::detail
