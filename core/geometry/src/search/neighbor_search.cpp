@@ -11,6 +11,7 @@
 #include <span>
 #include <sstream>
 #include <stdexcept>
+#include <variant>
 
 #include "finite_points.hpp"
 #include "primlabel/geometry/cancellation.hpp"
@@ -43,28 +44,37 @@ constexpr std::size_t kCheckMask = (std::size_t(1) << 12) - 1;
 // per allowed neighbour (a sphere fills ~1/6 of the cells' box in 3D, ~1/3 on a surface).
 constexpr std::size_t kCandidatesPerNeighbor = 8;
 
+// Clouds this large check the stop token while nanoflann builds their tree (a 5M-point build
+// takes seconds); smaller ones build in tens of milliseconds and are checked only before and
+// after, since the check on every read makes a build ~30% slower.
+constexpr std::size_t kCheckedBuildPoints = std::size_t(1) << 19;
+
 // nanoflann dataset adaptor over the finite points. Only the build reads points through it (the
 // distance below reads them directly), so the build is the only code that pays for its stop
 // check: nanoflann's buildIndex() has no cancellation of its own, but every node it splits reads
 // its points here, and an exception thrown here unwinds it (the tree is then discarded).
 static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be three packed floats");
+template <bool kCheckStop>
 struct TreePoints {
-  explicit TreePoints(const FinitePoints& finite)
-      : points(finite), xyz(reinterpret_cast<const float*>(finite.cloud())), map(finite.map()) {}
+  explicit TreePoints(const FinitePoints& finite, const std::stop_token& stop)
+      : points(finite), xyz(reinterpret_cast<const float*>(finite.cloud())), map(finite.map()),
+        build_stop(stop) {}
   const FinitePoints& points;
   // The same points as raw arrays: a 5M-point build reads coordinates ~10^8 times.
   const float* xyz;          // cloud index * 3 + dim
   const std::uint32_t* map;  // tree index -> cloud index, or nullptr: the identity
-  const std::stop_token* build_stop = nullptr;  // set only while buildIndex() runs
+  const std::stop_token& build_stop;
 
   std::size_t kdtree_get_point_count() const { return points.size(); }
   float kdtree_get_pt(std::size_t i, std::size_t dim) const {
-    if (build_stop != nullptr && (i & kCheckMask) == 0) [[unlikely]]
-      check_stop();
+    if constexpr (kCheckStop) {
+      if ((i & kCheckMask) == 0) [[unlikely]]
+        check_stop();
+    }
     return xyz[3 * std::size_t(map ? map[i] : i) + dim];
   }
   // Out of line, so that the read above stays small enough to inline into nanoflann's loops.
-  [[gnu::noinline, gnu::cold]] void check_stop() const { throw_if_stopped(*build_stop, kWhat); }
+  [[gnu::noinline, gnu::cold]] void check_stop() const { throw_if_stopped(build_stop, kWhat); }
   template <class BBox>
   bool kdtree_get_bbox(BBox&) const {
     return false;
@@ -73,13 +83,15 @@ struct TreePoints {
 
 // nanoflann's L2_Simple_Adaptor (the same arithmetic: ((0 + dx^2) + dy^2) + dz^2), reading the
 // points without the adaptor's build-time stop check.
+template <class Points>
 struct TreeDistance {
   using ElementType = float;
   using DistanceType = float;
-  const TreePoints& data;
-  explicit TreeDistance(const TreePoints& d) : data(d) {}
+  const float* xyz;
+  const std::uint32_t* map;
+  explicit TreeDistance(const Points& d) : xyz(d.xyz), map(d.map) {}
   float evalMetric(const float* a, std::uint32_t b, std::size_t size) const {
-    const float* p = data.xyz + 3 * std::size_t(data.map ? data.map[b] : b);
+    const float* p = xyz + 3 * std::size_t(map ? map[b] : b);
     float result = 0.0f;
     for (std::size_t i = 0; i < size; ++i) {
       const float diff = a[i] - p[i];
@@ -93,7 +105,23 @@ struct TreeDistance {
   }
 };
 
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<TreeDistance, TreePoints, 3, std::uint32_t>;
+// The two trees differ only in their build; queries go to whichever was built.
+template <bool kCheckStop>
+struct Tree {
+  using Points = TreePoints<kCheckStop>;
+  using Index =
+      nanoflann::KDTreeSingleIndexAdaptor<TreeDistance<Points>, Points, 3, std::uint32_t>;
+  Points points;
+  Index index;
+  Tree(const FinitePoints& finite, const std::stop_token& stop)
+      : points(finite, stop),
+        index(3, points,
+              nanoflann::KDTreeSingleIndexAdaptorParams(
+                  16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex)) {
+    index.buildIndex();
+  }
+};
+using AnyTree = std::variant<std::unique_ptr<Tree<false>>, std::unique_ptr<Tree<true>>>;
 
 // Result-set filters, by cloud index.
 struct AcceptAll {
@@ -241,12 +269,17 @@ void sort_by_distance(NeighborList& list) {
 
 struct NeighborSearch::Impl {
   Impl(const std::vector<Vec3f>& cloud, std::stop_token token)
-      : stop(std::move(token)), points(cloud, stop), adaptor(points) {}
+      : stop(std::move(token)), points(cloud, stop) {}
 
   std::stop_token stop;  // cuts the tree build and lazy grid builds short
   FinitePoints points;
-  TreePoints adaptor;
-  std::unique_ptr<KdTree> tree;
+  AnyTree tree;
+
+  template <class ResultSet>
+  void search_tree(ResultSet& result, const Vec3f& query,
+                   const nanoflann::SearchParams& params) const {
+    std::visit([&](const auto& t) { t->index.findNeighbors(result, query.data(), params); }, tree);
+  }
 
   // Radius grids are built on first use for a radius and kept; a radius that does not suit a
   // grid is remembered as such (nullptr) so the tree answers it.
@@ -271,7 +304,7 @@ struct NeighborSearch::Impl {
   void nearest(const Vec3f& query, std::size_t capacity, float sq_bound, const Accept& accept,
                NeighborList& out) const {
     NearestSet<Accept> result(capacity, sq_bound, points, accept);
-    tree->findNeighbors(result, query.data(), nanoflann::SearchParams());
+    search_tree(result, query, nanoflann::SearchParams());
     result.write(out);
     // Points exactly at the bound are outside a radius ("strictly inside").
     std::size_t found = out.size();
@@ -300,7 +333,7 @@ struct NeighborSearch::Impl {
         return;
       }
       RadiusCollector<Accept> collector(sq_radius, points, accept, out);
-      tree->findNeighbors(collector, query.data(), nanoflann::SearchParams(32, 0.0f, false));
+      search_tree(collector, query, nanoflann::SearchParams(32, 0.0f, false));
       if (sorted) sort_by_distance(out);
       return;
     }
@@ -319,7 +352,7 @@ struct NeighborSearch::Impl {
         }
       } else {
         BoundedRadiusCollector<Accept> collector(sq_radius, cap, points, accept, out);
-        tree->findNeighbors(collector, query.data(), nanoflann::SearchParams(32, 0.0f, false));
+        search_tree(collector, query, nanoflann::SearchParams(32, 0.0f, false));
         if (!collector.overflowed()) return;
         out.clear();
       }
@@ -332,14 +365,12 @@ NeighborSearch::NeighborSearch(const std::vector<Vec3f>& points, std::stop_token
     : impl_(std::make_unique<Impl>(points, std::move(stop))) {
   Impl& impl = *impl_;
   throw_if_stopped(impl.stop, kWhat);
-  // nanoflann's own build through its public API; the adaptor checks the token while it runs.
-  impl.tree = std::make_unique<KdTree>(
-      3, impl.adaptor,
-      nanoflann::KDTreeSingleIndexAdaptorParams(
-          16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
-  impl.adaptor.build_stop = &impl.stop;
-  impl.tree->buildIndex();
-  impl.adaptor.build_stop = nullptr;
+  // nanoflann's own build through its public API; for a large cloud the adaptor checks the
+  // token while it runs.
+  if (impl.points.size() >= kCheckedBuildPoints)
+    impl.tree = std::make_unique<Tree<true>>(impl.points, impl.stop);
+  else
+    impl.tree = std::make_unique<Tree<false>>(impl.points, impl.stop);
   throw_if_stopped(impl.stop, kWhat);
 }
 

@@ -48,8 +48,9 @@ class NeighborSearch {
  public:
   // Indexes the finite points of `points` in place (nothing is copied); the vector must outlive
   // the search object and not change while it lives. The k-d tree is nanoflann's, built through
-  // its public API; `stop` is checked before, during (every few hundred microseconds of the
-  // build; the tree is the same as an unchecked build) and after it, and the constructor then
+  // its public API; `stop` is checked before and after it, and during it for clouds of 2^19
+  // points or more (every few hundred microseconds; the tree is the same as an unchecked build;
+  // smaller builds take tens of milliseconds), and the constructor then
   // throws primlabel::Cancelled. It is also checked while a radius grid is built on first use of
   // a radius: a build cut short is not kept and the k-d tree answers instead (the same
   // neighbours; unsorted lists may come in another order), since the caller is about to give up.
