@@ -4,8 +4,8 @@
 #include <exception>
 #include <iostream>
 
-#include "primlabel/build_version.hpp"
 #include "features_bench.hpp"
+#include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 
 int main(int argc, char** argv) {

@@ -18,11 +18,11 @@
 #include <string>
 #include <vector>
 
-#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/build_version.hpp"
-#include "primlabel/geometry/json_text.hpp"
+#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "synthetic.hpp"
 
 namespace {

@@ -23,6 +23,7 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
 #include "primlabel/build_version.hpp"
 
 namespace {

@@ -24,8 +24,8 @@
 #include <thread>
 #include <vector>
 
-#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
@@ -58,8 +58,8 @@ LabelModel quick_model(synth::SensorKind sensor) {
   for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
   std::vector<pipeline::SceneData> train;
   train.push_back(
-      pipeline::prepare_scene(synth::synthetic_scene(synth::SceneSet::kTrain, 0, sensor),
-                              "train", features, graph, every_class));
+      pipeline::prepare_scene(synth::synthetic_scene(synth::SceneSet::kTrain, 0, sensor), "train",
+                              features, graph, every_class));
   const auto class_ids = pipeline::classes_present(train);
   pipeline::assign_labels(train.front(), class_ids);
   pipeline::ModelTrainingOptions options;

@@ -20,15 +20,15 @@
 #include <stop_token>
 #include <thread>
 
-#include "primlabel/build_version.hpp"
 #include "label_server.hpp"
 #include "logging.hpp"
+#include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
-#include "primlabel/synth/generate.hpp"
 #include "primlabel/scrape/exposition_parser.hpp"
+#include "primlabel/synth/generate.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "primlabel/wire/packing.hpp"
 #include "random_label_model.hpp"

@@ -12,8 +12,8 @@
 #include <limits>
 #include <sstream>
 
-#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/tabletop/segmentation_eval.hpp"

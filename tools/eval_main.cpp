@@ -15,19 +15,19 @@
 #include <fstream>
 #include <string>
 
-#include "primlabel/cli/cli_common.hpp"
 #include "node_basis.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/cli_common.hpp"
+#include "primlabel/crf/metrics.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
-#include "primlabel/crf/metrics.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
+#include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/research/confusion_plot.hpp"
 #include "primlabel/research/fig4.hpp"
-#include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/research/mosd_report.hpp"
 #include "primlabel/research/table1.hpp"
-#include "primlabel/geometry/labeled_cloud.hpp"
 
 namespace {
 

@@ -7,8 +7,8 @@
 #include <cstdio>
 #include <optional>
 
-#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"

@@ -8,13 +8,13 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/render/colorize.hpp"
 #include "primlabel/render/render.hpp"
-#include "primlabel/geometry/labeled_cloud.hpp"
 
 namespace {
 

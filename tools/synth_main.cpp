@@ -11,8 +11,8 @@
 #include <fstream>
 #include <map>
 
-#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"

@@ -10,8 +10,8 @@
 #include <sstream>
 #include <string>
 
-#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/render/render.hpp"

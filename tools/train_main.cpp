@@ -11,14 +11,14 @@
 #include <cstdio>
 #include <sstream>
 
-#include "primlabel/cli/cli_common.hpp"
 #include "node_basis.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
-#include "primlabel/research/curve_plot.hpp"
-#include "primlabel/pipeline/training.hpp"
-#include "primlabel/synth/generate.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
+#include "primlabel/pipeline/training.hpp"
+#include "primlabel/research/curve_plot.hpp"
+#include "primlabel/synth/generate.hpp"
 
 namespace {
 

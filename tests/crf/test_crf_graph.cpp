@@ -5,8 +5,8 @@
 #include <random>
 #include <stop_token>
 
-#include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/crf/graph.hpp"
+#include "primlabel/geometry/cancellation.hpp"
 
 namespace primlabel::crf {
 namespace {

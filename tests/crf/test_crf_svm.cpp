@@ -11,6 +11,10 @@
 #include "test_util.hpp"
 
 namespace primlabel::crf {
+using svm::SvmClassifier;
+using svm::SvmOptions;
+using svm::SvmPrediction;
+
 namespace {
 
 TEST(CrfSvm, LearnsASeparableProblem) {

@@ -11,9 +11,9 @@
 
 #include "png_decode.hpp"
 #include "primlabel/geometry/features.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
-#include "primlabel/geometry/labeled_cloud.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

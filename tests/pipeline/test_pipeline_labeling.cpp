@@ -70,8 +70,7 @@ LabelModel zero_model() {
 }
 
 PointCloud small_scene() {
-  PointCloud scene =
-      synth::synthetic_scene(synth::SceneSet::kTest, 1, synth::SensorKind::kLms400);
+  PointCloud scene = synth::synthetic_scene(synth::SceneSet::kTest, 1, synth::SensorKind::kLms400);
   return scene;
 }
 
@@ -136,8 +135,8 @@ TEST(PipelineLabeling, PiecewiseCrfTrainingKeepsTheCouplingThatValidatesBest) {
       synth::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
       features, graph, every_class, RunContext{2}));
   validation.push_back(pipeline::prepare_scene(
-      synth::synthetic_scene(synth::SceneSet::kVal, 0, synth::SensorKind::kLms400), "val",
-      features, graph, every_class, RunContext{2}));
+      synth::synthetic_scene(synth::SceneSet::kVal, 0, synth::SensorKind::kLms400), "val", features,
+      graph, every_class, RunContext{2}));
   const auto class_ids = pipeline::classes_present(train);
   pipeline::assign_labels(train[0], class_ids);
   pipeline::assign_labels(validation[0], class_ids);

@@ -8,9 +8,9 @@
 
 #include "png_decode.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/render/heatmap.hpp"
 #include "primlabel/research/confusion_plot.hpp"
 #include "primlabel/research/fig4.hpp"
-#include "primlabel/render/heatmap.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

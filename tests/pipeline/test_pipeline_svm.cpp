@@ -18,8 +18,7 @@ namespace {
 
 // A strip of a held-out LMS400 scene (its first sweep lines): small enough to label quickly.
 PointCloud small_scene() {
-  PointCloud scene =
-      synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400);
+  PointCloud scene = synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400);
   const std::size_t keep = 20000;
   scene.xyz.resize(keep);
   scene.labels.resize(keep);

@@ -10,8 +10,8 @@
 #include <sstream>
 
 #include "primlabel/geometry/cloud_io.hpp"
-#include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {

@@ -6,10 +6,10 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "primlabel/cli/cli_common.hpp"
 #include "commands.hpp"
 #include "common/labeled_output.hpp"
 #include "exit_codes.hpp"
+#include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel::client::tools {

@@ -5,8 +5,8 @@
 #include <memory>
 #include <stdexcept>
 
-#include "primlabel/geometry/parallel.hpp"
 #include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf {
 namespace {

@@ -4,9 +4,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "primlabel/geometry/parallel.hpp"
 #include "node_features.hpp"
 #include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf::detail {
 namespace {

@@ -6,8 +6,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "primlabel/geometry/parallel.hpp"
 #include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel {
 

@@ -255,7 +255,7 @@ void LabelModel::validate(const std::string& source) const {
   if (kind == ModelKind::kSvm) {
     if (svm_model.empty()) fail(source, "the SVM model is empty");
     try {
-      crf::SvmClassifier::from_libsvm_text(svm_model, svm_class_ids, features.descriptor_dim(),
+      svm::SvmClassifier::from_libsvm_text(svm_model, svm_class_ids, features.descriptor_dim(),
                                            weights.feature_scale);
     } catch (const std::invalid_argument& e) {
       fail(source, std::string("SVM model: ") + e.what());

@@ -21,7 +21,7 @@ ModelTrainingResult train_svm_model(std::span<const SceneData> training,
                                     std::span<const SceneData> validation,
                                     const std::vector<std::uint32_t>& class_ids,
                                     const FeatureSettings& features,
-                                    const crf::GraphSettings& graph, const crf::SvmOptions& options,
+                                    const crf::GraphSettings& graph, const svm::SvmOptions& options,
                                     const RunContext& context) {
   if (training.empty()) throw std::invalid_argument("no training scenes");
   std::vector<crf::LabeledGraph> graphs;
@@ -30,7 +30,7 @@ ModelTrainingResult train_svm_model(std::span<const SceneData> training,
 
   ModelTrainingResult out;
   const auto start = std::chrono::steady_clock::now();
-  const crf::SvmClassifier svm = crf::SvmClassifier::train(graphs, class_ids, options);
+  const svm::SvmClassifier svm = svm::SvmClassifier::train(graphs, class_ids, options);
   out.seconds = seconds_since(start);
 
   LabelModel& m = out.model;
@@ -59,10 +59,10 @@ ModelTrainingResult train_svm_model(std::span<const SceneData> training,
   return out;
 }
 
-crf::SvmClassifier svm_classifier_of(const LabelModel& model) {
+svm::SvmClassifier svm_classifier_of(const LabelModel& model) {
   if (model.kind != ModelKind::kSvm) throw ModelError(model.name + ": not an SVM model");
   try {
-    return crf::SvmClassifier::from_libsvm_text(model.svm_model, model.svm_class_ids,
+    return svm::SvmClassifier::from_libsvm_text(model.svm_model, model.svm_class_ids,
                                                 model.features.descriptor_dim(),
                                                 model.weights.feature_scale);
   } catch (const std::invalid_argument& e) {
@@ -74,8 +74,8 @@ void classify_with_svm(const LabelModel& model, DescribedCloud&& described,
                        const LabelingOptions& options, const RunContext& context,
                        LabelingResult& result) {
   const auto start = std::chrono::steady_clock::now();
-  const crf::SvmClassifier svm = svm_classifier_of(model);
-  crf::SvmPrediction predicted = svm.predict(
+  const svm::SvmClassifier svm = svm_classifier_of(model);
+  svm::SvmPrediction predicted = svm.predict(
       described.descriptors, class_id(PrimitiveClass::kUnknown), context.threads, context.stop);
   result.class_ids = model.class_ids();
   result.labels = std::move(predicted.labels);

@@ -8,8 +8,8 @@
 #include <limits>
 #include <stdexcept>
 
-#include "primlabel/geometry/parallel.hpp"
 #include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::tabletop {
 

@@ -5,13 +5,12 @@
 #include <stdexcept>
 #include <string>
 
-#include "primlabel/geometry/parallel.hpp"
 #include "inference/belief_propagation.hpp"
 #include "inference/mean_field.hpp"
 #include "mean_field.hpp"
-#include "primlabel/geometry/parallel.hpp"
 #include "potentials.hpp"
 #include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf {
 
@@ -101,8 +100,8 @@ InferenceResult infer(const CrfModel& model, const Descriptors& descriptors, con
                       const InferenceSettings& settings, const InferenceOutputs& outputs,
                       const RunContext& context, InferenceWorkspace& workspace) {
   check_dim(model, descriptors);
-  return infer(model, std::span<const float>(descriptors.values), graph, settings, outputs,
-               context, workspace);
+  return infer(model, std::span<const float>(descriptors.values), graph, settings, outputs, context,
+               workspace);
 }
 
 InferenceResult infer(const CrfModel& model, std::span<const float> descriptors, const Graph& graph,

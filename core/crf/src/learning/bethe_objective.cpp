@@ -12,8 +12,8 @@
 #include <memory>
 #include <span>
 
-#include "primlabel/geometry/parallel.hpp"
 #include "learning/objectives.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf::detail {
 namespace {

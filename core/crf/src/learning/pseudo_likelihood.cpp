@@ -9,8 +9,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "primlabel/geometry/parallel.hpp"
 #include "learning/objectives.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf::detail {
 namespace {

@@ -11,9 +11,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "primlabel/geometry/parallel.hpp"
-#include "node_features.hpp"
 #include "learning/objectives.hpp"
+#include "node_features.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf {
 namespace detail {

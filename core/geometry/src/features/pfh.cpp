@@ -9,9 +9,9 @@
 
 #include "feature_neighborhood.hpp"
 #include "pair_bins_batch.hpp"
-#include "primlabel/geometry/parallel.hpp"
 #include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/geometry/features.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel {
 

@@ -57,7 +57,9 @@ static_assert(sizeof(Vec3f) == 3 * sizeof(float), "Vec3f must be three packed fl
 template <bool kCheckStop>
 struct TreePoints {
   explicit TreePoints(const FinitePoints& finite, const std::stop_token& stop)
-      : points(finite), xyz(reinterpret_cast<const float*>(finite.cloud())), map(finite.map()),
+      : points(finite),
+        xyz(reinterpret_cast<const float*>(finite.cloud())),
+        map(finite.map()),
         build_stop(stop) {}
   const FinitePoints& points;
   // The same points as raw arrays: a 5M-point build reads coordinates ~10^8 times.
@@ -109,8 +111,7 @@ struct TreeDistance {
 template <bool kCheckStop>
 struct Tree {
   using Points = TreePoints<kCheckStop>;
-  using Index =
-      nanoflann::KDTreeSingleIndexAdaptor<TreeDistance<Points>, Points, 3, std::uint32_t>;
+  using Index = nanoflann::KDTreeSingleIndexAdaptor<TreeDistance<Points>, Points, 3, std::uint32_t>;
   Points points;
   Index index;
   Tree(const FinitePoints& finite, const std::stop_token& stop)

@@ -53,7 +53,8 @@ double MosdSceneReport::object_plane_share() const { return share(object_plane, 
 double MosdReport::plane_share() const { return share(table_plane, table_points); }
 
 MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& path,
-                                  const std::string& png_path, const pipeline::LabelingOptions& options,
+                                  const std::string& png_path,
+                                  const pipeline::LabelingOptions& options,
                                   const RunContext& context) {
   PointCloud cloud = read_cloud(path);
   if (!cloud.has_labels())

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/crf/metrics.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/model/svm_baseline.hpp"
 #include "primlabel/pipeline/training.hpp"
 
@@ -56,7 +56,8 @@ std::vector<Table1Row> rows_for(const FeatureSettings& features, const std::stri
     for (int i = 0; i < count; ++i) {
       PointCloud cloud = synth::synthetic_scene(set, i, options.sensor);
       const std::string source = std::string(synth::set_name(set)) + "#" + std::to_string(i);
-      out.push_back(pipeline::prepare_scene(std::move(cloud), source, features, graph, all_ids, context));
+      out.push_back(
+          pipeline::prepare_scene(std::move(cloud), source, features, graph, all_ids, context));
       feature_seconds += out.back().feature_seconds;
       described_points += out.back().truth.size();
       say(format("%s: %s described (%zu points, %.1f s)", descriptor.c_str(), source.c_str(),
@@ -100,10 +101,10 @@ std::vector<Table1Row> rows_for(const FeatureSettings& features, const std::stri
   if (options.with_svm) {
     std::vector<crf::LabeledGraph> graphs;
     for (const pipeline::SceneData& s : train) graphs.push_back(s.graph);
-    crf::SvmOptions svm_options;
+    svm::SvmOptions svm_options;
     svm_options.feature_scale = 0.01f;
     auto start = std::chrono::steady_clock::now();
-    const crf::SvmClassifier svm = crf::SvmClassifier::train(graphs, class_ids, svm_options);
+    const svm::SvmClassifier svm = svm::SvmClassifier::train(graphs, class_ids, svm_options);
     const double train_seconds = seconds_since(start);
     crf::ConfusionMatrix confusion(class_ids);
     start = std::chrono::steady_clock::now();

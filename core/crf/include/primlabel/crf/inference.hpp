@@ -15,10 +15,10 @@
 #include <span>
 #include <vector>
 
-#include "primlabel/geometry/descriptors.hpp"
-#include "primlabel/geometry/run_context.hpp"
 #include "primlabel/crf/graph.hpp"
 #include "primlabel/crf/model.hpp"
+#include "primlabel/geometry/descriptors.hpp"
+#include "primlabel/geometry/run_context.hpp"
 
 namespace primlabel::crf {
 

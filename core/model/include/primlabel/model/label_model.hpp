@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "primlabel/geometry/features.hpp"
 #include "primlabel/crf/graph.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/model.hpp"
+#include "primlabel/geometry/features.hpp"
 
 namespace primlabel {
 
@@ -70,7 +70,7 @@ struct LabelModel {
   FeatureSettings features;
   crf::GraphSettings graph;
   crf::CrfModel weights;  // kCrf, kNodeOnly (class_ids are the model's classes)
-  // kSvm: libsvm's text model (crf::SvmClassifier::to_libsvm_text; its labels index
+  // kSvm: libsvm's text model (svm::SvmClassifier::to_libsvm_text; its labels index
   // svm_class_ids), the classes, and weights.feature_scale as the SVM's feature scale.
   std::string svm_model;
   std::vector<std::uint32_t> svm_class_ids;

@@ -12,7 +12,7 @@
 
 #include "primlabel/crf/training.hpp"
 
-namespace primlabel::crf {
+namespace primlabel::svm {
 
 struct SvmOptions {
   double c = 10.0;
@@ -37,7 +37,7 @@ class SvmClassifier {
  public:
   // Trains on the labelled points (label >= 0) of the scenes' active nodes. Throws
   // std::invalid_argument for inconsistent data or fewer than one labelled point.
-  static SvmClassifier train(std::span<const LabeledGraph> scenes,
+  static SvmClassifier train(std::span<const crf::LabeledGraph> scenes,
                              const std::vector<std::uint32_t>& class_ids,
                              const SvmOptions& options = {});
 
@@ -82,4 +82,4 @@ class SvmClassifier {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace primlabel::crf
+}  // namespace primlabel::svm

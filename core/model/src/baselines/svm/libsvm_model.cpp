@@ -11,7 +11,7 @@
 #include <string_view>
 #include <type_traits>
 
-namespace primlabel::crf::detail {
+namespace primlabel::svm::detail {
 
 namespace {
 
@@ -285,4 +285,4 @@ std::string LibsvmModel::to_text() const {
   return out;
 }
 
-}  // namespace primlabel::crf::detail
+}  // namespace primlabel::svm::detail

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace primlabel::crf::detail {
+namespace primlabel::svm::detail {
 
 class LibsvmModel {
  public:
@@ -47,4 +47,4 @@ class LibsvmModel {
   std::vector<svm_node*> sv_rows_;
 };
 
-}  // namespace primlabel::crf::detail
+}  // namespace primlabel::svm::detail

@@ -11,11 +11,11 @@
 #include <stdexcept>
 #include <string>
 
-#include "primlabel/geometry/parallel.hpp"
 #include "libsvm_model.hpp"
 #include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
-namespace primlabel::crf {
+namespace primlabel::svm {
 namespace {
 
 void quiet(const char*) {}
@@ -50,7 +50,7 @@ SvmClassifier::SvmClassifier(SvmClassifier&&) noexcept = default;
 SvmClassifier& SvmClassifier::operator=(SvmClassifier&&) noexcept = default;
 SvmClassifier::~SvmClassifier() = default;
 
-SvmClassifier SvmClassifier::train(std::span<const LabeledGraph> scenes,
+SvmClassifier SvmClassifier::train(std::span<const crf::LabeledGraph> scenes,
                                    const std::vector<std::uint32_t>& class_ids,
                                    const SvmOptions& options) {
   if (scenes.empty() || class_ids.empty())
@@ -64,7 +64,7 @@ SvmClassifier SvmClassifier::train(std::span<const LabeledGraph> scenes,
   // Every usable labelled point, then a seeded subsample kept in data order.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> samples;  // (scene, point)
   for (std::size_t s = 0; s < scenes.size(); ++s) {
-    const LabeledGraph& g = scenes[s];
+    const crf::LabeledGraph& g = scenes[s];
     if (g.descriptors.dim != dim || g.labels.size() != g.graph.num_nodes() ||
         g.descriptors.size() != g.labels.size())
       throw std::invalid_argument("SVM: scene " + std::to_string(s) + " has inconsistent shapes");
@@ -239,4 +239,4 @@ std::size_t SvmClassifier::support_vectors() const {
 }
 const std::vector<std::uint32_t>& SvmClassifier::class_ids() const { return impl_->class_ids; }
 
-}  // namespace primlabel::crf
+}  // namespace primlabel::svm

@@ -8,13 +8,13 @@
 #include <memory>
 #include <vector>
 
+#include "primlabel/crf/graph.hpp"
+#include "primlabel/crf/training.hpp"
 #include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/geometry/descriptors.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/run_context.hpp"
-#include "primlabel/crf/graph.hpp"
-#include "primlabel/crf/training.hpp"
 #include "primlabel/model/label_model.hpp"
 
 namespace primlabel::pipeline {

@@ -17,11 +17,11 @@ ModelTrainingResult train_svm_model(std::span<const SceneData> training,
                                     std::span<const SceneData> validation,
                                     const std::vector<std::uint32_t>& class_ids,
                                     const FeatureSettings& features,
-                                    const crf::GraphSettings& graph, const crf::SvmOptions& options,
+                                    const crf::GraphSettings& graph, const svm::SvmOptions& options,
                                     const RunContext& context = {});
 
 // The classifier in an SVM model; throws ModelError when its libsvm text does not load.
-crf::SvmClassifier svm_classifier_of(const LabelModel& model);
+svm::SvmClassifier svm_classifier_of(const LabelModel& model);
 
 // Labels described points with an SVM model into `result`: labels, probabilities and descriptors
 // when asked, labeled points and inference time (the feature fields are left alone).

@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/crf/metrics.hpp"
-#include "primlabel/model/svm_baseline.hpp"
 #include "primlabel/crf/training.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/model/label_model.hpp"
+#include "primlabel/model/svm_baseline.hpp"
 
 namespace primlabel::pipeline {
 
@@ -48,7 +48,7 @@ struct ModelTrainingOptions {
   // the training scenes) best, as pseudo-likelihood overestimates them; and keep instead
   // node-only terms with a calibrated Potts coupling when that validates better (training.cpp).
   bool calibrate_edges = true;
-  crf::SvmOptions svm;  // kSvm
+  svm::SvmOptions svm;  // kSvm
   // Called per iteration with train / validation accuracy (slower: runs inference each time).
   std::function<void(const crf::TrainingIteration&)> on_iteration;
 };

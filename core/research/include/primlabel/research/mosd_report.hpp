@@ -33,7 +33,8 @@ struct MosdSceneReport {
 // Labels the scene at `path` with `model` and counts. When `png_path` is not empty, also renders
 // the predicted classes from the sensor's view (class colours, legend) there.
 MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& path,
-                                  const std::string& png_path, const pipeline::LabelingOptions& options = {},
+                                  const std::string& png_path,
+                                  const pipeline::LabelingOptions& options = {},
                                   const RunContext& context = {});
 
 struct MosdReport {

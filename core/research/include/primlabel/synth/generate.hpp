@@ -6,8 +6,8 @@
 #include <string>
 #include <string_view>
 
-#include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
+#include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/synth/scanners.hpp"
 #include "primlabel/synth/scene.hpp"
 

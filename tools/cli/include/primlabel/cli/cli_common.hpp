@@ -20,7 +20,6 @@ using ::primlabel::kExitUsage;
 // Parses "X,Y,Z" into a vector; throws std::invalid_argument with a readable reason.
 Vec3f parse_vec3(const std::string& text);
 
-
 // Prints "<stage>: 42% (1234/5678 points)" to stderr once a stage has run for a second:
 // redrawn in place on a terminal, a line per 10% otherwise. Silent when quiet.
 class ProgressPrinter {
