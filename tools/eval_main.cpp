@@ -7,34 +7,39 @@
 //   primlabel-eval --table1 [--json]
 //   primlabel-eval --fig4 out/ [--fig4-scenes 3]                    # the paper's Fig. 4
 //   primlabel-eval --model kinect.plm --mosd-report out/ ../shared/data/mosd/*.pcd
+//   primlabel-eval --calibrate-kinect ../shared/data/mosd [--calibration-json out.json]
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 
-#include "primlabel/cli/cli_common.hpp"
 #include "node_basis.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/cli_common.hpp"
+#include "primlabel/crf/metrics.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
-#include "primlabel/crf/metrics.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
+#include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/research/confusion_plot.hpp"
 #include "primlabel/research/fig4.hpp"
-#include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/research/kinect_calibration.hpp"
 #include "primlabel/research/mosd_report.hpp"
 #include "primlabel/research/table1.hpp"
-#include "primlabel/geometry/labeled_cloud.hpp"
 
 namespace {
 
 using namespace primlabel;
 
 struct Arguments {
-  std::string model, classes, out, confusion_png, fig4_dir, mosd_dir;
+  std::string model, classes, out, confusion_png, fig4_dir, mosd_dir, calibrate_dir,
+      calibration_json;
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
   bool table1 = false, no_pfh = false, no_svm = false;
@@ -191,6 +196,26 @@ int mosd_report(const Arguments& args) {
   return cli::kExitOk;
 }
 
+// The simulated Kinect's parameters measured on the table planes of the mOSD scenes in a folder.
+int calibrate_kinect(const Arguments& args) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(args.calibrate_dir, ec))
+    if (entry.path().extension() == ".pcd") files.push_back(entry.path().string());
+  if (ec) throw std::runtime_error(args.calibrate_dir + ": cannot be read (" + ec.message() + ")");
+  if (files.empty()) throw std::runtime_error(args.calibrate_dir + ": no .pcd file");
+  std::sort(files.begin(), files.end());
+  std::function<void(const std::string&)> progress;
+  if (!args.quiet)
+    progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  const research::KinectCalibration calibration =
+      research::calibrate_mosd(files, research::KinectCalibrationOptions{}, progress);
+  const std::string json = research::kinect_calibration_json(calibration);
+  if (!args.calibration_json.empty()) atomic_write_file(args.calibration_json, json);
+  std::fputs((args.json ? json : research::kinect_calibration_text(calibration)).c_str(), stdout);
+  return cli::kExitOk;
+}
+
 int fig4(const Arguments& args) {
   research::Fig4Options options;
   options.scenes = args.fig4_scenes;
@@ -276,11 +301,19 @@ int main(int argc, char** argv) {
   app.add_option("--fig4-scenes", args.fig4_scenes, "Fig. 4: training scenes (default 3)")
       ->check(CLI::PositiveNumber)
       ->needs(f4);
+  auto* calibrate = app.add_option(
+      "--calibrate-kinect", args.calibrate_dir,
+      "measure depth noise, disparity quantisation, density and missing returns on the table "
+      "planes of the mOSD scenes (*.pcd, label 1-9 table) in DIR; fit the simulated Kinect");
+  app.add_option("--calibration-json", args.calibration_json,
+                 "--calibrate-kinect: also write the calibration as JSON to FILE")
+      ->needs(calibrate);
   app.add_option("--threads", args.threads, "worker threads")
       ->check(CLI::PositiveNumber)
       ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
-  t1->excludes(model)->excludes(files)->excludes(f4);
+  t1->excludes(model)->excludes(files)->excludes(f4)->excludes(calibrate);
+  calibrate->excludes(model)->excludes(files)->excludes(f4);
   f4->excludes(model)->excludes(files);
 
   try {
@@ -296,11 +329,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "primlabel-eval: usage error: %s\n", e.what());
     return cli::kExitUsage;
   }
-  const bool study = args.table1 || !args.fig4_dir.empty();
+  const bool study = args.table1 || !args.fig4_dir.empty() || !args.calibrate_dir.empty();
   if (!study && (args.model.empty() || args.files.empty())) {
     std::fprintf(stderr,
                  "primlabel-eval: usage error: give --model and at least one file, or --table1 "
-                 "or --fig4 (see --help)\n");
+                 "or --fig4 or --calibrate-kinect (see --help)\n");
     return cli::kExitUsage;
   }
   if (!args.out.empty() && args.files.size() != 1) {
@@ -310,6 +343,7 @@ int main(int argc, char** argv) {
   try {
     if (args.table1) return table1(args);
     if (!args.fig4_dir.empty()) return fig4(args);
+    if (!args.calibrate_dir.empty()) return calibrate_kinect(args);
     if (!args.mosd_dir.empty()) return mosd_report(args);
     return evaluate_files(args);
   } catch (const std::exception& e) {

@@ -31,8 +31,10 @@ PointCloud scan_kinect(const Scene& scene, const KinectOptions& options, double 
   const Eigen::Matrix3d rotation = detail::camera_rotation(options.target - options.position);
   const double focal = options.focal_px * options.width / 640.0;
   const double cx = 0.5 * (options.width - 1), cy = 0.5 * (options.height - 1);
-  // Depth from disparity: z = focal * baseline / d, d quantised to 1/subpixel pixel.
-  const double focal_baseline = focal * options.baseline;
+  // Depth from disparity: z = focal * baseline / d, d quantised to 1/subpixel pixel of the IR
+  // camera.
+  const double focal_baseline =
+      options.disparity_focal_px * options.width / 640.0 * options.baseline;
   const Vec3d projector = options.position + options.baseline * rotation.col(0);
   const double min_cos_incidence = std::cos(options.max_incidence_deg * kDeg);
   const std::size_t pixels = std::size_t(options.width) * options.height;
