@@ -16,13 +16,16 @@ constexpr double kDeg = M_PI / 180.0;
 
 }  // namespace
 
-KinectOptions kinect_for_scene(const Scene& scene, std::uint64_t seed) {
+KinectOptions kinect_for_scene(const Scene& scene, std::uint64_t seed,
+                               const SensorPlacement& placement) {
   Rng rng(mix_seed(seed, kKinectStream - 1));
   KinectOptions options;
   const double front = -0.5 * scene.table_size.y();
   options.position =
       Vec3d(rng.uniform(-0.08, 0.08), front - rng.uniform(0.4, 0.5), rng.uniform(0.65, 0.8));
   options.target = Vec3d(rng.uniform(-0.05, 0.05), rng.uniform(0.0, 0.08), 0.0);
+  options.position =
+      detail::place_sensor(options.position, front, placement.range_scale, placement.elevation_deg);
   return options;
 }
 

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "primlabel/geometry/parallel.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
+#include "primlabel/geometry/parallel.hpp"
 #include "scan_common.hpp"
 
 namespace primlabel::synth::detail {

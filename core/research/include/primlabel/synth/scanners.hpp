@@ -34,9 +34,18 @@ struct Lms400Options {
   double min_range = 0.7, max_range = 3.0;
 };
 
+// Where a sensor stands, beyond the seed's small jitter (augmentation: other ranges and
+// incidences). Its offset from the table's front edge (back and up) is scaled by range_scale and
+// turned about the edge by elevation_deg (positive: higher, looking down more steeply).
+struct SensorPlacement {
+  double range_scale = 1.0;
+  double elevation_deg = 0.0;
+};
+
 // A scanner pose in front of the table (with a little seed-dependent variation in position and
 // heading) and a sweep over the region of the table the objects stand on, with a margin.
-Lms400Options lms400_for_scene(const Scene& scene, std::uint64_t seed);
+Lms400Options lms400_for_scene(const Scene& scene, std::uint64_t seed,
+                               const SensorPlacement& placement = {});
 
 PointCloud scan_lms400(const Scene& scene, const Lms400Options& options, double label_radius,
                        std::uint64_t seed);
@@ -68,7 +77,8 @@ struct KinectOptions {
   double min_range = 0.5, max_range = 4.0;
 };
 
-KinectOptions kinect_for_scene(const Scene& scene, std::uint64_t seed);
+KinectOptions kinect_for_scene(const Scene& scene, std::uint64_t seed,
+                               const SensorPlacement& placement = {});
 
 PointCloud scan_kinect(const Scene& scene, const KinectOptions& options, double label_radius,
                        std::uint64_t seed);
