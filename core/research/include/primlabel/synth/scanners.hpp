@@ -68,6 +68,11 @@ struct KinectOptions {
   // registered image's (the Kinect's IR camera: ~580 px); at 640 px width, scaled with it.
   double disparity_focal_px = 575;
   double depth_noise = 1.70e-3;
+  // The real error is spatially correlated (a disparity is matched over a window of pixels): the
+  // unit error is sqrt(independent_noise_share) white noise plus the rest white noise blurred by a
+  // Gaussian of std noise_correlation_px (each of unit variance). 0 px: every pixel on its own.
+  double noise_correlation_px = 0;
+  double independent_noise_share = 1;
   bool quantize = true;
   double baseline = 0.075;  // camera-projector distance (m)
   int subpixel = 8;
