@@ -42,7 +42,7 @@ struct Arguments {
       calibration_json;
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
-  bool table1 = false, no_pfh = false, no_svm = false;
+  bool table1 = false, no_pfh = false, no_svm = false, fit_simulation = false;
   std::string node_basis = "tent";
   std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
   int table1_train = 8, table1_test = 4, pfh_max_neighbors = 40, threads = 0, fig4_scenes = 3;
@@ -210,9 +210,24 @@ int calibrate_kinect(const Arguments& args) {
     progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   const research::KinectCalibration calibration =
       research::calibrate_mosd(files, research::KinectCalibrationOptions{}, progress);
-  const std::string json = research::kinect_calibration_json(calibration);
+  std::string json = research::kinect_calibration_json(calibration);
+  std::string text = research::kinect_calibration_text(calibration);
+  if (args.fit_simulation) {
+    const research::KinectSimulationFit fit =
+        research::fit_kinect_simulation(calibration, progress);
+    text += research::kinect_simulation_fit_text(fit);
+    json::Json root = json::Json::parse(json);
+    root["simulation_fit"] = {
+        {"depth_noise", json::rounded(fit.depth_noise, "%.6g")},
+        {"noise_correlation_px", fit.noise_correlation_px},
+        {"independent_noise_share", fit.independent_noise_share},
+        {"autocorrelation_rms", json::rounded(fit.autocorrelation_rms, "%.6g")},
+        {"simulated_depth_noise", json::rounded(fit.simulated.depth_noise, "%.6g")},
+        {"simulated_autocorrelation", fit.simulated.autocorrelation}};
+    json = json::dump(root) + "\n";
+  }
   if (!args.calibration_json.empty()) atomic_write_file(args.calibration_json, json);
-  std::fputs((args.json ? json : research::kinect_calibration_text(calibration)).c_str(), stdout);
+  std::fputs((args.json ? json : text).c_str(), stdout);
   return cli::kExitOk;
 }
 
@@ -305,6 +320,10 @@ int main(int argc, char** argv) {
       "--calibrate-kinect", args.calibrate_dir,
       "measure depth noise, disparity quantisation, density and missing returns on the table "
       "planes of the mOSD scenes (*.pcd, label 1-9 table) in DIR; fit the simulated Kinect");
+  app.add_flag("--fit-simulation", args.fit_simulation,
+               "--calibrate-kinect: also fit the simulator's correlated depth error by simulating "
+               "bare-table frames (about 20 s of CPU)")
+      ->needs(calibrate);
   app.add_option("--calibration-json", args.calibration_json,
                  "--calibrate-kinect: also write the calibration as JSON to FILE")
       ->needs(calibrate);

@@ -37,11 +37,13 @@ TEST(KinectCalibration, QuantizedSpreadMatchesSampledErrors) {
 
 // A bare-table Kinect frame with known noise and quantisation, calibrated on its table.
 KinectCalibration calibrate_synthetic(double depth_noise, double disparity_focal_px,
-                                      std::uint64_t seed) {
+                                      std::uint64_t seed, double correlation_px = 0) {
   const synth::Scene scene = synth::make_scene(synth::SceneKind::kEmptyTable, seed);
   synth::KinectOptions options = synth::kinect_for_scene(scene, seed);
   options.depth_noise = depth_noise;
   options.disparity_focal_px = disparity_focal_px;
+  options.noise_correlation_px = correlation_px;
+  options.independent_noise_share = correlation_px > 0 ? 0.05 : 1.0;
   const PointCloud cloud = synth::scan_kinect(scene, options, 0.025, seed);
   std::vector<bool> table(cloud.size());
   const FloatField* object = cloud.find_field("object");
@@ -72,6 +74,20 @@ TEST(KinectCalibration, RecoversKnownNoiseAndQuantisation) {
     for (const auto& bin : c.bins) fitted += std::isfinite(bin.model_noise);
     EXPECT_GE(fitted, 6u);
   }
+}
+
+// The simulator's correlated error (its defaults: 3.5 px, 5% white): the frame's plane still sees
+// the whole error, tiles a part of it, and neighbours share most of theirs.
+TEST(KinectCalibration, MeasuresTheCorrelatedError) {
+  const KinectCalibration c = calibrate_synthetic(2.25e-3, 575, 11, 3.5);
+  EXPECT_NEAR(c.global_depth_noise, 2.25e-3, 0.08 * 2.25e-3);
+  EXPECT_LT(c.depth_noise, 0.85 * c.global_depth_noise);
+  EXPECT_NEAR(c.depth_noise, 1.70e-3, 0.1 * 1.70e-3);  // the real frames' tile noise
+  ASSERT_EQ(c.lags.size(), 5u);
+  EXPECT_EQ(c.lags[2], 4);
+  EXPECT_NEAR(c.autocorrelation[0], 0.70, 0.1);  // the real frames: 0.70, 0.55, 0.34
+  EXPECT_NEAR(c.autocorrelation[2], 0.34, 0.1);
+  EXPECT_LT(c.autocorrelation[3], 0.15);
 }
 
 TEST(KinectCalibration, RealMosdSceneIsPlausible) {

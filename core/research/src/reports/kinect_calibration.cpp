@@ -11,6 +11,8 @@
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/research/mosd_report.hpp"
+#include "primlabel/synth/scanners.hpp"
+#include "primlabel/synth/scene.hpp"
 #include "primlabel/tabletop/plane_fit.hpp"
 
 namespace primlabel::research {
@@ -405,6 +407,86 @@ KinectCalibration KinectCalibrator::finish() const {
   return out;
 }
 
+namespace {
+
+// Bare-table frames (seeds 11, 12) simulated with `options`' error model, calibrated on the
+// table's top face.
+KinectCalibration calibrate_simulated(double depth_noise, double correlation_px,
+                                      double independent_share, int frames) {
+  KinectCalibrator calibrator;
+  for (int k = 0; k < frames; ++k) {
+    const std::uint64_t seed = 11 + static_cast<std::uint64_t>(k);
+    const synth::Scene scene = synth::make_scene(synth::SceneKind::kEmptyTable, seed);
+    synth::KinectOptions options = synth::kinect_for_scene(scene, seed);
+    options.depth_noise = depth_noise;
+    options.noise_correlation_px = correlation_px;
+    options.independent_noise_share = independent_share;
+    const PointCloud cloud = synth::scan_kinect(scene, options, 0.025, seed);
+    const FloatField* object = cloud.find_field("object");
+    // The top face only: the slab's front face (y = front) belongs to the table object too.
+    const float front = static_cast<float>(-0.5 * scene.table_size.y() + 0.01);
+    std::vector<bool> table(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+      table[i] = object->values[i] == 0.0f && cloud.xyz[i].y() > front;
+    calibrator.add_frame(cloud, table, "simulated:" + std::to_string(seed));
+  }
+  return calibrator.finish();
+}
+
+double autocorrelation_distance(const KinectCalibration& a, const KinectCalibration& b) {
+  double sum = 0;
+  int n = 0;
+  for (std::size_t k = 0; k < std::min(a.lags.size(), b.lags.size()); ++k)
+    if (a.lags[k] <= 4) sum += std::pow(a.autocorrelation[k] - b.autocorrelation[k], 2), ++n;
+  return n ? std::sqrt(sum / n) : NAN;
+}
+
+}  // namespace
+
+KinectSimulationFit fit_kinect_simulation(const KinectCalibration& real,
+                                          const std::function<void(const std::string&)>& progress) {
+  if (!(real.depth_noise > 0) || real.autocorrelation.empty())
+    throw std::invalid_argument("the real calibration has no noise fit to match");
+  constexpr double kProbeNoise = 1.7e-3;  // the coefficient the grid is simulated with
+  KinectSimulationFit best;
+  best.autocorrelation_rms = INFINITY;
+  double best_tile_noise = NAN;
+  for (double correlation : {0.0, 2.0, 2.5, 3.0, 3.5, 4.0, 5.0})
+    for (double share : {0.0, 0.05, 0.1, 0.2, 0.4}) {
+      if (correlation == 0 && share > 0) continue;  // all white already
+      const KinectCalibration sim = calibrate_simulated(kProbeNoise, correlation, share, 1);
+      const double distance = autocorrelation_distance(real, sim);
+      if (progress)
+        progress(
+            format("simulated: correlation %.1f px, white share %.2f: autocorrelation rms "
+                   "%.3f, tile noise %.4g for %.4g",
+                   correlation, share, distance, sim.depth_noise, kProbeNoise));
+      if (distance < best.autocorrelation_rms)
+        best.autocorrelation_rms = distance, best.noise_correlation_px = correlation,
+        best.independent_noise_share = share, best_tile_noise = sim.depth_noise;
+    }
+  if (best.noise_correlation_px == 0) best.independent_noise_share = 1;
+  best.depth_noise = real.depth_noise * kProbeNoise / best_tile_noise;
+  best.simulated = calibrate_simulated(best.depth_noise, best.noise_correlation_px,
+                                       best.independent_noise_share, 2);
+  best.autocorrelation_rms = autocorrelation_distance(real, best.simulated);
+  return best;
+}
+
+std::string kinect_simulation_fit_text(const KinectSimulationFit& fit) {
+  std::string out = format(
+      "simulator fit: depth_noise %.4g, noise_correlation_px %.1f, independent_noise_share %.2f; "
+      "its frames calibrate to tile noise %.4g * z^2, frame-plane noise %.4g * z^2, F %.1f,",
+      fit.depth_noise, fit.noise_correlation_px, fit.independent_noise_share,
+      fit.simulated.depth_noise, fit.simulated.global_depth_noise,
+      fit.simulated.focal_baseline_subpixel);
+  for (std::size_t k = 0; k < fit.simulated.lags.size(); ++k)
+    out += format(" lag %d px %.3f%s", fit.simulated.lags[k], fit.simulated.autocorrelation[k],
+                  k + 1 < fit.simulated.lags.size() ? "," : "");
+  out += format(" (rms to the real over 1-4 px %.3f)\n", fit.autocorrelation_rms);
+  return out;
+}
+
 KinectCalibration calibrate_mosd(const std::vector<std::string>& files,
                                  const KinectCalibrationOptions& options,
                                  const std::function<void(const std::string&)>& progress) {
@@ -432,12 +514,11 @@ std::string kinect_calibration_text(const KinectCalibration& c) {
                            "spacing", "missing", "holes");
   for (const auto& b : c.bins) {
     if (!b.points) continue;
-    out += format(
-        "%4.2f-%4.2f %9llu %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f %8.3f %7.2f%% %7.3f%%\n",
-        b.depth_lo, b.depth_hi, static_cast<unsigned long long>(b.points), 1e3 * b.global_spread,
-        1e3 * b.local_spread, 1e3 * b.local_noise, 1e3 * b.model_noise, 1e3 * b.level_spacing,
-        1e3 * b.model_level_spacing, b.point_spacing_ratio, 100 * b.missing_share,
-        100 * b.isolated_missing_share);
+    out += format("%4.2f-%4.2f %9llu %9.3f %9.3f %9.3f %9.3f %9.3f %9.3f %8.3f %7.2f%% %7.3f%%\n",
+                  b.depth_lo, b.depth_hi, static_cast<unsigned long long>(b.points),
+                  1e3 * b.global_spread, 1e3 * b.local_spread, 1e3 * b.local_noise,
+                  1e3 * b.model_noise, 1e3 * b.level_spacing, 1e3 * b.model_level_spacing,
+                  b.point_spacing_ratio, 100 * b.missing_share, 100 * b.isolated_missing_share);
   }
   out += format(
       "frames %zu, focal %.2f px, depth resolution of the files %.3g mm\n"

@@ -126,6 +126,20 @@ double quantized_robust_spread(double sigma, double q);
 // The sigma whose quantized_robust_spread is `spread` (0 when the quantisation alone explains it).
 double noise_from_quantized_spread(double spread, double q);
 
+// The simulator's correlated depth error fitted to a real calibration by simulation: bare-table
+// frames are simulated over a grid of correlation lengths and white shares and calibrated like the
+// real ones; the grid point whose autocorrelation at 1, 2 and 4 px is closest to the real one
+// wins, and the noise coefficient is scaled so that the simulated tile noise matches the real
+// (tiles absorb part of a correlated error, so the simulator's coefficient is larger).
+struct KinectSimulationFit {
+  double noise_correlation_px = 0, independent_noise_share = 1;
+  double depth_noise = NAN;          // the simulator's coefficient
+  double autocorrelation_rms = NAN;  // over lags 1, 2, 4 px, real against simulated
+  KinectCalibration simulated;       // calibration of frames simulated with the fitted values
+};
+KinectSimulationFit fit_kinect_simulation(
+    const KinectCalibration& real, const std::function<void(const std::string&)>& progress = {});
+
 // Every mOSD scene (label 1-9 the table) in `files`, through a calibrator.
 KinectCalibration calibrate_mosd(const std::vector<std::string>& files,
                                  const KinectCalibrationOptions& options = {},
@@ -133,5 +147,6 @@ KinectCalibration calibrate_mosd(const std::vector<std::string>& files,
 
 std::string kinect_calibration_text(const KinectCalibration& calibration);
 std::string kinect_calibration_json(const KinectCalibration& calibration);
+std::string kinect_simulation_fit_text(const KinectSimulationFit& fit);
 
 }  // namespace primlabel::research

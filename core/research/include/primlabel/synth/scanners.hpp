@@ -54,11 +54,13 @@ PointCloud scan_lms400(const Scene& scene, const Lms400Options& options, double 
 // return), depth noise sigma = depth_noise * z^2 (Khoshelham & Elberink 2012) and quantisation to
 // 1/subpixel of a disparity pixel, shadows where the projector does not light the surface.
 //
-// depth_noise and disparity_focal_px are calibrated on the table planes of the 45 mOSD learning
-// scenes (primlabel-eval --calibrate-kinect, README "Kinect calibration"): depth levels are
-// z^2 / F apart with F = disparity_focal_px * baseline * subpixel = 344.9 m px measured (0.5% rms
-// over 0.6-1.7 m), and the noise left after the quantisation is 1.70e-3 * z^2 (8.8% rms).
-// The pre-calibration values were depth_noise 1.425e-3 and disparity in focal_px (F = 315).
+// The error model is calibrated on the table planes of the 45 mOSD learning scenes
+// (primlabel-eval --calibrate-kinect --fit-simulation, README "Kinect calibration"): depth levels
+// are z^2 / F apart with F = disparity_focal_px * baseline * subpixel = 344.9 m px measured (0.5%
+// rms over 0.6-1.7 m); the error is correlated over ~3.5 px (autocorrelation 0.70 / 0.55 / 0.34
+// at 1 / 2 / 4 px), and depth_noise is what makes simulated frames show the real residual to
+// 24-px tile planes, 1.70e-3 * z^2 (tiles absorb part of a correlated error). The values before
+// the calibration: depth_noise 1.425e-3, white, disparity in focal_px (F = 315).
 struct KinectOptions {
   Vec3d position = Vec3d(0, -0.85, 0.75);
   Vec3d target = Vec3d(0, 0.05, 0);
@@ -67,12 +69,12 @@ struct KinectOptions {
   // Disparity is measured in the IR camera's pixels, whose focal length differs from the
   // registered image's (the Kinect's IR camera: ~580 px); at 640 px width, scaled with it.
   double disparity_focal_px = 575;
-  double depth_noise = 1.70e-3;
+  double depth_noise = 2.25e-3;
   // The real error is spatially correlated (a disparity is matched over a window of pixels): the
   // unit error is sqrt(independent_noise_share) white noise plus the rest white noise blurred by a
   // Gaussian of std noise_correlation_px (each of unit variance). 0 px: every pixel on its own.
-  double noise_correlation_px = 0;
-  double independent_noise_share = 1;
+  double noise_correlation_px = 3.5;
+  double independent_noise_share = 0.05;
   bool quantize = true;
   double baseline = 0.075;  // camera-projector distance (m)
   int subpixel = 8;
