@@ -7,12 +7,15 @@
 //   primlabel-eval --table1 [--json]
 //   primlabel-eval --fig4 out/ [--fig4-scenes 3]                    # the paper's Fig. 4
 //   primlabel-eval --model kinect.plm --mosd-report out/ ../shared/data/mosd/*.pcd
+//   primlabel-eval --calibrate-kinect ../shared/data/mosd [--calibration-json out.json]
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 
 #include "node_basis.hpp"
@@ -26,6 +29,7 @@
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/research/confusion_plot.hpp"
 #include "primlabel/research/fig4.hpp"
+#include "primlabel/research/kinect_calibration.hpp"
 #include "primlabel/research/mosd_report.hpp"
 #include "primlabel/research/table1.hpp"
 
@@ -34,10 +38,11 @@ namespace {
 using namespace primlabel;
 
 struct Arguments {
-  std::string model, classes, out, confusion_png, fig4_dir, mosd_dir;
+  std::string model, classes, out, confusion_png, fig4_dir, mosd_dir, calibrate_dir,
+      calibration_json;
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
-  bool table1 = false, no_pfh = false, no_svm = false;
+  bool table1 = false, no_pfh = false, no_svm = false, fit_simulation = false;
   std::string node_basis = "tent";
   std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
   int table1_train = 8, table1_test = 4, pfh_max_neighbors = 40, threads = 0, fig4_scenes = 3;
@@ -191,6 +196,41 @@ int mosd_report(const Arguments& args) {
   return cli::kExitOk;
 }
 
+// The simulated Kinect's parameters measured on the table planes of the mOSD scenes in a folder.
+int calibrate_kinect(const Arguments& args) {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(args.calibrate_dir, ec))
+    if (entry.path().extension() == ".pcd") files.push_back(entry.path().string());
+  if (ec) throw std::runtime_error(args.calibrate_dir + ": cannot be read (" + ec.message() + ")");
+  if (files.empty()) throw std::runtime_error(args.calibrate_dir + ": no .pcd file");
+  std::sort(files.begin(), files.end());
+  std::function<void(const std::string&)> progress;
+  if (!args.quiet)
+    progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  const research::KinectCalibration calibration =
+      research::calibrate_mosd(files, research::KinectCalibrationOptions{}, progress);
+  std::string json = research::kinect_calibration_json(calibration);
+  std::string text = research::kinect_calibration_text(calibration);
+  if (args.fit_simulation) {
+    const research::KinectSimulationFit fit =
+        research::fit_kinect_simulation(calibration, progress);
+    text += research::kinect_simulation_fit_text(fit);
+    json::Json root = json::Json::parse(json);
+    root["simulation_fit"] = {
+        {"depth_noise", json::rounded(fit.depth_noise, "%.6g")},
+        {"noise_correlation_px", fit.noise_correlation_px},
+        {"independent_noise_share", fit.independent_noise_share},
+        {"autocorrelation_rms", json::rounded(fit.autocorrelation_rms, "%.6g")},
+        {"simulated_depth_noise", json::rounded(fit.simulated.depth_noise, "%.6g")},
+        {"simulated_autocorrelation", fit.simulated.autocorrelation}};
+    json = json::dump(root) + "\n";
+  }
+  if (!args.calibration_json.empty()) atomic_write_file(args.calibration_json, json);
+  std::fputs((args.json ? json : text).c_str(), stdout);
+  return cli::kExitOk;
+}
+
 int fig4(const Arguments& args) {
   research::Fig4Options options;
   options.scenes = args.fig4_scenes;
@@ -276,11 +316,23 @@ int main(int argc, char** argv) {
   app.add_option("--fig4-scenes", args.fig4_scenes, "Fig. 4: training scenes (default 3)")
       ->check(CLI::PositiveNumber)
       ->needs(f4);
+  auto* calibrate = app.add_option(
+      "--calibrate-kinect", args.calibrate_dir,
+      "measure depth noise, disparity quantisation, density and missing returns on the table "
+      "planes of the mOSD scenes (*.pcd, label 1-9 table) in DIR; fit the simulated Kinect");
+  app.add_flag("--fit-simulation", args.fit_simulation,
+               "--calibrate-kinect: also fit the simulator's correlated depth error by simulating "
+               "bare-table frames (about 20 s of CPU)")
+      ->needs(calibrate);
+  app.add_option("--calibration-json", args.calibration_json,
+                 "--calibrate-kinect: also write the calibration as JSON to FILE")
+      ->needs(calibrate);
   app.add_option("--threads", args.threads, "worker threads")
       ->check(CLI::PositiveNumber)
       ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
-  t1->excludes(model)->excludes(files)->excludes(f4);
+  t1->excludes(model)->excludes(files)->excludes(f4)->excludes(calibrate);
+  calibrate->excludes(model)->excludes(files)->excludes(f4);
   f4->excludes(model)->excludes(files);
 
   try {
@@ -296,11 +348,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "primlabel-eval: usage error: %s\n", e.what());
     return cli::kExitUsage;
   }
-  const bool study = args.table1 || !args.fig4_dir.empty();
+  const bool study = args.table1 || !args.fig4_dir.empty() || !args.calibrate_dir.empty();
   if (!study && (args.model.empty() || args.files.empty())) {
     std::fprintf(stderr,
                  "primlabel-eval: usage error: give --model and at least one file, or --table1 "
-                 "or --fig4 (see --help)\n");
+                 "or --fig4 or --calibrate-kinect (see --help)\n");
     return cli::kExitUsage;
   }
   if (!args.out.empty() && args.files.size() != 1) {
@@ -310,6 +362,7 @@ int main(int argc, char** argv) {
   try {
     if (args.table1) return table1(args);
     if (!args.fig4_dir.empty()) return fig4(args);
+    if (!args.calibrate_dir.empty()) return calibrate_kinect(args);
     if (!args.mosd_dir.empty()) return mosd_report(args);
     return evaluate_files(args);
   } catch (const std::exception& e) {

@@ -29,6 +29,7 @@ struct Arguments {
   std::uint64_t seed = 1;
   int count = 0;
   double radius = kDefaultLabelRadius, noise_scale = 1.0, dropout = -1, angular_step = 0;
+  double keep = 1.0, range_scale = 1.0, elevation = 0.0;
   int lines = 0, min_objects = 0, max_objects = 0;
   bool list_classes = false, quiet = false;
 };
@@ -43,6 +44,9 @@ GenerateOptions options_from(const Arguments& args, std::uint64_t seed) {
   if (args.dropout >= 0) options.dropout = args.dropout;
   if (args.lines > 0) options.lms400_lines = args.lines;
   if (args.angular_step > 0) options.lms400_angular_step_deg = args.angular_step;
+  options.keep = args.keep;
+  options.placement.range_scale = args.range_scale;
+  options.placement.elevation_deg = args.elevation;
   if (args.min_objects > 0) options.table.min_objects = args.min_objects;
   if (args.max_objects > 0) options.table.max_objects = args.max_objects;
   options.table.max_objects = std::max(options.table.max_objects, options.table.min_objects);
@@ -174,6 +178,14 @@ int main(int argc, char** argv) {
   app.add_option("--angular-step", args.angular_step, "lms400: degrees between beams of a line")
       ->check(CLI::Range(0.01, 5.0))
       ->default_str("the sensor's");
+  app.add_option("--keep", args.keep, "random subsampling: the share of points kept (0, 1]")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--range-scale", args.range_scale,
+                 "scale the sensor's distance from the table's front edge")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--elevation", args.elevation,
+                 "turn the sensor about the table's front edge by this many degrees (up: +)")
+      ->check(CLI::Range(-59.0, 59.0));
   app.add_option("--min-objects", args.min_objects, "table scene: fewest objects")
       ->check(CLI::Range(1, 20))
       ->default_str("the scene's");

@@ -18,6 +18,7 @@
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/research/curve_plot.hpp"
+#include "primlabel/synth/augment.hpp"
 #include "primlabel/synth/generate.hpp"
 
 namespace {
@@ -33,7 +34,8 @@ struct Arguments {
   std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
   float feature_radius = 0.025f, normal_radius = 0.01f;
   std::vector<std::string> train_files, val_files;
-  std::string classes, output, curve_csv, curve_png, name;
+  std::string classes, output, curve_csv, curve_png, name, augment;
+  synth::Augmentation augmentation;  // --augment, parsed
   bool quiet = false;
 };
 
@@ -72,10 +74,24 @@ std::vector<pipeline::SceneData> load_scenes(const Arguments& args, bool validat
   const auto sensor = synth::sensor_from_name(args.sensor);
   const auto set = validation ? synth::SceneSet::kVal : synth::SceneSet::kTrain;
   const int count = validation ? args.synth_val : args.synth_train;
-  for (int i = 0; i < count; ++i)
-    add(synth::synthetic_scene(set, i, *sensor, args.label_radius),
-        "synth:" + args.sensor + ":" + std::string(synth::set_name(set)) + ":seed" +
-            std::to_string(synth::set_seed(set, i)));
+  for (int i = 0; i < count; ++i) {
+    const std::string source = "synth:" + args.sensor + ":" + std::string(synth::set_name(set)) +
+                               ":seed" + std::to_string(synth::set_seed(set, i));
+    synth::GenerateOptions options;
+    options.sensor = *sensor;
+    options.seed = synth::set_seed(set, i);
+    options.label_radius = args.label_radius;
+    add(synth::generate(options).cloud, source);
+    // Training scenes also in augmented variants; validation stays as the sensor scans nominally.
+    for (int copy = 0; !validation && copy < args.augmentation.copies; ++copy) {
+      const synth::GenerateOptions variant = synth::augmented(options, args.augmentation, copy);
+      char how[160];
+      std::snprintf(how, sizeof how, ":aug%d(noise %.2f, keep %.2f, range %.2f, elevation %+.1f)",
+                    copy, variant.noise_scale, variant.keep, variant.placement.range_scale,
+                    variant.placement.elevation_deg);
+      add(synth::generate(variant).cloud, source + how);
+    }
+  }
   return scenes;
 }
 
@@ -216,6 +232,11 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--graph-k", args.graph_k, "CRF graph: K nearest neighbours (default 8)")
       ->check(CLI::PositiveNumber);
+  app.add_option("--augment", args.augment,
+                 "synthetic training: also scan each scene with other noise, density, range and "
+                 "incidence, e.g. noise=0.5:4,density=0.25:1,range=0.9:1.4,elevation=-10:10,"
+                 "copies=1 (noise log-uniform, the rest uniform; seeded by the scene)")
+      ->excludes(train_files);
   app.add_option("-o,--output", args.output, "model file to write")->required();
   app.add_option("--name", args.name, "model name recorded in the file");
   app.add_option("--curve", args.curve_csv, "training curve CSV (objective, accuracies)");
@@ -234,6 +255,7 @@ int main(int argc, char** argv) {
   }
   try {  // before any scene is described
     args.node_knots = cli::node_knots(args.node_basis, args.node_knots);
+    if (!args.augment.empty()) args.augmentation = synth::parse_augmentation(args.augment);
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "primlabel-train: usage error: %s\n", e.what());
     return cli::kExitUsage;

@@ -140,11 +140,42 @@ TEST_F(PipelineCli, BadUsageExitsTwo) {
         eval() + " --table1 --node-knots 0,0.5,0.2",
         eval() + " --table1 --node-basis linear --node-knots 0,1",
         test::binary("primlabel-train") + " --node-knots 0 -o m.plm",
-        test::binary("primlabel-train") + " --node-knots 0,0.2,0.2 -o m.plm"}) {
+        test::binary("primlabel-train") + " --node-knots 0,0.2,0.2 -o m.plm",
+        // Bad augmentation specs, and augmentation of files (only synthetic scenes are rescanned).
+        test::binary("primlabel-train") + " --augment colour=1 -o m.plm",
+        test::binary("primlabel-train") + " --augment noise=4:1 -o m.plm",
+        test::binary("primlabel-train") + " --augment density=0:1 -o m.plm",
+        test::binary("primlabel-train") + " --train a.pcd --augment noise=1:2 -o m.plm",
+        eval() + " --calibrate-kinect dir --model m.plm", eval() + " --calibrate-kinect dir x.pcd",
+        eval() + " --calibration-json c.json --table1"}) {
     const Result r = run(command);
     EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
     EXPECT_EQ(lines(r.output), 1) << command << "\n" << r.output;
   }
+}
+
+// Each training scene is also described as its augmented variant (seeded: the same draw twice).
+TEST_F(PipelineCli, TrainAugmentsTheTrainingScenes) {
+  const std::string command = test::binary("primlabel-train") +
+                              " --synth-train 1 --synth-val 0 --kind node --iterations 5 "
+                              "--threads 2 --augment noise=2,density=0.5 -o " +
+                              (*dir_ / "augmented.plm").string();
+  const Result r = run(command);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("training: synth:lms400:train:seed1000, "), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("training: synth:lms400:train:seed1000:aug0(noise 2.00, keep 0.50, "
+                          "range 1.00, elevation +0.0)"),
+            std::string::npos)
+      << r.output;
+  const LabelModel model = load_model((*dir_ / "augmented.plm").string());
+  EXPECT_EQ(model.training.scenes, 2u);
+}
+
+TEST_F(PipelineCli, CalibrateKinectWithoutScenesFailsWithOneLine) {
+  const Result r = run(eval() + " -q --calibrate-kinect /nonexistent/mosd");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(lines(r.output), 1) << r.output;
 }
 
 TEST_F(PipelineCli, TrainMissingFileFails) {

@@ -146,7 +146,7 @@ TEST(Scanners, KinectDepthNoiseAndQuantisation) {
     return probe.viewpoint.orientation.cast<double>().toRotationMatrix();
   }();
   const Vec3d forward = rotation.col(2);
-  const double focal_baseline = options.focal_px * options.baseline;
+  const double focal_baseline = options.disparity_focal_px * options.baseline;
 
   options.quantize = false;
   PointCloud cloud = scan_kinect(scene, options, kR, 6);

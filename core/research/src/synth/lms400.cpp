@@ -16,7 +16,8 @@ constexpr double kDeg = M_PI / 180.0;
 
 }  // namespace
 
-Lms400Options lms400_for_scene(const Scene& scene, std::uint64_t seed) {
+Lms400Options lms400_for_scene(const Scene& scene, std::uint64_t seed,
+                               const SensorPlacement& placement) {
   Rng rng(mix_seed(seed, kLms400Stream - 1));
   Lms400Options options;
   const double front = -0.5 * scene.table_size.y(), back = 0.5 * scene.table_size.y();
@@ -24,6 +25,8 @@ Lms400Options lms400_for_scene(const Scene& scene, std::uint64_t seed) {
   options.position =
       Vec3d(rng.uniform(-0.05, 0.05), front - rng.uniform(0.38, 0.45), rng.uniform(0.62, 0.70));
   options.heading_deg = 90 + rng.uniform(-3.0, 3.0);
+  options.position =
+      detail::place_sensor(options.position, front, placement.range_scale, placement.elevation_deg);
 
   // Like the arm in the paper, sweep the part of the table the objects stand on (with a margin
   // of table around them), not the whole table.

@@ -1,6 +1,7 @@
 #pragma once
 // What both scanners do with a return: label it, colour it, store it.
 
+#include <cmath>
 #include <cstdint>
 
 #include "primlabel/geometry/point_cloud.hpp"
@@ -62,6 +63,17 @@ inline void store_returns(const std::vector<Return>& returns, PointCloud& cloud)
     cloud.rgba[i] = returns[i].rgba;
     object.values[i] = returns[i].object;
   }
+}
+
+// `position` moved as SensorPlacement says: its (back, up) offset from the table's front edge
+// (the line y = front, z = 0) scaled and turned about the edge.
+inline Vec3d place_sensor(const Vec3d& position, double front, double range_scale,
+                          double elevation_deg) {
+  if (range_scale == 1.0 && elevation_deg == 0.0) return position;  // bit-identical default
+  const double back = front - position.y(), up = position.z();
+  const double length = range_scale * std::hypot(back, up);
+  const double angle = std::atan2(up, back) + elevation_deg * M_PI / 180.0;
+  return Vec3d(position.x(), front - length * std::cos(angle), length * std::sin(angle));
 }
 
 // Orientation whose z axis is `forward`, x axis horizontal to the right and y axis down (the

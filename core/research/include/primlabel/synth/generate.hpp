@@ -28,6 +28,11 @@ struct GenerateOptions {
   std::optional<double> dropout;    // overrides the sensor's dropout probability
   std::optional<int> lms400_lines;  // sweep lines (density across lines)
   std::optional<double> lms400_angular_step_deg;  // density along a line
+  // Random subsampling: the share of returns kept, each point drawn on its own (seeded); dropped
+  // points leave an unorganised cloud and are NaN (label 0, object -1) in an organised one.
+  double keep = 1.0;
+  SensorPlacement placement;               // range and incidence beyond the seed's jitter
+  std::optional<std::uint64_t> scan_seed;  // sensor jitter, noise and subsampling (default: seed)
   TableSceneOptions table;
 };
 
@@ -38,6 +43,10 @@ struct Generated {
 };
 
 Generated generate(const GenerateOptions& options);
+
+// Keeps each point with probability `keep` (its own draw from seed and index): unorganised clouds
+// are compacted, organised ones keep their layout with dropped points NaN, label 0, object -1.
+void subsample(PointCloud& cloud, double keep, std::uint64_t seed);
 
 std::string_view sensor_name(SensorKind sensor);
 std::optional<SensorKind> sensor_from_name(std::string_view name);

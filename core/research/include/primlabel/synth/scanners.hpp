@@ -34,9 +34,18 @@ struct Lms400Options {
   double min_range = 0.7, max_range = 3.0;
 };
 
+// Where a sensor stands, beyond the seed's small jitter (augmentation: other ranges and
+// incidences). Its offset from the table's front edge (back and up) is scaled by range_scale and
+// turned about the edge by elevation_deg (positive: higher, looking down more steeply).
+struct SensorPlacement {
+  double range_scale = 1.0;
+  double elevation_deg = 0.0;
+};
+
 // A scanner pose in front of the table (with a little seed-dependent variation in position and
 // heading) and a sweep over the region of the table the objects stand on, with a margin.
-Lms400Options lms400_for_scene(const Scene& scene, std::uint64_t seed);
+Lms400Options lms400_for_scene(const Scene& scene, std::uint64_t seed,
+                               const SensorPlacement& placement = {});
 
 PointCloud scan_lms400(const Scene& scene, const Lms400Options& options, double label_radius,
                        std::uint64_t seed);
@@ -44,12 +53,28 @@ PointCloud scan_lms400(const Scene& scene, const Lms400Options& options, double 
 // Kinect-like structured-light depth camera: organised width x height (NaN where there is no
 // return), depth noise sigma = depth_noise * z^2 (Khoshelham & Elberink 2012) and quantisation to
 // 1/subpixel of a disparity pixel, shadows where the projector does not light the surface.
+//
+// The error model is calibrated on the table planes of the 45 mOSD learning scenes
+// (primlabel-eval --calibrate-kinect --fit-simulation, README "Kinect calibration"): depth levels
+// are z^2 / F apart with F = disparity_focal_px * baseline * subpixel = 344.9 m px measured (0.5%
+// rms over 0.6-1.7 m); the error is correlated over ~3.5 px (autocorrelation 0.70 / 0.55 / 0.34
+// at 1 / 2 / 4 px), and depth_noise is what makes simulated frames show the real residual to
+// 24-px tile planes, 1.70e-3 * z^2 (tiles absorb part of a correlated error). The values before
+// the calibration: depth_noise 1.425e-3, white, disparity in focal_px (F = 315).
 struct KinectOptions {
   Vec3d position = Vec3d(0, -0.85, 0.75);
   Vec3d target = Vec3d(0, 0.05, 0);
   int width = 640, height = 480;
-  double focal_px = 525;  // at 640 px width; scaled with width
-  double depth_noise = 1.425e-3;
+  double focal_px = 525;  // the image the depth is registered to; at 640 px width, scaled with it
+  // Disparity is measured in the IR camera's pixels, whose focal length differs from the
+  // registered image's (the Kinect's IR camera: ~580 px); at 640 px width, scaled with it.
+  double disparity_focal_px = 575;
+  double depth_noise = 2.25e-3;
+  // The real error is spatially correlated (a disparity is matched over a window of pixels): the
+  // unit error is sqrt(independent_noise_share) white noise plus the rest white noise blurred by a
+  // Gaussian of std noise_correlation_px (each of unit variance). 0 px: every pixel on its own.
+  double noise_correlation_px = 3.5;
+  double independent_noise_share = 0.05;
   bool quantize = true;
   double baseline = 0.075;  // camera-projector distance (m)
   int subpixel = 8;
@@ -59,7 +84,8 @@ struct KinectOptions {
   double min_range = 0.5, max_range = 4.0;
 };
 
-KinectOptions kinect_for_scene(const Scene& scene, std::uint64_t seed);
+KinectOptions kinect_for_scene(const Scene& scene, std::uint64_t seed,
+                               const SensorPlacement& placement = {});
 
 PointCloud scan_kinect(const Scene& scene, const KinectOptions& options, double label_radius,
                        std::uint64_t seed);
