@@ -55,6 +55,7 @@ json::Json fitted_object_json(const FittedObject& o) {
           {"points", o.points},
           {"inlier_share", json_number(o.inlier_share())},
           {"rms", json::rounded(o.rms, "%.5f")},
+          {"bound", json::rounded(o.bound, "%.5f")},
           {"on_table", o.on_table},
           {"faces", o.faces},
           {"size", {json::rounded(o.size.x(), "%.4f"), json::rounded(o.size.y(), "%.4f"),

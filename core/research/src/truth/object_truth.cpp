@@ -66,13 +66,16 @@ FittedObject choose_model(int segment, const truth::SegmentPoints& points,
   chosen.points = points.p.size();
   chosen.box_cost = box ? box_evidence.cost : NAN;
   chosen.cylinder_cost = cylinder ? cylinder_evidence.cost : NAN;
-  if (chosen.inlier_share() < options.min_inlier_share) chosen.kind = FittedKind::kUnfitted;
+  chosen.bound = truth::quantile(points.bound, 0.5);
+  if (chosen.inlier_share() < options.min_inlier_share ||
+      chosen.rms > options.max_rms_share * chosen.bound)
+    chosen.kind = FittedKind::kUnfitted;
   return chosen;
 }
 
 // A solid cannot lie inside another: a segment whose points are mostly inside another fitted
-// solid (deeper than their bound) is part of a vessel's inside (the floor of a pot), not an
-// object of its own.
+// solid (deeper than their bound, or facing into it) is part of a vessel's inside (the floor of
+// a pot), not an object of its own.
 void reject_nested(std::vector<FittedObject>& objects,
                    const std::vector<truth::SegmentPoints>& points) {
   std::vector<bool> nested(objects.size(), false);
@@ -85,8 +88,10 @@ void reject_nested(std::vector<FittedObject>& objects,
       std::size_t inside = 0;
       for (std::size_t i = 0; i < points[a].p.size(); ++i) {
         const Vec3d local = local_from_table * points[a].p[i];
-        inside += shape->distance_outside(local) == 0 &&
-                  truth::closest_surface(objects[b], local).distance > points[a].bound[i];
+        if (shape->distance_outside(local) > 0) continue;
+        const truth::SurfacePoint sp = truth::closest_surface(objects[b], local);
+        const Vec3d normal = local_from_table.linear() * points[a].n[i];
+        inside += sp.distance > points[a].bound[i] || normal.dot(sp.normal) < -0.5;
       }
       nested[a] = 2 * inside > points[a].p.size();
     }
@@ -204,7 +209,8 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
     const int index = static_cast<int>(scene.objects.size()) - 1;
     const Eigen::Isometry3d local_from_table = object.table_from_local.inverse();
     for (std::size_t j = 0; j < indices.size(); ++j) {
-      const truth::SurfacePoint sp = truth::closest_surface(object, local_from_table * s.p[j]);
+      const truth::SurfacePoint sp = truth::closest_surface(
+          object, local_from_table * s.p[j], local_from_table.linear() * s.n[j]);
       if (sp.distance >= s.bound[j]) continue;
       rule_points.push_back({index, sp.part, object.table_from_local * sp.point});
       rule_index.push_back(indices[j]);

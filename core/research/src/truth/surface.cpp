@@ -8,64 +8,66 @@
 namespace primlabel::research::truth {
 namespace {
 
-SurfacePoint closest_on_box(const Vec3d& size, const Vec3d& p) {
+// Among candidate surface points, the nearest one whose surface the point's normal supports
+// (when it has a normal and some candidate agrees), else the nearest: a point beside a face the
+// scan never saw keeps the part its normal shows.
+SurfacePoint pick(const SurfacePoint* candidates, int count, const Vec3d& normal) {
+  SurfacePoint best, agreeing;
+  best.distance = agreeing.distance = INFINITY;
+  for (int k = 0; k < count; ++k) {
+    const SurfacePoint& c = candidates[k];
+    if (c.distance < best.distance) best = c;
+    if (!(normal.dot(c.normal) < 0.5) && c.distance < agreeing.distance) agreeing = c;
+  }
+  return agreeing.part >= 0 ? agreeing : best;
+}
+
+SurfacePoint closest_on_box(const Vec3d& size, const Vec3d& p, const Vec3d& normal) {
   const Vec3d lo(-0.5 * size.x(), -0.5 * size.y(), 0.0);
   const Vec3d hi(0.5 * size.x(), 0.5 * size.y(), size.z());
   const Vec3d clamped = p.cwiseMax(lo).cwiseMin(hi);
-  SurfacePoint out;
-  if (clamped != p) {  // outside: the face beyond which the point lies farthest
-    double excess = -INFINITY;
-    for (int k = 0; k < 3; ++k) {
-      const double below = lo[k] - p[k], above = p[k] - hi[k];
-      if (below > excess) excess = below, out.part = 2 * k;
-      if (above > excess) excess = above, out.part = 2 * k + 1;
-    }
-    out.point = clamped;
-    out.distance = (p - clamped).norm();
-    out.normal[out.part / 2] = out.part % 2 ? 1.0 : -1.0;
-    return out;
+  SurfacePoint faces[6];
+  for (int part = 0; part < 6; ++part) {
+    SurfacePoint& f = faces[part];
+    f.part = part;
+    f.point = clamped;
+    f.point[part / 2] = part % 2 ? hi[part / 2] : lo[part / 2];
+    f.distance = (p - f.point).norm();
+    f.normal[part / 2] = part % 2 ? 1.0 : -1.0;
   }
-  out.distance = INFINITY;  // inside: the nearest face
-  for (int k = 0; k < 3; ++k) {
-    if (p[k] - lo[k] < out.distance) out.distance = p[k] - lo[k], out.part = 2 * k;
-    if (hi[k] - p[k] < out.distance) out.distance = hi[k] - p[k], out.part = 2 * k + 1;
-  }
-  out.point = p;
-  out.point[out.part / 2] = out.part % 2 ? hi[out.part / 2] : lo[out.part / 2];
-  out.normal[out.part / 2] = out.part % 2 ? 1.0 : -1.0;
-  return out;
+  return pick(faces, 6, normal);
 }
 
 // Can of `radius` and `height` around the z axis, bottom at z = 0: 0 side, 1 lid, 2 bottom.
-SurfacePoint closest_on_can(double radius, double height, const Vec3d& p) {
+SurfacePoint closest_on_can(double radius, double height, const Vec3d& p, const Vec3d& normal) {
   const double rho = std::hypot(p.x(), p.y());
   const Eigen::Vector2d dir =
       rho > 1e-12 ? Eigen::Vector2d(p.x() / rho, p.y() / rho) : Eigen::Vector2d(1, 0);
   const double in = std::min(rho, radius);
-  const Vec3d candidates[3] = {
+  const Vec3d points[3] = {
       Vec3d(radius * dir.x(), radius * dir.y(), std::clamp(p.z(), 0.0, height)),
       Vec3d(in * dir.x(), in * dir.y(), height), Vec3d(in * dir.x(), in * dir.y(), 0.0)};
   const Vec3d normals[3] = {Vec3d(dir.x(), dir.y(), 0), Vec3d::UnitZ(), -Vec3d::UnitZ()};
-  SurfacePoint out;
-  out.distance = INFINITY;
-  for (int part = 0; part < 3; ++part) {
-    const double d = (p - candidates[part]).norm();
-    if (d < out.distance) out = {part, candidates[part], d, normals[part]};
-  }
-  return out;
+  SurfacePoint parts[3];
+  for (int part = 0; part < 3; ++part)
+    parts[part] = {part, points[part], (p - points[part]).norm(), normals[part]};
+  return pick(parts, 3, normal);
 }
 
 }  // namespace
 
-SurfacePoint closest_surface(const FittedObject& object, const Vec3d& local) {
+SurfacePoint closest_surface(const FittedObject& object, const Vec3d& local,
+                             const Vec3d& normal) {
   switch (object.kind) {
     case FittedKind::kBox:
-      return closest_on_box(object.size, local);
+      return closest_on_box(object.size, local, normal);
     case FittedKind::kUprightCylinder:
-      return closest_on_can(object.size.x(), object.size.y(), local);
+      return closest_on_can(object.size.x(), object.size.y(), local, normal);
     case FittedKind::kLyingCylinder: {
       const synth::LyingCanShape can(object.size.x(), object.size.y());
-      SurfacePoint out = closest_on_can(can.radius(), can.length(), can.upright_from_local(local));
+      const Vec3d mirrored(normal.z(), normal.y(), normal.x());
+      SurfacePoint out =
+          closest_on_can(can.radius(), can.length(), can.upright_from_local(local), mirrored);
       out.point = can.local_from_upright(out.point);
       out.normal = Vec3d(out.normal.z(), out.normal.y(), out.normal.x());  // the mirror
       return out;
@@ -97,9 +99,10 @@ Evidence evaluate(const FittedObject& object, const SegmentPoints& segment) {
   const Eigen::Isometry3d local_from_table = object.table_from_local.inverse();
   double cost = 0, squares = 0;
   for (std::size_t i = 0; i < segment.p.size(); ++i) {
-    const SurfacePoint sp = closest_surface(object, local_from_table * segment.p[i]);
+    const Vec3d normal = local_from_table.linear() * segment.n[i];
+    const SurfacePoint sp = closest_surface(object, local_from_table * segment.p[i], normal);
     const double t = segment.bound[i];
-    if (!supports(sp.distance, t, local_from_table.linear() * segment.n[i], sp.normal)) {
+    if (!supports(sp.distance, t, normal, sp.normal)) {
       cost += 1;
       continue;
     }

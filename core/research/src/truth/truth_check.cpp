@@ -88,6 +88,9 @@ std::string truth_check_text(const TruthCheck& check) {
                 static_cast<unsigned long long>(check.box_can.total()),
                 static_cast<unsigned long long>(check.box_can_points));
   out += confusion_text(check.box_can);
+  std::vector<std::string> names;
+  for (std::uint32_t id : check.box_can.class_ids()) names.push_back(class_name(id));
+  out += "  confusion (rows true, columns fitted):\n" + check.box_can.to_text(names);
   out += format("all objects: %llu of %llu points labeled\n",
                 static_cast<unsigned long long>(check.all.total()),
                 static_cast<unsigned long long>(check.all_points));

@@ -27,6 +27,7 @@ struct FitSettings {
 
 // The closest point of a fitted object's closed surface to `local` (its local frame), its part
 // (numbered as the synth shape's), distance and the surface normal there (out of the material).
+// With the point's normal (NaN: none), the closest part that normal supports, when there is one.
 struct SurfacePoint {
   int part = -1;
   Vec3d point = Vec3d::Zero();
@@ -41,7 +42,8 @@ inline bool supports(double distance, double bound, const Vec3d& point_normal,
                      const Vec3d& surface_normal) {
   return distance < bound && !(point_normal.dot(surface_normal) < 0.5);
 }
-SurfacePoint closest_surface(const FittedObject& object, const Vec3d& local);
+SurfacePoint closest_surface(const FittedObject& object, const Vec3d& local,
+                             const Vec3d& normal = Vec3d::Constant(NAN));
 
 // The synthetic shape of a fitted object (BoxShape, CanShape, LyingCanShape).
 std::shared_ptr<const synth::Shape> make_shape(const FittedObject& object);

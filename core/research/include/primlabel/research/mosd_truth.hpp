@@ -8,8 +8,11 @@
 //      its lowest points reach the table) and a closed cylinder (axis and radius by MSAC on
 //      point + normal pairs, then Gauss-Newton least squares; upright or lying, on the table when
 //      its foot reaches it). The model with the lower mean MSAC cost wins; when fewer than
-//      min_inlier_share of the segment's points lie within the residual bound of it, the segment
-//      is unfitted (not scored, counted);
+//      min_inlier_share of the segment's points lie within the residual bound of it, or its
+//      inliers' RMS residual exceeds max_rms_share of the segment's median bound (a wrong surface
+//      spreads the residuals over the whole band, RMS ~0.58 of it; sensor noise alone gives
+//      ~0.1-0.25), the segment is unfitted (not scored, counted). So is a segment mostly inside
+//      another fitted solid (a pot's inner floor);
 //   3. the fitted shapes become a synthetic scene (synth::Scene: the table slab and the shapes),
 //      and every point within the residual bound of its surface is labeled by the synthetic
 //      ground-truth rule itself (synth::ground_truth at the label radius, then the
@@ -41,6 +44,7 @@ struct FittedObject {
   int faces = 0;  // box faces found
   std::size_t points = 0, inliers = 0;  // of the segment; within the residual bound of the model
   double rms = 0;                       // residual of the inliers (m)
+  double bound = 0;                     // median residual bound of the segment's points (m)
   // Mean truncated cost of each model, min(d², bound²) / bound² over the segment's points
   // (0: every point on the surface, 1: none within the bound); NaN when the model failed.
   double box_cost = NAN, cylinder_cost = NAN;
@@ -54,6 +58,7 @@ struct ObjectTruthOptions {
   // half a step and 2 mm of model error.
   double residual_base = 0.002, residual_z2 = 0.006;
   double min_inlier_share = 0.8;   // below: the segment is unfitted
+  double max_rms_share = 0.4;      // inlier RMS above this share of the median bound: unfitted
   double contact_tolerance = 0.02; // lowest points this close to the table: standing on it (m)
   std::size_t min_segment_points = 50;
   float normal_radius = 0.015f;  // PCA normals for the cylinder hypotheses (m)
