@@ -18,20 +18,20 @@
 #include <fstream>
 #include <string>
 
-#include "primlabel/cli/cli_common.hpp"
 #include "node_basis.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/cli_common.hpp"
+#include "primlabel/crf/metrics.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
-#include "primlabel/crf/metrics.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
+#include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/research/confusion_plot.hpp"
 #include "primlabel/research/fig4.hpp"
-#include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/research/mosd_report.hpp"
-#include "primlabel/research/truth_check.hpp"
 #include "primlabel/research/table1.hpp"
-#include "primlabel/geometry/labeled_cloud.hpp"
+#include "primlabel/research/truth_check.hpp"
 
 namespace {
 
@@ -199,14 +199,14 @@ int write_truth(const Arguments& args) {
     } catch (const std::exception& e) {
       throw std::runtime_error(path + ": " + e.what());
     }
-    std::printf("%s: %zu segments: %zu box, %zu upright cylinder, %zu lying cylinder, %zu "
-                "unfitted; %llu of %llu object points labeled; wrote %s\n",
-                path.c_str(), t.objects.size(), t.count(research::FittedKind::kBox),
-                t.count(research::FittedKind::kUprightCylinder),
-                t.count(research::FittedKind::kLyingCylinder),
-                t.count(research::FittedKind::kUnfitted),
-                static_cast<unsigned long long>(t.truth_points),
-                static_cast<unsigned long long>(t.object_points), t.truth_file.c_str());
+    std::printf(
+        "%s: %zu segments: %zu box, %zu upright cylinder, %zu lying cylinder, %zu "
+        "unfitted; %llu of %llu object points labeled; wrote %s\n",
+        path.c_str(), t.objects.size(), t.count(research::FittedKind::kBox),
+        t.count(research::FittedKind::kUprightCylinder),
+        t.count(research::FittedKind::kLyingCylinder), t.count(research::FittedKind::kUnfitted),
+        static_cast<unsigned long long>(t.truth_points),
+        static_cast<unsigned long long>(t.object_points), t.truth_file.c_str());
     json::Json scene = research::object_truth_json(t, true);
     scene["file"] = path;
     scenes.push_back(std::move(scene));
@@ -227,9 +227,9 @@ int truth_check(const Arguments& args) {
   options.truth.label_radius = args.truth_radius;
   const research::TruthCheck check =
       research::check_truth_on_synthetic(options, RunContext{args.threads});
-  std::fputs((args.json ? research::truth_check_json(check) : research::truth_check_text(check))
-                 .c_str(),
-             stdout);
+  std::fputs(
+      (args.json ? research::truth_check_json(check) : research::truth_check_text(check)).c_str(),
+      stdout);
   return cli::kExitOk;
 }
 
@@ -245,8 +245,8 @@ int mosd_report(const Arguments& args) {
     const std::string png = (std::filesystem::path(args.mosd_dir) /
                              (std::filesystem::path(path).stem().string() + "_labels.png"))
                                 .string();
-    scenes.push_back(research::report_mosd_scene(model, path, png, options, context,
-                                                 truth_request(args, path)));
+    scenes.push_back(
+        research::report_mosd_scene(model, path, png, options, context, truth_request(args, path)));
     if (!args.quiet)
       std::fprintf(stderr, "%s: %.2f%% of %llu table points plane, wrote %s\n", path.c_str(),
                    100.0 * scenes.back().plane_share(),

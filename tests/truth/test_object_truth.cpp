@@ -8,10 +8,12 @@
 #include <filesystem>
 
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/research/mosd_truth.hpp"
 #include "primlabel/research/truth_check.hpp"
 #include "primlabel/synth/scanners.hpp"
 #include "primlabel/synth/scene.hpp"
+#include "test_util.hpp"
 
 namespace primlabel::research {
 namespace {
@@ -105,8 +107,7 @@ TEST(ObjectTruth, ABallFitsNeitherModel) {
   ASSERT_EQ(f.truth.objects.size(), 1u);
   EXPECT_EQ(f.truth.objects[0].kind, FittedKind::kUnfitted)
       << f.truth.objects[0].inlier_share() << " rms " << f.truth.objects[0].rms << " "
-      << f.truth.objects[0].box_cost << " "
-      << f.truth.objects[0].cylinder_cost;
+      << f.truth.objects[0].box_cost << " " << f.truth.objects[0].cylinder_cost;
   const std::vector<int> segments = synthetic_segments(f.cloud);
   for (std::size_t i = 0; i < segments.size(); ++i)
     if (segments[i] > 0) ASSERT_EQ(f.truth.labels[i], 0u) << "an unfitted segment is not scored";
@@ -121,8 +122,9 @@ TEST(ObjectTruth, AgreesWithSyntheticLabelsOnBoxesAndCans) {
   options.first = 5;
   const TruthCheck check = check_truth_on_synthetic(options, RunContext{2});
   ASSERT_GT(check.box_can_points, 5000u);
+  RecordProperty("agreement", std::to_string(check.box_can.accuracy()));
   EXPECT_GT(double(check.box_can.total()), 0.95 * double(check.box_can_points));
-  EXPECT_GT(check.box_can.accuracy(), 0.88) << truth_check_text(check);
+  EXPECT_GT(check.box_can.accuracy(), 0.95) << truth_check_text(check);
 }
 
 std::string mosd(const std::string& name) {
@@ -154,6 +156,36 @@ TEST(ObjectTruthMosd, CylinderSceneGetsUprightCylinders) {
     EXPECT_EQ(o.kind, FittedKind::kUprightCylinder) << o.segment;
     EXPECT_GE(o.inlier_share(), 0.9) << o.segment;
   }
+}
+
+// primlabel-eval --write-truth: the fitted truth of a scene as a labeled cloud (taxonomy labels,
+// a segment field) and truth_fits.json; usage errors exit 2 with a reason.
+TEST(ObjectTruthCli, WritesTheTruthOfAScene) {
+  const std::string eval = test::binary("primlabel-eval");
+  const test::CommandResult no_files = test::run_command(eval + " --write-truth /tmp/x");
+  EXPECT_EQ(no_files.exit_code, 2) << no_files.output;
+  EXPECT_NE(no_files.output.find("--write-truth needs"), std::string::npos) << no_files.output;
+  const test::CommandResult no_report =
+      test::run_command(eval + " --model m.plm --write-truth /tmp/x a.pcd");
+  EXPECT_EQ(no_report.exit_code, 2) << no_report.output;
+
+  const std::string path = mosd("learn0");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+  const test::TempDir dir;
+  const test::CommandResult r =
+      test::run_command(eval + " --threads 2 --write-truth " + dir.file("t") + " " + path);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("2 box"), std::string::npos) << r.output;
+  const PointCloud truth = load_labeled_cloud(dir.file("t/learn0_truth.pcd"));
+  ASSERT_NE(truth.find_field("segment"), nullptr);
+  std::size_t planes = 0, edges = 0;
+  for (std::uint32_t label : truth.labels) {
+    planes += label == class_id(PrimitiveClass::kPlane);
+    edges += label == class_id(PrimitiveClass::kEdgeConvex);
+  }
+  EXPECT_GT(planes, 100000u);
+  EXPECT_GT(edges, 1000u);
+  EXPECT_TRUE(std::filesystem::exists(dir.file("t/truth_fits.json")));
 }
 
 }  // namespace

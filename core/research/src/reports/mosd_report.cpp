@@ -58,10 +58,12 @@ json::Json fitted_object_json(const FittedObject& o) {
           {"bound", json::rounded(o.bound, "%.5f")},
           {"on_table", o.on_table},
           {"faces", o.faces},
-          {"size", {json::rounded(o.size.x(), "%.4f"), json::rounded(o.size.y(), "%.4f"),
-                    json::rounded(o.size.z(), "%.4f")}},
-          {"at", {json::rounded(at.x(), "%.4f"), json::rounded(at.y(), "%.4f"),
-                  json::rounded(at.z(), "%.4f")}},
+          {"size",
+           {json::rounded(o.size.x(), "%.4f"), json::rounded(o.size.y(), "%.4f"),
+            json::rounded(o.size.z(), "%.4f")}},
+          {"at",
+           {json::rounded(at.x(), "%.4f"), json::rounded(at.y(), "%.4f"),
+            json::rounded(at.z(), "%.4f")}},
           {"box_cost", json_number(o.box_cost)},
           {"cylinder_cost", json_number(o.cylinder_cost)}};
 }
@@ -88,7 +90,8 @@ double MosdSceneReport::object_plane_share() const { return share(object_plane, 
 double MosdReport::plane_share() const { return share(table_plane, table_points); }
 
 MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& path,
-                                  const std::string& png_path, const pipeline::LabelingOptions& options,
+                                  const std::string& png_path,
+                                  const pipeline::LabelingOptions& options,
                                   const RunContext& context, const MosdTruthRequest& truth) {
   PointCloud cloud = read_cloud(path);
   if (!cloud.has_labels())

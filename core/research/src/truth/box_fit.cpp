@@ -69,8 +69,8 @@ std::vector<Face> find_faces(const SegmentPoints& s, const FitSettings& settings
         face.points.push_back(i);
     // Its points leave the pool either way, so the next hypothesis sees the rest.
     std::vector<std::uint32_t> rest;
-    std::set_difference(remaining.begin(), remaining.end(), fit.inliers.begin(),
-                        fit.inliers.end(), std::back_inserter(rest));
+    std::set_difference(remaining.begin(), remaining.end(), fit.inliers.begin(), fit.inliers.end(),
+                        std::back_inserter(rest));
     remaining.swap(rest);
     if (face.points.size() < min_face) continue;
     bool orthogonal = true;

@@ -4,9 +4,8 @@
 // table plane, the circle refitted, the foot on the table when the points reach it.
 
 #include <Eigen/Dense>
+#include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "primlabel/synth/random.hpp"
 #include "truth_fit.hpp"
@@ -76,8 +75,8 @@ double msac_cost(const Cylinder& c, const SegmentPoints& s, const std::vector<st
     const bool top = std::abs(along - hi) < std::abs(along - lo);
     const double cap = std::hypot(std::abs(along - (top ? hi : lo)), cap_rho);
     const double d = std::min(side, cap);
-    const Vec3d normal = side <= cap ? Vec3d(c.radial(s.p[i]).normalized())
-                                     : Vec3d(top ? c.axis : Vec3d(-c.axis));
+    const Vec3d normal =
+        side <= cap ? Vec3d(c.radial(s.p[i]).normalized()) : Vec3d(top ? c.axis : Vec3d(-c.axis));
     cost += supports(d, s.bound[i], s.n[i], normal) ? d * d / t2 : 1.0;
   }
   return cost / double(idx.size());
@@ -177,11 +176,6 @@ std::optional<FittedObject> fit_cylinder(const SegmentPoints& s, const FitSettin
   }
   if (!best) return std::nullopt;
   Cylinder c = refine(*best, s, inliers(*best, s), true);
-  if (std::getenv("GT_DEBUG"))
-    std::fprintf(stderr, "cyl n=%zu best cost %.3f r=%.4f axis %.2f %.2f %.2f -> r=%.4f axis %.2f %.2f %.2f inl %zu\n",
-                 s.p.size(), best_cost, best->radius, best->axis.x(), best->axis.y(), best->axis.z(), c.radius,
-                 c.axis.x(), c.axis.y(), c.axis.z(), inliers(c, s).size());
-
   const Vec3d up = Vec3d::UnitZ();
   const double tilt = std::acos(std::min(1.0, std::abs(c.axis.dot(up)))) / kDeg;
   FittedObject out;

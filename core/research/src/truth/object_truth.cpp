@@ -1,6 +1,7 @@
 // The fitted ground truth of a scene: the table frame, a model per object segment, and the
 // synthetic rule on the fitted scene (mosd_truth.hpp).
 
+#include <algorithm>
 #include <map>
 #include <stdexcept>
 
@@ -160,7 +161,8 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
 
   // Per point: residual bound from its depth along the sensor's view axis.
   const Eigen::Isometry3d& t = truth.table_from_cloud;
-  const Eigen::Matrix3d sensor_from_cloud = cloud.viewpoint.orientation.cast<double>().inverse().toRotationMatrix();
+  const Eigen::Matrix3d sensor_from_cloud =
+      cloud.viewpoint.orientation.cast<double>().inverse().toRotationMatrix();
   const Vec3d origin = cloud.viewpoint.origin.cast<double>();
   auto bound = [&](const Vec3f& p) {
     const double z = (sensor_from_cloud * (p.cast<double>() - origin)).z();
@@ -188,8 +190,8 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
   synth::Scene scene;
   Eigen::Isometry3d slab = Eigen::Isometry3d::Identity();
   slab.translate(Vec3d(0, 0, -0.04));
-  scene.objects.emplace_back(std::make_shared<synth::BoxShape>(Vec3d(20, 20, 0.04)), slab,
-                             0xC8A67A, false);
+  scene.objects.emplace_back(std::make_shared<synth::BoxShape>(Vec3d(20, 20, 0.04)), slab, 0xC8A67A,
+                             false);
   std::vector<truth::RulePoint> rule_points;
   std::vector<std::uint32_t> rule_index;  // cloud index of each rule point
   for (std::uint32_t i = 0; i < cloud.size(); ++i) {
@@ -209,8 +211,8 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
     const int index = static_cast<int>(scene.objects.size()) - 1;
     const Eigen::Isometry3d local_from_table = object.table_from_local.inverse();
     for (std::size_t j = 0; j < indices.size(); ++j) {
-      const truth::SurfacePoint sp = truth::closest_surface(
-          object, local_from_table * s.p[j], local_from_table.linear() * s.n[j]);
+      const truth::SurfacePoint sp = truth::closest_surface(object, local_from_table * s.p[j],
+                                                            local_from_table.linear() * s.n[j]);
       if (sp.distance >= s.bound[j]) continue;
       rule_points.push_back({index, sp.part, object.table_from_local * sp.point});
       rule_index.push_back(indices[j]);

@@ -18,7 +18,8 @@ std::vector<std::uint32_t> label_by_rule(const synth::Scene& scene,
     r.surface_xyz = p.surface.cast<float>();
     r.part = p.part;
     r.object = static_cast<float>(p.object);
-    r.surface_label = class_id(owner.shape->surface_class(p.part, owner.local_from_world * p.surface));
+    r.surface_label =
+        class_id(owner.shape->surface_class(p.part, owner.local_from_world * p.surface));
   }
   synth::detail::label_unseen_creases_as_surface(returns, radius);
   std::vector<std::uint32_t> labels(points.size());

@@ -56,8 +56,7 @@ SurfacePoint closest_on_can(double radius, double height, const Vec3d& p, const 
 
 }  // namespace
 
-SurfacePoint closest_surface(const FittedObject& object, const Vec3d& local,
-                             const Vec3d& normal) {
+SurfacePoint closest_surface(const FittedObject& object, const Vec3d& local, const Vec3d& normal) {
   switch (object.kind) {
     case FittedKind::kBox:
       return closest_on_box(object.size, local, normal);

@@ -56,8 +56,7 @@ struct Evidence {
 Evidence evaluate(const FittedObject& object, const SegmentPoints& segment);
 
 std::optional<FittedObject> fit_box(const SegmentPoints& segment, const FitSettings& settings);
-std::optional<FittedObject> fit_cylinder(const SegmentPoints& segment,
-                                         const FitSettings& settings);
+std::optional<FittedObject> fit_cylinder(const SegmentPoints& segment, const FitSettings& settings);
 
 // Value at quantile q in [0, 1] (nearest rank) of `values` (copied).
 double quantile(std::vector<double> values, double q);

@@ -24,7 +24,7 @@ struct MosdObjectTruth {
   std::uint64_t object_points = 0;  // finite points of object segments
   std::uint64_t truth_points = 0;   // ... that the fitted truth labels (the scored ones)
   crf::ConfusionMatrix scores{scored_class_ids()};  // rows fitted truth, columns the model
-  std::string truth_file;                            // the labeled truth PCD, when written
+  std::string truth_file;                           // the labeled truth PCD, when written
   std::size_t count(FittedKind kind) const;
 };
 
@@ -48,7 +48,7 @@ struct MosdSceneReport {
   std::uint64_t object_points = 0, object_plane = 0;
   std::vector<std::uint64_t> table_predicted;  // table points per predicted taxonomy id
   double feature_seconds = 0, inference_seconds = 0;
-  std::string png;  // the labeled picture, when written
+  std::string png;                              // the labeled picture, when written
   std::optional<MosdObjectTruth> object_truth;  // with MosdTruthRequest::enabled
 
   // Table points without a descriptor (unknown) count as not plane.
@@ -60,7 +60,8 @@ struct MosdSceneReport {
 // the predicted classes from the sensor's view (class colours, legend) there. With `truth`
 // enabled, also fits the object truth and scores the model's labels of the object points on it.
 MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& path,
-                                  const std::string& png_path, const pipeline::LabelingOptions& options = {},
+                                  const std::string& png_path,
+                                  const pipeline::LabelingOptions& options = {},
                                   const RunContext& context = {},
                                   const MosdTruthRequest& truth = {});
 
@@ -68,7 +69,7 @@ struct MosdReport {
   std::vector<MosdSceneReport> scenes;
   std::uint64_t table_points = 0, table_plane = 0;
   std::optional<MosdObjectTruth> object_truth;  // over every scene that has one
-  double plane_share() const;  // over all scenes' table points
+  double plane_share() const;                   // over all scenes' table points
 };
 
 MosdReport summarize_mosd(std::vector<MosdSceneReport> scenes);

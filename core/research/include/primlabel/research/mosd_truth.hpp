@@ -41,7 +41,7 @@ struct FittedObject {
   Eigen::Isometry3d table_from_local = Eigen::Isometry3d::Identity();
   Eigen::Vector3d size = Eigen::Vector3d::Zero();  // box: x, y, z extents; cylinder: radius, length
   bool on_table = false;
-  int faces = 0;  // box faces found
+  int faces = 0;                        // box faces found
   std::size_t points = 0, inliers = 0;  // of the segment; within the residual bound of the model
   double rms = 0;                       // residual of the inliers (m)
   double bound = 0;                     // median residual bound of the segment's points (m)
@@ -57,9 +57,9 @@ struct ObjectTruthOptions {
   // noise is 1.425e-3 z² (sigma) and a disparity step ~3.2e-3 z² at 1/8 pixel: three sigma,
   // half a step and 2 mm of model error.
   double residual_base = 0.002, residual_z2 = 0.006;
-  double min_inlier_share = 0.8;   // below: the segment is unfitted
-  double max_rms_share = 0.4;      // inlier RMS above this share of the median bound: unfitted
-  double contact_tolerance = 0.02; // lowest points this close to the table: standing on it (m)
+  double min_inlier_share = 0.8;    // below: the segment is unfitted
+  double max_rms_share = 0.4;       // inlier RMS above this share of the median bound: unfitted
+  double contact_tolerance = 0.02;  // lowest points this close to the table: standing on it (m)
   std::size_t min_segment_points = 50;
   float normal_radius = 0.015f;  // PCA normals for the cylinder hypotheses (m)
   std::uint64_t seed = 1;

@@ -23,7 +23,7 @@ void add_object_points(crf::ConfusionMatrix& confusion, const std::vector<int>& 
                        const std::vector<std::uint32_t>& predicted);
 
 struct TruthCheckOptions {
-  int scenes = 4;       // synthetic Kinect table scenes of the test set (seeds 3000 + first + i)
+  int scenes = 4;  // synthetic Kinect table scenes of the test set (seeds 3000 + first + i)
   int first = 0;
   ObjectTruthOptions truth;
 };
@@ -45,6 +45,5 @@ std::string truth_check_json(const TruthCheck& check);
 
 // JSON of the per-class precision / recall / support and the accuracy of a confusion matrix.
 json::Json confusion_classes_json(const crf::ConfusionMatrix& confusion);
-
 
 }  // namespace primlabel::research
