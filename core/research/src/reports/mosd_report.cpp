@@ -56,6 +56,7 @@ json::Json fitted_object_json(const FittedObject& o) {
           {"inlier_share", json_number(o.inlier_share())},
           {"rms", json::rounded(o.rms, "%.5f")},
           {"bound", json::rounded(o.bound, "%.5f")},
+          {"max_rms", json::rounded(o.max_rms, "%.5f")},
           {"on_table", o.on_table},
           {"faces", o.faces},
           {"size",

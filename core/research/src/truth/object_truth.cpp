@@ -68,8 +68,9 @@ FittedObject choose_model(int segment, const truth::SegmentPoints& points,
   chosen.box_cost = box ? box_evidence.cost : NAN;
   chosen.cylinder_cost = cylinder ? cylinder_evidence.cost : NAN;
   chosen.bound = truth::quantile(points.bound, 0.5);
-  if (chosen.inlier_share() < options.min_inlier_share ||
-      chosen.rms > options.max_rms_share * chosen.bound)
+  const double z = truth::quantile(points.depth, 0.5);
+  chosen.max_rms = options.rms_base + options.rms_z2 * z * z;
+  if (chosen.inlier_share() < options.min_inlier_share || chosen.rms > chosen.max_rms)
     chosen.kind = FittedKind::kUnfitted;
   return chosen;
 }
@@ -164,8 +165,11 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
   const Eigen::Matrix3d sensor_from_cloud =
       cloud.viewpoint.orientation.cast<double>().inverse().toRotationMatrix();
   const Vec3d origin = cloud.viewpoint.origin.cast<double>();
+  auto depth = [&](const Vec3f& p) {
+    return (sensor_from_cloud * (p.cast<double>() - origin)).z();
+  };
   auto bound = [&](const Vec3f& p) {
-    const double z = (sensor_from_cloud * (p.cast<double>() - origin)).z();
+    const double z = depth(p);
     return options.residual_base + options.residual_z2 * z * z;
   };
 
@@ -180,6 +184,7 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
       s.p.push_back(t * cloud.xyz[i].cast<double>());
       s.n.push_back(t.linear() * work.normals[i].cast<double>());
       s.bound.push_back(bound(cloud.xyz[i]));
+      s.depth.push_back(depth(cloud.xyz[i]));
     }
     truth.objects.push_back(choose_model(segment, s, options));
     points.push_back(std::move(s));

@@ -17,6 +17,7 @@ using Vec3d = Eigen::Vector3d;
 struct SegmentPoints {
   std::vector<Vec3d> p, n;
   std::vector<double> bound;
+  std::vector<double> depth;        // along the sensor's view axis (m)
   Vec3d viewpoint = Vec3d::Zero();  // the sensor, so faces can be oriented toward it
 };
 

@@ -9,9 +9,10 @@
 //      point + normal pairs, then Gauss-Newton least squares; upright or lying, on the table when
 //      its foot reaches it). The model with the lower mean MSAC cost wins; when fewer than
 //      min_inlier_share of the segment's points lie within the residual bound of it, or its
-//      inliers' RMS residual exceeds max_rms_share of the segment's median bound (a wrong surface
-//      spreads the residuals over the whole band, RMS ~0.58 of it; sensor noise alone gives
-//      ~0.1-0.25), the segment is unfitted (not scored, counted). So is a segment mostly inside
+//      inliers' RMS residual exceeds the RMS bound (the sensor's noise RMS at the segment's median
+//      depth plus a margin for surfaces that are not exactly boxes or cylinders; a wrong model
+//      spreads the residuals over the whole band instead), the segment is unfitted (not scored,
+//      counted). So is a segment mostly inside
 //      another fitted solid (a pot's inner floor);
 //   3. the fitted shapes become a synthetic scene (synth::Scene: the table slab and the shapes),
 //      and every point within the residual bound of its surface is labeled by the synthetic
@@ -45,6 +46,7 @@ struct FittedObject {
   std::size_t points = 0, inliers = 0;  // of the segment; within the residual bound of the model
   double rms = 0;                       // residual of the inliers (m)
   double bound = 0;                     // median residual bound of the segment's points (m)
+  double max_rms = 0;                   // the RMS bound at the segment's median depth (m)
   // Mean truncated cost of each model, min(d², bound²) / bound² over the segment's points
   // (0: every point on the surface, 1: none within the bound); NaN when the model failed.
   double box_cost = NAN, cylinder_cost = NAN;
@@ -57,8 +59,11 @@ struct ObjectTruthOptions {
   // noise is 1.425e-3 z² (sigma) and a disparity step ~3.2e-3 z² at 1/8 pixel: three sigma,
   // half a step and 2 mm of model error.
   double residual_base = 0.002, residual_z2 = 0.006;
-  double min_inlier_share = 0.8;    // below: the segment is unfitted
-  double max_rms_share = 0.4;       // inlier RMS above this share of the median bound: unfitted
+  double min_inlier_share = 0.8;  // below: the segment is unfitted
+  // RMS bound at the median depth z: rms_base + rms_z2 · z² (m). The Kinect noise RMS is
+  // sqrt(1.425² + 3.2² / 12) · 1e-3 z² (depth sigma and a uniform disparity step), and 1.5 mm
+  // allows for print, bulges and rounded edges.
+  double rms_base = 0.0015, rms_z2 = 0.0017;
   double contact_tolerance = 0.02;  // lowest points this close to the table: standing on it (m)
   std::size_t min_segment_points = 50;
   float normal_radius = 0.015f;  // PCA normals for the cylinder hypotheses (m)
