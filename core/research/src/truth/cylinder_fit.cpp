@@ -4,6 +4,7 @@
 // table plane, the circle refitted, the foot on the table when the points reach it.
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -17,6 +18,8 @@ constexpr double kDeg = M_PI / 180.0;
 constexpr double kMinRadius = 0.01, kMaxRadius = 0.25;
 const double kNormalAgrees = std::cos(45 * kDeg);
 const double kCapNormal = std::cos(30 * kDeg);
+// The side must be seen over this much of its circumference (a can in view shows 90-180°).
+constexpr double kMinArc = 45 * kDeg;
 
 struct Cylinder {
   Vec3d axis = Vec3d::UnitZ();  // unit
@@ -145,6 +148,22 @@ Cylinder refine(Cylinder c, const SegmentPoints& s, const std::vector<std::size_
   return c;
 }
 
+// Angle the side inliers span around the axis (2π less the widest empty sector). A narrow arc
+// of a wide cylinder is as flat as a plane within the noise: no evidence of curvature.
+double arc_span(const Cylinder& c, const SegmentPoints& s, const std::vector<std::size_t>& idx) {
+  if (idx.size() < 2) return 0;
+  const Vec3d u = c.axis.unitOrthogonal(), v = c.axis.cross(u);
+  std::vector<double> angles;
+  for (std::size_t i : idx) {
+    const Vec3d r = c.radial(s.p[i]);
+    angles.push_back(std::atan2(r.dot(v), r.dot(u)));
+  }
+  std::sort(angles.begin(), angles.end());
+  double gap = angles.front() + 2 * M_PI - angles.back();
+  for (std::size_t k = 1; k < angles.size(); ++k) gap = std::max(gap, angles[k] - angles[k - 1]);
+  return 2 * M_PI - gap;
+}
+
 std::vector<std::size_t> inliers(const Cylinder& c, const SegmentPoints& s) {
   std::vector<std::size_t> out;
   for (std::size_t i = 0; i < s.p.size(); ++i)
@@ -191,6 +210,7 @@ std::optional<FittedObject> fit_cylinder(const SegmentPoints& s, const FitSettin
   c.point -= c.point.dot(c.axis) * c.axis;
   c = refine(c, s, inliers(c, s), false);
   if (!(c.radius > kMinRadius && c.radius < kMaxRadius)) return std::nullopt;
+  if (arc_span(c, s, inliers(c, s)) < kMinArc) return std::nullopt;
 
   std::vector<std::size_t> all(s.p.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
