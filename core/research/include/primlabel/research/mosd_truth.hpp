@@ -7,13 +7,12 @@
 //      MSAC plane refined by least squares, standing on the table when its faces are level and
 //      its lowest points reach the table) and a closed cylinder (axis and radius by MSAC on
 //      point + normal pairs, then Gauss-Newton least squares; upright or lying, on the table when
-//      its foot reaches it). The model with the lower mean MSAC cost wins; when fewer than
-//      min_inlier_share of the segment's points lie within the residual bound of it, or its
-//      inliers' RMS residual exceeds the RMS bound (the sensor's noise RMS at the segment's median
-//      depth plus a margin for surfaces that are not exactly boxes or cylinders; a wrong model
-//      spreads the residuals over the whole band instead), the segment is unfitted (not scored,
-//      counted). So is a segment mostly inside
-//      another fitted solid (a pot's inner floor);
+//      its foot reaches it; its side seen over 45 degrees of arc at least). The model with the
+//      lower mean MSAC cost wins. The segment is unfitted (not scored, counted) when fewer than
+//      min_inlier_share of its points lie within the residual bound of the model, when the
+//      inliers' RMS residual exceeds the RMS bound (the sensor's noise RMS at the segment's
+//      median depth plus a margin; a wrong model spreads the residuals over the whole band), or
+//      when it lies mostly inside another fitted solid (a pot's inner floor);
 //   3. the fitted shapes become a synthetic scene (synth::Scene: the table slab and the shapes),
 //      and every point within the residual bound of its surface is labeled by the synthetic
 //      ground-truth rule itself (synth::ground_truth at the label radius, then the
