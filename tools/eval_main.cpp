@@ -8,6 +8,9 @@
 //   primlabel-eval --fig4 out/ [--fig4-scenes 3]                    # the paper's Fig. 4
 //   primlabel-eval --model kinect.plm --mosd-report out/ ../shared/data/mosd/*.pcd
 //   primlabel-eval --calibrate-kinect ../shared/data/mosd [--calibration-json out.json]
+//   primlabel-eval --model kinect.plm --mosd-report out/ --object-truth [--write-truth t/] scenes
+//   primlabel-eval --write-truth truth/ ../shared/data/mosd/*.pcd     # the fitted truth only
+//   primlabel-eval --truth-check 4                                   # its error on synthetic
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -32,17 +35,21 @@
 #include "primlabel/research/kinect_calibration.hpp"
 #include "primlabel/research/mosd_report.hpp"
 #include "primlabel/research/table1.hpp"
+#include "primlabel/research/truth_check.hpp"
 
 namespace {
 
 using namespace primlabel;
 
 struct Arguments {
-  std::string model, classes, out, confusion_png, fig4_dir, mosd_dir, calibrate_dir,
+  std::string model, classes, out, confusion_png, fig4_dir, mosd_dir, truth_dir, calibrate_dir,
       calibration_json;
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
-  bool table1 = false, no_pfh = false, no_svm = false, fit_simulation = false;
+  bool table1 = false, no_pfh = false, no_svm = false, object_truth = false,
+       fit_simulation = false;
+  int truth_check = 0;
+  double truth_radius = research::ObjectTruthOptions{}.label_radius;
   std::string node_basis = "tent";
   std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
   int table1_train = 8, table1_test = 4, pfh_max_neighbors = 40, threads = 0, fig4_scenes = 3;
@@ -168,11 +175,74 @@ int table1(const Arguments& args) {
   return cli::kExitOk;
 }
 
+void make_directory(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error(dir + ": cannot be created (" + ec.message() + ")");
+}
+
+research::MosdTruthRequest truth_request(const Arguments& args, const std::string& scene) {
+  research::MosdTruthRequest request;
+  request.enabled = args.object_truth || !args.truth_dir.empty();
+  request.options.label_radius = args.truth_radius;
+  if (!args.truth_dir.empty())
+    request.write_path = (std::filesystem::path(args.truth_dir) /
+                          (std::filesystem::path(scene).stem().string() + "_truth.pcd"))
+                             .string();
+  return request;
+}
+
+// The fitted object truth of mOSD scenes alone: a labeled PCD per scene and truth_fits.json.
+int write_truth(const Arguments& args) {
+  make_directory(args.truth_dir);
+  json::Json scenes = json::Json::array();
+  research::MosdObjectTruth all;
+  for (const std::string& path : args.files) {
+    const PointCloud cloud = read_cloud(path);
+    research::MosdObjectTruth t;
+    try {
+      t = research::fit_mosd_truth(cloud, truth_request(args, path), RunContext{args.threads});
+    } catch (const std::exception& e) {
+      throw std::runtime_error(path + ": " + e.what());
+    }
+    std::printf(
+        "%s: %zu segments: %zu box, %zu upright cylinder, %zu lying cylinder, %zu "
+        "unfitted; %llu of %llu object points labeled; wrote %s\n",
+        path.c_str(), t.objects.size(), t.count(research::FittedKind::kBox),
+        t.count(research::FittedKind::kUprightCylinder),
+        t.count(research::FittedKind::kLyingCylinder), t.count(research::FittedKind::kUnfitted),
+        static_cast<unsigned long long>(t.truth_points),
+        static_cast<unsigned long long>(t.object_points), t.truth_file.c_str());
+    json::Json scene = research::object_truth_json(t, true);
+    scene["file"] = path;
+    scenes.push_back(std::move(scene));
+    all.objects.insert(all.objects.end(), t.objects.begin(), t.objects.end());
+    all.object_points += t.object_points;
+    all.truth_points += t.truth_points;
+  }
+  const json::Json out = {{"scenes", std::move(scenes)},
+                          {"overall", research::object_truth_json(all, false)}};
+  atomic_write_file((std::filesystem::path(args.truth_dir) / "truth_fits.json").string(),
+                    json::dump(out) + "\n");
+  return cli::kExitOk;
+}
+
+int truth_check(const Arguments& args) {
+  research::TruthCheckOptions options;
+  options.scenes = args.truth_check;
+  options.truth.label_radius = args.truth_radius;
+  const research::TruthCheck check =
+      research::check_truth_on_synthetic(options, RunContext{args.threads});
+  std::fputs(
+      (args.json ? research::truth_check_json(check) : research::truth_check_text(check)).c_str(),
+      stdout);
+  return cli::kExitOk;
+}
+
 int mosd_report(const Arguments& args) {
   const LabelModel model = load_model(args.model);
-  std::error_code ec;
-  std::filesystem::create_directories(args.mosd_dir, ec);
-  if (ec) throw std::runtime_error(args.mosd_dir + ": cannot be created (" + ec.message() + ")");
+  make_directory(args.mosd_dir);
+  if (!args.truth_dir.empty()) make_directory(args.truth_dir);
   pipeline::LabelingOptions options;
   options.tabletop_only = args.tabletop_only;
   const RunContext context{args.threads};
@@ -181,7 +251,8 @@ int mosd_report(const Arguments& args) {
     const std::string png = (std::filesystem::path(args.mosd_dir) /
                              (std::filesystem::path(path).stem().string() + "_labels.png"))
                                 .string();
-    scenes.push_back(research::report_mosd_scene(model, path, png, options, context));
+    scenes.push_back(
+        research::report_mosd_scene(model, path, png, options, context, truth_request(args, path)));
     if (!args.quiet)
       std::fprintf(stderr, "%s: %.2f%% of %llu table points plane, wrote %s\n", path.c_str(),
                    100.0 * scenes.back().plane_share(),
@@ -284,6 +355,26 @@ int main(int argc, char** argv) {
           ->needs(model)
           ->excludes(no_truth)
           ->excludes(out);
+  auto* object_truth =
+      app.add_flag("--object-truth", args.object_truth,
+                   "--mosd-report: also fit box / cylinder models to the object segments, label "
+                   "their points by the ground-truth rule and score the model on them per class")
+          ->needs(mosd);
+  auto* write_truth_dir =
+      app.add_option("--write-truth", args.truth_dir,
+                     "write the fitted object truth of each mOSD scene as DIR/<scene>_truth.pcd "
+                     "(taxonomy labels, 0 unscored; a `segment` field); without --model only "
+                     "that, with truth_fits.json")
+          ->excludes(no_truth)
+          ->excludes(out);
+  auto* check = app.add_option("--truth-check", args.truth_check,
+                               "the fitted truth's own error: fit and label N held-out synthetic "
+                               "Kinect scenes and compare with their true labels, per class")
+                    ->check(CLI::PositiveNumber);
+  app.add_option("--truth-radius", args.truth_radius,
+                 "label radius of the fitted truth (m), as primlabel-synth --radius")
+      ->check(CLI::PositiveNumber);
+  check->excludes(model)->excludes(files)->excludes(object_truth)->excludes(write_truth_dir);
   app.add_option("--confusion-png", args.confusion_png,
                  "confusion matrix over all scored files as PNG (rows true, columns predicted)")
       ->excludes(no_truth)
@@ -348,8 +439,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "primlabel-eval: usage error: %s\n", e.what());
     return cli::kExitUsage;
   }
-  const bool study = args.table1 || !args.fig4_dir.empty() || !args.calibrate_dir.empty();
-  if (!study && (args.model.empty() || args.files.empty())) {
+  const bool study = args.table1 || !args.fig4_dir.empty() || args.truth_check > 0 ||
+                     !args.calibrate_dir.empty();
+  const bool truth_only = !args.truth_dir.empty() && args.model.empty();
+  if (!args.truth_dir.empty() && !args.model.empty() && args.mosd_dir.empty()) {
+    std::fprintf(stderr,
+                 "primlabel-eval: usage error: --write-truth with --model needs --mosd-report\n");
+    return cli::kExitUsage;
+  }
+  if (truth_only && args.files.empty()) {
+    std::fprintf(stderr, "primlabel-eval: usage error: --write-truth needs mOSD scene files\n");
+    return cli::kExitUsage;
+  }
+  if (!study && !truth_only && (args.model.empty() || args.files.empty())) {
     std::fprintf(stderr,
                  "primlabel-eval: usage error: give --model and at least one file, or --table1 "
                  "or --fig4 or --calibrate-kinect (see --help)\n");
@@ -363,6 +465,8 @@ int main(int argc, char** argv) {
     if (args.table1) return table1(args);
     if (!args.fig4_dir.empty()) return fig4(args);
     if (!args.calibrate_dir.empty()) return calibrate_kinect(args);
+    if (args.truth_check > 0) return truth_check(args);
+    if (truth_only) return write_truth(args);
     if (!args.mosd_dir.empty()) return mosd_report(args);
     return evaluate_files(args);
   } catch (const std::exception& e) {

@@ -46,6 +46,27 @@ TEST(Shapes, CanSideAndLid) {
   EXPECT_EQ(hit.part, 1);
 }
 
+TEST(Shapes, LyingCanSideAndCaps) {
+  const LyingCanShape can(0.04, 0.16);  // axis x, on the table along y = 0
+  SurfaceHit hit = hit_of(can, down_at(0.03, 0.0));
+  EXPECT_NEAR(hit.t, 1.0 - 0.08, 1e-12);  // the top of the side
+  EXPECT_EQ(hit.part, 0);
+  EXPECT_NEAR(hit.normal.z(), 1.0, 1e-12);
+  EXPECT_EQ(can.surface_class(0, Vec3d()), PrimitiveClass::kCylinderConvex);
+  hit = hit_of(can, along_x(0.0, 0.04));  // from -x: the -x cap
+  EXPECT_NEAR(hit.t, 1.0 - 0.08, 1e-12);
+  EXPECT_EQ(hit.part, 2);
+  EXPECT_NEAR(hit.normal.x(), -1.0, 1e-12);
+  EXPECT_EQ(can.surface_class(2, Vec3d()), PrimitiveClass::kPlane);
+  EXPECT_NEAR(can.distance_outside(Vec3d(0.0, 0.0, 0.1)), 0.02, 1e-12);
+  EXPECT_NEAR(can.distance_outside(Vec3d(0.1, 0.0, 0.04)), 0.02, 1e-12);
+  // Both cap circles are convex edges of the side and their cap.
+  int edges_near_plus_cap = 0;
+  for (const Feature& f : can.features())
+    edges_near_plus_cap += f.distance(Vec3d(0.08, 0.0, 0.0)) < 1e-12 && (f.parts >> 1 & 1u);
+  EXPECT_EQ(edges_near_plus_cap, 1);
+}
+
 TEST(Shapes, MugFloorLipWallsAndHandle) {
   const MugShape::Handle handle{0.028, 0.006, 0.055, 0.01};
   const MugShape mug(0.042, 0.10, 0.005, 0.008, handle);

@@ -48,6 +48,44 @@ void render_labels(const PointCloud& cloud, const std::vector<std::uint32_t>& la
 
 }  // namespace
 
+json::Json fitted_object_json(const FittedObject& o) {
+  const Eigen::Vector3d at = o.table_from_local.translation();
+  return {{"segment", o.segment},
+          {"kind", std::string(fitted_kind_name(o.kind))},
+          {"points", o.points},
+          {"inlier_share", json_number(o.inlier_share())},
+          {"rms", json::rounded(o.rms, "%.5f")},
+          {"bound", json::rounded(o.bound, "%.5f")},
+          {"max_rms", json::rounded(o.max_rms, "%.5f")},
+          {"on_table", o.on_table},
+          {"faces", o.faces},
+          {"size",
+           {json::rounded(o.size.x(), "%.4f"), json::rounded(o.size.y(), "%.4f"),
+            json::rounded(o.size.z(), "%.4f")}},
+          {"at",
+           {json::rounded(at.x(), "%.4f"), json::rounded(at.y(), "%.4f"),
+            json::rounded(at.z(), "%.4f")}},
+          {"box_cost", json_number(o.box_cost)},
+          {"cylinder_cost", json_number(o.cylinder_cost)}};
+}
+
+json::Json object_truth_json(const MosdObjectTruth& t, bool with_objects) {
+  json::Json out = {{"boxes", t.count(FittedKind::kBox)},
+                    {"upright_cylinders", t.count(FittedKind::kUprightCylinder)},
+                    {"lying_cylinders", t.count(FittedKind::kLyingCylinder)},
+                    {"unfitted", t.count(FittedKind::kUnfitted)},
+                    {"object_points", t.object_points},
+                    {"truth_points", t.truth_points}};
+  if (t.scores.total()) out["scores"] = confusion_classes_json(t.scores);
+  if (!t.truth_file.empty()) out["truth_file"] = t.truth_file;
+  if (with_objects) {
+    json::Json objects = json::Json::array();
+    for (const FittedObject& o : t.objects) objects.push_back(fitted_object_json(o));
+    out["objects"] = std::move(objects);
+  }
+  return out;
+}
+
 double MosdSceneReport::plane_share() const { return share(table_plane, table_points); }
 double MosdSceneReport::object_plane_share() const { return share(object_plane, object_points); }
 double MosdReport::plane_share() const { return share(table_plane, table_points); }
@@ -55,11 +93,20 @@ double MosdReport::plane_share() const { return share(table_plane, table_points)
 MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& path,
                                   const std::string& png_path,
                                   const pipeline::LabelingOptions& options,
-                                  const RunContext& context) {
+                                  const RunContext& context, const MosdTruthRequest& truth) {
   PointCloud cloud = read_cloud(path);
   if (!cloud.has_labels())
     throw std::runtime_error(path + ": no label field (an mOSD scene labels table and objects)");
   const std::vector<std::uint32_t> segments = cloud.labels;
+  std::optional<MosdObjectTruth> object_truth;
+  std::vector<std::uint32_t> truth_labels;
+  if (truth.enabled) {
+    try {
+      object_truth = fit_mosd_truth(cloud, truth, context, &truth_labels);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(path + ": " + e.what());
+    }
+  }
   const pipeline::LabelingResult result = pipeline::label_cloud(model, cloud, options, context);
 
   MosdSceneReport report;
@@ -81,6 +128,10 @@ MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& pa
       report.object_plane += is_plane;
     }
   }
+  if (object_truth) {
+    add_object_points(object_truth->scores, mosd_segments(segments), truth_labels, result.labels);
+    report.object_truth = std::move(object_truth);
+  }
   if (!png_path.empty()) {
     const std::string scene = std::filesystem::path(path).stem().string();
     render_labels(
@@ -98,6 +149,14 @@ MosdReport summarize_mosd(std::vector<MosdSceneReport> scenes) {
   for (const MosdSceneReport& s : report.scenes) {
     report.table_points += s.table_points;
     report.table_plane += s.table_plane;
+    if (!s.object_truth) continue;
+    if (!report.object_truth) report.object_truth.emplace();
+    MosdObjectTruth& all = *report.object_truth;
+    all.objects.insert(all.objects.end(), s.object_truth->objects.begin(),
+                       s.object_truth->objects.end());
+    all.object_points += s.object_truth->object_points;
+    all.truth_points += s.object_truth->truth_points;
+    all.scores.add(s.object_truth->scores);
   }
   return report;
 }
@@ -113,6 +172,30 @@ std::string mosd_report_text(const MosdReport& report) {
                   100.0 * s.object_plane_share(), s.feature_seconds + s.inference_seconds);
   out += format("%-28s %9s %12llu %11.2f%%\n", "overall", "",
                 static_cast<unsigned long long>(report.table_points), 100.0 * report.plane_share());
+  if (!report.object_truth) return out;
+  out += format("\nobject truth (fitted)       %5s %5s %5s %5s %12s %12s %9s\n", "box", "cyl|",
+                "cyl-", "none", "object pts", "scored pts", "accuracy");
+  auto truth_row = [&](const std::string& label, const MosdObjectTruth& t) {
+    return format("%-27s %5zu %5zu %5zu %5zu %12llu %12llu %8.2f%%\n", label.c_str(),
+                  t.count(FittedKind::kBox), t.count(FittedKind::kUprightCylinder),
+                  t.count(FittedKind::kLyingCylinder), t.count(FittedKind::kUnfitted),
+                  static_cast<unsigned long long>(t.object_points),
+                  static_cast<unsigned long long>(t.truth_points), 100.0 * t.scores.accuracy());
+  };
+  for (const MosdSceneReport& s : report.scenes)
+    if (s.object_truth)
+      out += truth_row(std::filesystem::path(s.file).filename().string(), *s.object_truth);
+  out += truth_row("overall", *report.object_truth);
+  out += "the model on the object points, against the fitted truth:\n";
+  const crf::ConfusionMatrix& m = report.object_truth->scores;
+  out += format("  %-16s %10s %9s %9s\n", "class", "points", "recall", "precision");
+  for (int k = 0; k < m.num_classes(); ++k) {
+    const crf::ClassScores c = m.scores(k);
+    if (!c.support && !(c.precision >= 0)) continue;
+    const auto cls = class_from_id(m.class_ids()[k]);
+    out += format("  %-16s %10llu %8.1f%% %8.1f%%\n", std::string(name(*cls)).c_str(),
+                  static_cast<unsigned long long>(c.support), 100 * c.recall, 100 * c.precision);
+  }
   return out;
 }
 
@@ -135,11 +218,13 @@ std::string mosd_report_json(const MosdReport& report) {
                       {"table_predicted", std::move(predicted)},
                       {"seconds", json_number(s.feature_seconds + s.inference_seconds)},
                       {"png", s.png}});
+    if (s.object_truth) scenes.back()["object_truth"] = object_truth_json(*s.object_truth, true);
   }
-  const json::Json out = {{"scenes", std::move(scenes)},
-                          {"table_points", report.table_points},
-                          {"table_plane", report.table_plane},
-                          {"plane_share", json_number(report.plane_share())}};
+  json::Json out = {{"scenes", std::move(scenes)},
+                    {"table_points", report.table_points},
+                    {"table_plane", report.table_plane},
+                    {"plane_share", json_number(report.plane_share())}};
+  if (report.object_truth) out["object_truth"] = object_truth_json(*report.object_truth, false);
   return json::dump(out) + "\n";
 }
 

@@ -268,6 +268,35 @@ double CanShape::footprint_inset(const Vec3d& p) const {
   return std::max(radius_ - radial(p), 0.0);
 }
 
+// --- Lying can ------------------------------------------------------------------------------
+
+LyingCanShape::LyingCanShape(double radius, double length)
+    : radius_(radius), length_(length), upright_(radius, length) {
+  using K = Feature::Kind;
+  features_.push_back(Feature::circle(K::kConvexEdge, Vec3d(0.5 * length, 0, radius),
+                                      Vec3d::UnitX(), radius, 0b011));
+  features_.push_back(Feature::circle(K::kConvexEdge, Vec3d(-0.5 * length, 0, radius),
+                                      Vec3d::UnitX(), radius, 0b101));
+  bound_center_ = Vec3d(0, 0, radius);
+  bound_radius_ = std::hypot(radius, 0.5 * length);
+}
+
+bool LyingCanShape::intersect(const Ray& ray, double t_min, double t_max, SurfaceHit& hit) const {
+  // The upright frame is this one mirrored (x and z swapped, then shifted): directions map alike.
+  const Ray upright{upright_from_local(ray.origin), Vec3d(ray.dir.z(), ray.dir.y(), ray.dir.x())};
+  if (!upright_.intersect(upright, t_min, t_max, hit)) return false;
+  hit.normal = Vec3d(hit.normal.z(), hit.normal.y(), hit.normal.x());
+  return true;  // parts coincide: 0 side, 1 the lid (+x), 2 the bottom (-x)
+}
+
+PrimitiveClass LyingCanShape::surface_class(int part, const Vec3d&) const {
+  return part == 0 ? PrimitiveClass::kCylinderConvex : PrimitiveClass::kPlane;
+}
+
+double LyingCanShape::distance_outside(const Vec3d& p) const {
+  return upright_.distance_outside(upright_from_local(p));
+}
+
 // --- Mug / cup -------------------------------------------------------------------------------
 
 MugShape::MugShape(double radius, double height, double wall, double floor, const Handle& handle)

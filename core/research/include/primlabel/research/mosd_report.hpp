@@ -4,16 +4,41 @@
 // segments, not primitives: 0 invalid, 1-9 (parts of) the table, 20 and up objects.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/research/mosd_truth.hpp"
+#include "primlabel/research/truth_check.hpp"
 
 namespace primlabel::research {
 
 inline bool is_mosd_table_label(std::uint32_t label) { return label >= 1 && label <= 9; }
 inline bool is_mosd_object_label(std::uint32_t label) { return label >= 20; }
+
+// The fitted object truth of one scene (mosd_truth.hpp) and, with a model, its scores on it.
+struct MosdObjectTruth {
+  std::vector<FittedObject> objects;
+  std::uint64_t object_points = 0;  // finite points of object segments
+  std::uint64_t truth_points = 0;   // ... that the fitted truth labels (the scored ones)
+  crf::ConfusionMatrix scores{scored_class_ids()};  // rows fitted truth, columns the model
+  std::string truth_file;                           // the labeled truth PCD, when written
+  std::size_t count(FittedKind kind) const;
+};
+
+struct MosdTruthRequest {
+  bool enabled = false;
+  ObjectTruthOptions options;
+  std::string write_path;  // when set: the truth as a labeled PCD (taxonomy ids, `segment` field)
+};
+
+// Fits the object truth of an mOSD scene (its `label` field holds the segments); `labels`, when
+// given, receives the truth label of every point.
+MosdObjectTruth fit_mosd_truth(const PointCloud& cloud, const MosdTruthRequest& request,
+                               const RunContext& context = {},
+                               std::vector<std::uint32_t>* labels = nullptr);
 
 struct MosdSceneReport {
   std::string file;
@@ -23,7 +48,8 @@ struct MosdSceneReport {
   std::uint64_t object_points = 0, object_plane = 0;
   std::vector<std::uint64_t> table_predicted;  // table points per predicted taxonomy id
   double feature_seconds = 0, inference_seconds = 0;
-  std::string png;  // the labeled picture, when written
+  std::string png;                              // the labeled picture, when written
+  std::optional<MosdObjectTruth> object_truth;  // with MosdTruthRequest::enabled
 
   // Table points without a descriptor (unknown) count as not plane.
   double plane_share() const;
@@ -31,23 +57,33 @@ struct MosdSceneReport {
 };
 
 // Labels the scene at `path` with `model` and counts. When `png_path` is not empty, also renders
-// the predicted classes from the sensor's view (class colours, legend) there.
+// the predicted classes from the sensor's view (class colours, legend) there. With `truth`
+// enabled, also fits the object truth and scores the model's labels of the object points on it.
 MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& path,
                                   const std::string& png_path,
                                   const pipeline::LabelingOptions& options = {},
-                                  const RunContext& context = {});
+                                  const RunContext& context = {},
+                                  const MosdTruthRequest& truth = {});
 
 struct MosdReport {
   std::vector<MosdSceneReport> scenes;
   std::uint64_t table_points = 0, table_plane = 0;
-  double plane_share() const;  // over all scenes' table points
+  std::optional<MosdObjectTruth> object_truth;  // over every scene that has one
+  double plane_share() const;                   // over all scenes' table points
 };
 
 MosdReport summarize_mosd(std::vector<MosdSceneReport> scenes);
 
-// Fixed-width text table, one row per scene and the overall share.
+// JSON of a fitted object (segment, kind, points, inlier share, rms, size, pose, both costs) and
+// of a scene's (or the overall) object truth: model counts, points, scores, per object.
+json::Json fitted_object_json(const FittedObject& object);
+json::Json object_truth_json(const MosdObjectTruth& truth, bool with_objects);
+
+// Fixed-width text table, one row per scene and the overall share; with object truth, the fitted
+// models per scene and the model's per-class recall / precision on the object points.
 std::string mosd_report_text(const MosdReport& report);
-// One JSON object: {"scenes":[{...}], "table_points", "table_plane", "plane_share"}.
+// One JSON object: {"scenes":[{...}], "table_points", "table_plane", "plane_share"}, and
+// "object_truth" (per scene and overall) when fitted.
 std::string mosd_report_json(const MosdReport& report);
 
 }  // namespace primlabel::research

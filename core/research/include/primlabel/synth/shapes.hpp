@@ -122,6 +122,33 @@ class CanShape : public Shape {
   double radius_, height_;
 };
 
+// Closed cylinder lying on its side (a can or a roll on the table): axis along x, length
+// [-length/2, length/2], touching z = 0 along the line y = 0. Parts: 0 side (convex cylinder),
+// 1 cap at +x, 2 cap at -x (planes); both cap circles are convex edges. Its footprint on z = 0 is
+// a line, so every side point within r of the table is at the contact crease, as for a ball.
+class LyingCanShape : public Shape {
+ public:
+  LyingCanShape(double radius, double length);
+  std::string_view kind() const override { return "lying-can"; }
+  bool intersect(const Ray& ray, double t_min, double t_max, SurfaceHit& hit) const override;
+  PrimitiveClass surface_class(int part, const Vec3d&) const override;
+  double distance_outside(const Vec3d& p) const override;
+  double footprint_radius() const override { return std::hypot(radius_, 0.5 * length_); }
+  // The upright frame of the same can (axis z, bottom cap at z = 0, the -x cap) from this frame.
+  Vec3d upright_from_local(const Vec3d& p) const {
+    return Vec3d(p.z() - radius_, p.y(), p.x() + 0.5 * length_);
+  }
+  Vec3d local_from_upright(const Vec3d& q) const {
+    return Vec3d(q.z() - 0.5 * length_, q.y(), q.x() + radius_);
+  }
+  double radius() const { return radius_; }
+  double length() const { return length_; }
+
+ private:
+  double radius_, length_;
+  CanShape upright_;
+};
+
 // Open vessel with a wall and a floor (a mug; a cup without the handle). Parts: 0 outer wall
 // (convex cylinder), 1 inner wall (concave cylinder), 2 lip (the flat annulus on top), 3 inner
 // floor (plane), 4 bottom, 5 handle (a torus arc, torus-convex: at the label scale a thin ring).
