@@ -133,6 +133,9 @@ int evaluate_files(const Arguments& args) {
     if (!args.quiet)
       std::fprintf(stderr, "%s: %zu points, features %.2f s, inference %.2f s\n", path.c_str(),
                    cloud.size(), result.feature_seconds, result.inference_seconds);
+    if (!result.domain_warning.empty())
+      std::fprintf(stderr, "primlabel-eval: warning: %s: %s\n", path.c_str(),
+                   result.domain_warning.c_str());
     if (scored) {
       crf::ConfusionMatrix confusion(model.class_ids());
       confusion.add(cloud.labels, result.labels, class_id(PrimitiveClass::kUnknown));

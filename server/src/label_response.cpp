@@ -1,5 +1,6 @@
 #include "label_response.hpp"
 
+#include <cmath>
 #include <algorithm>
 #include <map>
 
@@ -96,6 +97,8 @@ void fill_summary(const RequestRecord& record, const ModelEntry& entry,
     timing->set_seconds(seconds);
   }
   summary.set_descriptor_dim(static_cast<std::uint32_t>(result.descriptors.dim));
+  if (std::isfinite(result.point_spacing)) summary.set_point_spacing(result.point_spacing);
+  summary.set_domain_warning(result.domain_warning);
   *summary.mutable_classes() = entry.metadata.classes();
 }
 

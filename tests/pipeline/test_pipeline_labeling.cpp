@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <limits>
+#include <random>
 
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/pipeline/labeling.hpp"
@@ -95,6 +96,34 @@ TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRo
   options.want_probabilities = true;
   const auto result = pipeline::label_cloud(model, cloud, options, RunContext{2});
   ASSERT_EQ(result.labels.size(), cloud.size());
+  // The training scenes' spacing is recorded; a held-out scene of the same sensor is inside it,
+  // the same scene four times larger or smaller is not.
+  EXPECT_GT(model.training.point_spacing_min, 0.0f);
+  EXPECT_GE(model.training.point_spacing_max, model.training.point_spacing_min);
+  EXPECT_LT(model.training.point_spacing_max, 0.01f);
+  EXPECT_GT(model.training.surface_variation_max, 0.0f);
+  EXPECT_EQ(result.domain_warning, "");
+  EXPECT_GT(result.point_spacing, model.training.point_spacing_min / 2);
+  EXPECT_LT(result.point_spacing, model.training.point_spacing_max * 2);
+  for (float scale : {4.0f, 0.25f}) {
+    PointCloud scaled = trained.test_scene;
+    for (Vec3f& p : scaled.xyz) p *= scale;
+    const auto far = pipeline::label_cloud(model, scaled, {}, RunContext{2});
+    EXPECT_NEAR(far.point_spacing, result.point_spacing * scale,
+                result.point_spacing * scale * 0.01f);
+    EXPECT_NE(far.domain_warning.find(scale > 1 ? "sparser" : "denser"), std::string::npos)
+        << scale << ": " << far.domain_warning;
+  }
+  {  // 4 mm of range noise, far above the scanner's: the warning names the noise
+    PointCloud noisy = trained.test_scene;
+    std::mt19937 rng(5);
+    std::normal_distribution<float> noise(0.0f, 0.004f);
+    for (Vec3f& p : noisy.xyz) p.z() += noise(rng);
+    const auto warned = pipeline::label_cloud(model, noisy, {}, RunContext{2});
+    EXPECT_NE(warned.domain_warning.find("surface variation"), std::string::npos)
+        << warned.domain_warning << " (" << warned.surface_variation << " vs "
+        << model.training.surface_variation_max << ")";
+  }
   const double node_accuracy = accuracy(model, trained.test_scene, result.labels);
   EXPECT_GT(node_accuracy, 0.80);
   EXPECT_GT(node_accuracy, majority_fraction(trained.test_scene) + 0.15);
@@ -119,6 +148,9 @@ TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRo
   save_model(path.string(), crf);
   const LabelModel loaded = load_model(path.string());
   std::filesystem::remove(path);
+  EXPECT_EQ(loaded.training.point_spacing_min, model.training.point_spacing_min);
+  EXPECT_EQ(loaded.training.point_spacing_max, model.training.point_spacing_max);
+  EXPECT_EQ(loaded.training.surface_variation_max, model.training.surface_variation_max);
   PointCloud again = trained.test_scene;
   EXPECT_EQ(pipeline::label_cloud(loaded, again, options, RunContext{2}).labels, with_two.labels);
 }

@@ -36,6 +36,28 @@ TEST(LabelService, StreamedLabelsMatchLabelCloudInProcess) {
                                               "inference", "send"}));
 }
 
+// The summary carries the cloud's point spacing, and a warning when the model was trained for a
+// spacing far from it (here: recorded as 10x finer than the 1 cm table grid).
+TEST(LabelService, TheSummaryWarnsOfACloudOutsideTheModelsSpacing) {
+  LabelModel fitting = random_label_model("fitting", "1");
+  fitting.training.point_spacing_min = 0.008f, fitting.training.point_spacing_max = 0.012f;
+  LabelModel finer = random_label_model("finer", "1");
+  finer.training.point_spacing_min = 0.0008f, finer.training.point_spacing_max = 0.0012f;
+  TestServer server({fitting, finer});
+  const PointCloud cloud = table_with_box_cloud(0.01f);
+  const LabelAnswer fits =
+      label_stream(*server.stub, scan_requests(cloud, header_for("fitting"), 1000));
+  ASSERT_TRUE(fits.status.ok()) << fits.status.error_message();
+  EXPECT_NEAR(fits.summary->point_spacing(), 0.01f, 0.002f);
+  EXPECT_EQ(fits.summary->domain_warning(), "");
+  const LabelAnswer warned =
+      label_stream(*server.stub, scan_requests(cloud, header_for("finer"), 1000));
+  ASSERT_TRUE(warned.status.ok()) << warned.status.error_message();
+  EXPECT_EQ(warned.labels, reference_labels(finer, cloud));  // labeled all the same
+  EXPECT_NE(warned.summary->domain_warning().find("sparser"), std::string::npos)
+      << warned.summary->domain_warning();
+}
+
 // SVM models (the paper's baseline) are served like CRFs: the same labels as in process.
 TEST(LabelService, SvmModelsLabelAsInProcess) {
   LabelModel model = testing::train_small_svm_model();

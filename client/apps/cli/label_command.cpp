@@ -87,6 +87,10 @@ int run_label(Client& client, LabelCommand command) {
       if (exit_code == kExitOk) exit_code = kExitFile;
       continue;
     }
+    // Even with --quiet: labels from a model of another sensor look plausible and are not.
+    if (!result.summary.domain_warning().empty())
+      std::fprintf(stderr, "primlabel: warning: %s: %s\n", input.c_str(),
+                   result.summary.domain_warning().c_str());
     if (!command.quiet)
       std::fprintf(stderr, "%s: %zu points -> %s in %.2f s, model %s %s (%s)\n", input.c_str(),
                    result.size(), out.c_str(), seconds, result.summary.model().c_str(),

@@ -136,6 +136,9 @@ v1::Model to_proto(const LabelModel& m) {
   for (auto c : m.training.class_points) t->add_class_points(c);
   t->set_objective(m.training.objective), t->set_l2(m.training.l2);
   t->set_iterations(m.training.iterations), t->set_seconds(m.training.seconds);
+  t->set_point_spacing_min(m.training.point_spacing_min);
+  t->set_point_spacing_max(m.training.point_spacing_max);
+  t->set_surface_variation_max(m.training.surface_variation_max);
 
   v1::Evaluation* e = out.mutable_validation();
   e->set_points(m.validation.points), e->set_accuracy(m.validation.accuracy);
@@ -233,6 +236,9 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
   m.training.class_points.assign(t.class_points().begin(), t.class_points().end());
   m.training.objective = t.objective(), m.training.l2 = t.l2();
   m.training.iterations = t.iterations(), m.training.seconds = t.seconds();
+  m.training.point_spacing_min = t.point_spacing_min();
+  m.training.point_spacing_max = t.point_spacing_max();
+  m.training.surface_variation_max = t.surface_variation_max();
 
   const v1::Evaluation& e = in.validation();
   m.validation.points = e.points(), m.validation.accuracy = e.accuracy();

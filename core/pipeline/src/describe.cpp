@@ -2,10 +2,12 @@
 // shared by normals, descriptors and the graph.
 
 #include <chrono>
+#include <limits>
 #include <stdexcept>
 
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/normals.hpp"
+#include "primlabel/geometry/point_spacing.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 
 namespace primlabel::pipeline {
@@ -39,6 +41,7 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   DescribedCloud out;
   // The index build checks the token itself (a 5M-point k-d tree takes about a second).
   out.search = std::make_unique<NeighborSearch>(cloud.xyz, context.stop);
+  out.point_spacing = median_point_spacing(cloud.xyz, *out.search);
   // The stages' own progress counts (points, then twice the points for FPFH) would not add up to
   // one describe call: only threads and stop go down.
   const RunContext stage{context.threads, context.stop, {}};
@@ -49,6 +52,9 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
     normal_options.neighborhood = capped(settings.normals);
     estimate_normals(cloud, normal_options, stage, out.search.get());
     out.normal_seconds = seconds_since(start);
+    out.surface_variation = median_surface_variation(cloud.curvature);
+  } else {
+    out.surface_variation = std::numeric_limits<float>::quiet_NaN();  // the client's normals
   }
 
   const auto start = std::chrono::steady_clock::now();

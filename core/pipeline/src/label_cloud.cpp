@@ -11,6 +11,7 @@
 
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/pipeline/domain.hpp"
 #include "primlabel/pipeline/duplicates.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/svm_model.hpp"
@@ -58,6 +59,8 @@ LabelingResult label_distinct_points(const LabelModel& model, const FeatureSetti
   result.descriptor_seconds = described.feature_seconds;
   result.feature_seconds = described.normal_seconds + described.feature_seconds;
   result.described_points = cloud.size();
+  result.point_spacing = described.point_spacing;
+  result.surface_variation = described.surface_variation;
   context.throw_if_stopped("labeling");
   if (model.kind == ModelKind::kSvm) {  // point by point: no graph
     classify_with_svm(model, std::move(described), options, context, result);
@@ -98,6 +101,8 @@ LabelingResult unknown_result(std::size_t points, const LabelingResult& like,
   result.descriptor_seconds = like.descriptor_seconds;
   result.feature_seconds = like.feature_seconds;
   result.inference_seconds = like.inference_seconds;
+  result.point_spacing = like.point_spacing;
+  result.surface_variation = like.surface_variation;
   result.labels.assign(points, class_id(PrimitiveClass::kUnknown));
   if (options.want_probabilities)
     result.probabilities =
@@ -259,8 +264,12 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
   const float voxel_size =
       options.voxel_size > 0.0f ? options.voxel_size : model.features.voxel_size;
   context.throw_if_stopped("labeling");
-  if (voxel_size > 0.0f) return label_voxels(model, features, cloud, voxel_size, options, context);
-  return label_points(model, features, cloud, options, context);
+  LabelingResult result = voxel_size > 0.0f
+                              ? label_voxels(model, features, cloud, voxel_size, options, context)
+                              : label_points(model, features, cloud, options, context);
+  result.domain_warning =
+      domain_warning(model.training, result.point_spacing, result.surface_variation);
+  return result;
 }
 
 }  // namespace primlabel::pipeline

@@ -2,6 +2,7 @@
 
 #include "primlabel/pipeline/training.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <set>
@@ -89,6 +90,8 @@ SceneData prepare_scene(PointCloud cloud, std::string source, const FeatureSetti
   DescribedCloud described = describe_cloud(cloud, features, context);
   scene.normal_seconds = described.normal_seconds;
   scene.feature_seconds = described.feature_seconds;
+  scene.point_spacing = described.point_spacing;
+  scene.surface_variation = described.surface_variation;
   crf::Graph g = build_scene_graph(cloud, described, graph, context);
   scene.graph = to_labeled_graph(cloud, std::move(described), std::move(g), class_ids);
   scene.truth = std::move(cloud.labels);
@@ -154,6 +157,16 @@ TrainingSummary summarize_training(std::span<const SceneData> training, std::siz
     summary.points += s.truth.size();
   }
   summary.scenes = training.size();
+  for (const SceneData& s : training) {
+    if (!(s.point_spacing > 0.0f)) continue;  // NaN: no distinct points
+    summary.point_spacing_min = summary.point_spacing_min > 0.0f
+                                    ? std::min(summary.point_spacing_min, s.point_spacing)
+                                    : s.point_spacing;
+    summary.point_spacing_max = std::max(summary.point_spacing_max, s.point_spacing);
+  }
+  for (const SceneData& s : training)
+    if (s.surface_variation > 0.0f)
+      summary.surface_variation_max = std::max(summary.surface_variation_max, s.surface_variation);
   summary.class_points.assign(num_classes, 0);
   for (const SceneData& s : training)
     for (int label : s.graph.labels)

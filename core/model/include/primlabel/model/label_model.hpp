@@ -55,6 +55,12 @@ struct TrainingSummary {
   double l2 = 0;
   std::uint32_t iterations = 0;
   double seconds = 0;
+  // The least and greatest median point spacing (m) of the training scenes as described
+  // (geometry/point_spacing.hpp); 0 in models trained before it was recorded.
+  float point_spacing_min = 0, point_spacing_max = 0;
+  // The greatest median surface variation of the training scenes' normals (a measure of their
+  // range noise at the model's normal radius); 0 when not recorded.
+  float surface_variation_max = 0;
 };
 
 struct EvaluationSummary {

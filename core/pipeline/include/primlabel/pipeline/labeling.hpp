@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "primlabel/crf/graph.hpp"
@@ -26,6 +27,8 @@ struct DescribedCloud {
   Descriptors descriptors;  // one row per point; NaN rows = invalid
   std::unique_ptr<NeighborSearch> search;
   double normal_seconds = 0, feature_seconds = 0;
+  float point_spacing = 0;      // median_point_spacing of the described cloud (m; NaN: none)
+  float surface_variation = 0;  // median_surface_variation of its normals (NaN: its own normals)
 };
 
 // Thrown by describe_cloud and label_cloud when their stop token is requested.
@@ -90,6 +93,11 @@ struct LabelingResult {
   double descriptor_seconds = 0;     // FPFH / PFH
   double feature_seconds = 0;        // normals + descriptors
   double inference_seconds = 0;      // graph + inference
+  float point_spacing = 0;           // median point spacing of the described cloud (m)
+  float surface_variation = 0;       // median surface variation of its computed normals
+  // Not empty when point_spacing is far outside what the model was trained for (domain.hpp):
+  // the labels are then unreliable, and the caller should be told so.
+  std::string domain_warning;
 };
 
 // Labels every point with the model's own feature, graph and inference settings (and the

@@ -22,7 +22,9 @@ struct SceneData {
   crf::LabeledGraph graph;           // labels follow the class list of the last assign_labels
   std::vector<std::uint32_t> truth;  // taxonomy id per point
   double normal_seconds = 0;
-  double feature_seconds = 0;  // descriptors only
+  double feature_seconds = 0;   // descriptors only
+  float point_spacing = 0;      // median point spacing as described (m; NaN: none)
+  float surface_variation = 0;  // median surface variation of its normals (NaN: none)
 };
 
 // Describes a labeled cloud and builds its graph (labels are assigned with `class_ids`).

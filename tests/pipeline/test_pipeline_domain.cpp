@@ -1,0 +1,78 @@
+// The point spacing a model was trained for, and the warning for clouds far outside it.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "primlabel/geometry/point_spacing.hpp"
+#include "primlabel/pipeline/domain.hpp"
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+TEST(PointSpacing, IsTheMedianNearestDistanceAndSkipsCoincidentCopies) {
+  PointCloud grid = test::plane_grid(0.0f, 0.0f, 0.1f, 0.002f);
+  const NeighborSearch search(grid.xyz);
+  EXPECT_NEAR(median_point_spacing(grid.xyz, search), 0.002f, 1e-5f);
+
+  // Every point twice, and a NaN: the copies are not a spacing of 0.
+  PointCloud doubled = grid;
+  doubled.xyz.insert(doubled.xyz.end(), grid.xyz.begin(), grid.xyz.end());
+  doubled.xyz.push_back(Vec3f::Constant(std::nanf("")));
+  const NeighborSearch doubled_search(doubled.xyz);
+  EXPECT_NEAR(median_point_spacing(doubled.xyz, doubled_search), 0.002f, 1e-5f);
+
+  // Ten times apart, ten times the spacing (and a tilted plane does not change it).
+  PointCloud sparse = test::plane_grid(0.3f, -0.2f, 1.0f, 0.02f);
+  const NeighborSearch sparse_search(sparse.xyz);
+  EXPECT_NEAR(median_point_spacing(sparse.xyz, sparse_search), 0.02f * std::sqrt(1.0f + 0.09f),
+              2e-3f);
+
+  const std::vector<Vec3f> empty, one{Vec3f(1, 2, 3)};
+  EXPECT_TRUE(std::isnan(median_point_spacing(empty, NeighborSearch(empty))));
+  EXPECT_TRUE(std::isnan(median_point_spacing(one, NeighborSearch(one))));
+}
+
+TEST(DomainWarning, OnlyForCloudsMoreThanTwiceOutsideTheTrainedRange) {
+  TrainingSummary trained;
+  trained.point_spacing_min = 0.001f;
+  trained.point_spacing_max = 0.003f;
+  EXPECT_EQ(pipeline::spacing_warning(trained, 0.002f), "");
+  EXPECT_EQ(pipeline::spacing_warning(trained, 0.0006f), "");  // within 2x below
+  EXPECT_EQ(pipeline::spacing_warning(trained, 0.0059f), "");  // within 2x above
+  const std::string sparser = pipeline::spacing_warning(trained, 0.008f);
+  EXPECT_NE(sparser.find("8.00 mm"), std::string::npos) << sparser;
+  EXPECT_NE(sparser.find("sparser"), std::string::npos) << sparser;
+  EXPECT_NE(sparser.find("1.00-3.00 mm"), std::string::npos) << sparser;
+  EXPECT_NE(pipeline::spacing_warning(trained, 0.0004f).find("denser"), std::string::npos);
+  // Nothing to compare: no warning rather than a false one.
+  EXPECT_EQ(pipeline::spacing_warning(trained, std::nanf("")), "");
+  EXPECT_EQ(pipeline::spacing_warning(TrainingSummary{}, 0.5f), "");
+}
+
+TEST(DomainWarning, NoiseOnlyWhenMoreThanTwiceTheNoisiestTrainingScenes) {
+  TrainingSummary trained;
+  trained.surface_variation_max = 0.002f;
+  EXPECT_EQ(pipeline::noise_warning(trained, 0.0001f), "");  // cleaner passes
+  EXPECT_EQ(pipeline::noise_warning(trained, 0.0079f), "");  // under twice the noise
+  const std::string noisy = pipeline::noise_warning(trained, 0.018f);
+  EXPECT_NE(noisy.find("9.0x"), std::string::npos) << noisy;
+  EXPECT_NE(noisy.find("3.0x its range noise"), std::string::npos) << noisy;
+  EXPECT_EQ(pipeline::noise_warning(TrainingSummary{}, 0.5f), "");
+  EXPECT_EQ(pipeline::noise_warning(trained, std::nanf("")), "");
+
+  trained.point_spacing_min = 0.001f, trained.point_spacing_max = 0.002f;
+  EXPECT_EQ(pipeline::domain_warning(trained, 0.0015f, 0.001f), "");
+  EXPECT_EQ(pipeline::domain_warning(trained, 0.0015f, 0.018f), noisy);
+  const std::string both = pipeline::domain_warning(trained, 0.01f, 0.018f);
+  EXPECT_EQ(both, pipeline::spacing_warning(trained, 0.01f) + "; " + noisy);
+}
+
+TEST(SurfaceVariation, IsTheMedianOfTheFiniteValues) {
+  EXPECT_FLOAT_EQ(median_surface_variation({0.1f, std::nanf(""), 0.3f, 0.2f}), 0.2f);
+  EXPECT_TRUE(std::isnan(median_surface_variation({})));
+  EXPECT_TRUE(std::isnan(median_surface_variation({std::nanf("")})));
+}
+
+}  // namespace
+}  // namespace primlabel
