@@ -16,6 +16,7 @@
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
+#include "primlabel/pipeline/labeled_voxels.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/research/curve_plot.hpp"
 #include "primlabel/synth/augment.hpp"
@@ -33,6 +34,7 @@ struct Arguments {
   std::size_t svm_max_points = 20000;
   std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
   float feature_radius = 0.025f, normal_radius = 0.01f;
+  float voxel_size = 0.0f;  // > 0: train on voxels of this edge and record it in the model
   std::vector<std::string> train_files, val_files;
   std::string classes, output, curve_csv, curve_png, name, augment;
   synth::Augmentation augmentation;  // --augment, parsed
@@ -54,6 +56,9 @@ std::vector<pipeline::SceneData> load_scenes(const Arguments& args, bool validat
   std::vector<pipeline::SceneData> scenes;
   auto add = [&](PointCloud cloud, const std::string& source) {
     const auto start = std::chrono::steady_clock::now();
+    // The density the model is served at: label_cloud downsamples to the model's voxel size.
+    if (args.voxel_size > 0.0f)
+      cloud = pipeline::voxelize_labeled(cloud, args.voxel_size, RunContext{args.threads});
     scenes.push_back(pipeline::prepare_scene(std::move(cloud), source, features, graph, every_class,
                                              RunContext{args.threads}));
     const double s =
@@ -151,6 +156,7 @@ int run(const Arguments& args) {
   LabelModel& model = trained.model;
   if (options.kind != ModelKind::kNodeOnly) say(args, model.training.objective);
   if (!args.name.empty()) model.name = args.name;
+  model.features.voxel_size = args.voxel_size;  // applied by label_cloud (and so the server)
   save_model(args.output, model);
 
   if (!args.curve_csv.empty()) {
@@ -228,6 +234,10 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--feature-radius", args.feature_radius, "descriptor radius (m, default 0.025)")
       ->check(CLI::PositiveNumber);
+  app.add_option("--voxel-size", args.voxel_size,
+                 "train on voxel centroids of this edge (m) and record it: the model is served "
+                 "at that density (default 0: every point)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--normal-radius", args.normal_radius, "normal radius (m, default 0.01)")
       ->check(CLI::PositiveNumber);
   app.add_option("--graph-k", args.graph_k, "CRF graph: K nearest neighbours (default 8)")

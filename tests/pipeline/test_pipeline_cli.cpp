@@ -172,6 +172,27 @@ TEST_F(PipelineCli, TrainAugmentsTheTrainingScenes) {
   EXPECT_EQ(model.training.scenes, 2u);
 }
 
+// --voxel-size trains on voxel centroids and records the size, so label_cloud (and the server)
+// serves the model at the density it was trained at.
+TEST_F(PipelineCli, TrainAtAVoxelSizeRecordsItAndEvalAppliesIt) {
+  const std::string path = (*dir_ / "voxel.plm").string();
+  const Result r = run(test::binary("primlabel-train") +
+                       " --synth-train 1 --synth-val 0 --kind node --iterations 30 --threads 2 "
+                       "--normal-radius 0.02 --feature-radius 0.04 --voxel-size 0.008 -o " +
+                       path);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const LabelModel model = load_model(path);
+  EXPECT_FLOAT_EQ(model.features.voxel_size, 0.008f);
+  // The scene was described as voxels: centroids about half an edge apart or more (partly filled
+  // voxels pull them closer), not the scanner's 2 mm.
+  EXPECT_GT(model.training.point_spacing_min, 0.0035f);
+  EXPECT_LT(model.training.point_spacing_max, 0.010f);
+  const Result e = run(eval() + " --model " + path + " --json -q --threads 2 " + scene_path());
+  ASSERT_EQ(e.exit_code, 0) << e.output;
+  EXPECT_NE(e.output.find("\"accuracy\":0."), std::string::npos) << e.output;
+  EXPECT_EQ(e.output.find("domain"), std::string::npos) << e.output;  // served at its density
+}
+
 TEST_F(PipelineCli, CalibrateKinectWithoutScenesFailsWithOneLine) {
   const Result r = run(eval() + " -q --calibrate-kinect /nonexistent/mosd");
   EXPECT_EQ(r.exit_code, 1) << r.output;
