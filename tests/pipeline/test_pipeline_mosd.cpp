@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "png_decode.hpp"
@@ -52,9 +53,51 @@ TEST(PipelineMosd, ReportCountsTablePointsAndDrawsTheScene) {
   const research::MosdReport report = research::summarize_mosd({scene, scene});
   EXPECT_EQ(report.table_points, 2 * scene.table_points);
   EXPECT_DOUBLE_EQ(report.plane_share(), share);
+  EXPECT_DOUBLE_EQ(report.mean_plane_share(), share);
+  EXPECT_GT(scene.table_away, scene.table_points / 2);  // the band is a rim around 2-4 objects
+  EXPECT_LT(scene.table_away, scene.table_points);
   const std::string json = research::mosd_report_json(report);
   EXPECT_NE(json.find("\"plane_share\":"), std::string::npos) << json;
   EXPECT_NE(research::mosd_report_text(report).find("overall"), std::string::npos);
+}
+
+// The contact band: table points within kContactBand of an object point are counted apart, as a
+// brute-force distance check says.
+TEST(PipelineMosd, TablePointsNearAnObjectAreTheContactBand) {
+  PointCloud cloud;
+  for (int i = 0; i < 60; ++i)
+    for (int j = 0; j < 60; ++j) {
+      cloud.xyz.emplace_back(-0.15f + 0.005f * float(i), -0.15f + 0.005f * float(j), 1.0f);
+      cloud.labels.push_back(1 + std::uint32_t(i % 3));  // table parts 1-3
+    }
+  for (int i = 0; i < 9; ++i)  // a small block standing on the table, segment 20
+    for (int j = 0; j < 9; ++j)
+      for (int k = 1; k <= 4; ++k) {
+        cloud.xyz.emplace_back(-0.02f + 0.005f * float(i), -0.02f + 0.005f * float(j),
+                               1.0f - 0.005f * float(k));
+        cloud.labels.push_back(20);
+      }
+  cloud.width = std::uint32_t(cloud.size());
+  std::uint64_t near = 0;
+  for (std::size_t t = 0; t < 3600; ++t) {
+    float best = 1e9f;
+    for (std::size_t o = 3600; o < cloud.size(); ++o)
+      best = std::min(best, (cloud.xyz[t] - cloud.xyz[o]).norm());
+    near += best <= research::kContactBand;
+  }
+  ASSERT_GT(near, 100u);
+  test::TempDir dir;
+  write_cloud(dir.file("scene.pcd"), cloud);
+  const research::MosdSceneReport scene =
+      research::report_mosd_scene(zero_model(), dir.file("scene.pcd"), "", {}, RunContext{2});
+  EXPECT_EQ(scene.table_points, 3600u);
+  EXPECT_EQ(scene.table_points - scene.table_away, near);
+  EXPECT_LE(scene.table_away_plane, scene.table_away);
+  const research::MosdReport report = research::summarize_mosd({scene});
+  EXPECT_EQ(report.table_away, scene.table_away);
+  EXPECT_DOUBLE_EQ(report.mean_away_plane_share(), scene.away_plane_share());
+  EXPECT_NE(research::mosd_report_json(report).find("\"mean_away_plane_share\":"),
+            std::string::npos);
 }
 
 TEST(PipelineMosd, SceneWithoutLabelsIsAClearError) {

@@ -8,6 +8,7 @@
 
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
+#include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/render/colorize.hpp"
 #include "primlabel/render/render.hpp"
@@ -27,6 +28,34 @@ std::string format(const char* fmt, auto... args) {
 }
 
 json::Json json_number(double v) { return json::rounded(v, "%.6f"); }
+
+// Per point: whether it is a table point within kContactBand of an object point.
+std::vector<std::uint8_t> contact_band(const PointCloud& cloud,
+                                       const std::vector<std::uint32_t>& segments,
+                                       const RunContext& context) {
+  std::vector<Vec3f> objects;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (is_mosd_object_label(segments[i]) && is_finite(cloud.xyz[i]))
+      objects.push_back(cloud.xyz[i]);
+  std::vector<std::uint8_t> near(cloud.size(), 0);
+  if (objects.empty()) return near;
+  const NeighborSearch search(objects, context.stop);
+  NeighborList nearest;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (!is_mosd_table_label(segments[i])) continue;
+    search.find(cloud.xyz[i], Neighborhood::Knn(1), nearest);
+    near[i] = nearest.size() && nearest.sq_dists[0] <= kContactBand * kContactBand;
+  }
+  return near;
+}
+
+double mean(const std::vector<MosdSceneReport>& scenes, double (MosdSceneReport::*share)() const) {
+  double sum = 0;
+  int n = 0;
+  for (const MosdSceneReport& s : scenes)
+    if (const double v = (s.*share)(); std::isfinite(v)) sum += v, ++n;
+  return n ? sum / n : NAN;
+}
 
 void render_labels(const PointCloud& cloud, const std::vector<std::uint32_t>& labels,
                    const std::string& title, const std::string& path) {
@@ -87,8 +116,14 @@ json::Json object_truth_json(const MosdObjectTruth& t, bool with_objects) {
 }
 
 double MosdSceneReport::plane_share() const { return share(table_plane, table_points); }
+double MosdSceneReport::away_plane_share() const { return share(table_away_plane, table_away); }
 double MosdSceneReport::object_plane_share() const { return share(object_plane, object_points); }
 double MosdReport::plane_share() const { return share(table_plane, table_points); }
+double MosdReport::away_plane_share() const { return share(table_away_plane, table_away); }
+double MosdReport::mean_plane_share() const { return mean(scenes, &MosdSceneReport::plane_share); }
+double MosdReport::mean_away_plane_share() const {
+  return mean(scenes, &MosdSceneReport::away_plane_share);
+}
 
 MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& path,
                                   const std::string& png_path,
@@ -107,6 +142,7 @@ MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& pa
       throw std::runtime_error(path + ": " + e.what());
     }
   }
+  const std::vector<std::uint8_t> near_object = contact_band(cloud, segments, context);
   const pipeline::LabelingResult result = pipeline::label_cloud(model, cloud, options, context);
 
   MosdSceneReport report;
@@ -122,6 +158,7 @@ MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& pa
     if (is_mosd_table_label(segments[i])) {
       ++report.table_points;
       report.table_plane += is_plane;
+      if (!near_object[i]) ++report.table_away, report.table_away_plane += is_plane;
       if (result.labels[i] < kPrimitiveClassCount) ++report.table_predicted[result.labels[i]];
     } else if (is_mosd_object_label(segments[i])) {
       ++report.object_points;
@@ -149,6 +186,8 @@ MosdReport summarize_mosd(std::vector<MosdSceneReport> scenes) {
   for (const MosdSceneReport& s : report.scenes) {
     report.table_points += s.table_points;
     report.table_plane += s.table_plane;
+    report.table_away += s.table_away;
+    report.table_away_plane += s.table_away_plane;
     if (!s.object_truth) continue;
     if (!report.object_truth) report.object_truth.emplace();
     MosdObjectTruth& all = *report.object_truth;
@@ -162,16 +201,21 @@ MosdReport summarize_mosd(std::vector<MosdSceneReport> scenes) {
 }
 
 std::string mosd_report_text(const MosdReport& report) {
-  std::string out = format("%-28s %9s %12s %12s %13s %8s\n", "scene", "points", "table pts",
-                           "table plane", "objects plane", "s");
+  std::string out = format("%-28s %9s %12s %12s %12s %13s %8s\n", "scene", "points", "table pts",
+                           "table plane", "away plane", "objects plane", "s");
   for (const MosdSceneReport& s : report.scenes)
-    out += format("%-28s %9llu %12llu %11.2f%% %12.2f%% %8.2f\n",
+    out += format("%-28s %9llu %12llu %11.2f%% %11.2f%% %12.2f%% %8.2f\n",
                   std::filesystem::path(s.file).filename().string().c_str(),
                   static_cast<unsigned long long>(s.points),
                   static_cast<unsigned long long>(s.table_points), 100.0 * s.plane_share(),
-                  100.0 * s.object_plane_share(), s.feature_seconds + s.inference_seconds);
-  out += format("%-28s %9s %12llu %11.2f%%\n", "overall", "",
-                static_cast<unsigned long long>(report.table_points), 100.0 * report.plane_share());
+                  100.0 * s.away_plane_share(), 100.0 * s.object_plane_share(),
+                  s.feature_seconds + s.inference_seconds);
+  out += format("%-28s %9s %12llu %11.2f%% %11.2f%%\n", "overall", "",
+                static_cast<unsigned long long>(report.table_points), 100.0 * report.plane_share(),
+                100.0 * report.away_plane_share());
+  out += format("%-28s %9s %12s %11.2f%% %11.2f%%   (away: > %.0f mm from any object point)\n",
+                "mean of the scenes", "", "", 100.0 * report.mean_plane_share(),
+                100.0 * report.mean_away_plane_share(), 1000.0 * kContactBand);
   if (!report.object_truth) return out;
   out += format("\nobject truth (fitted)       %5s %5s %5s %5s %12s %12s %9s\n", "box", "cyl|",
                 "cyl-", "none", "object pts", "scored pts", "accuracy");
@@ -213,6 +257,8 @@ std::string mosd_report_json(const MosdReport& report) {
                       {"table_points", s.table_points},
                       {"table_plane", s.table_plane},
                       {"plane_share", json_number(s.plane_share())},
+                      {"table_away", s.table_away},
+                      {"away_plane_share", json_number(s.away_plane_share())},
                       {"object_points", s.object_points},
                       {"object_plane_share", json_number(s.object_plane_share())},
                       {"table_predicted", std::move(predicted)},
@@ -223,7 +269,11 @@ std::string mosd_report_json(const MosdReport& report) {
   json::Json out = {{"scenes", std::move(scenes)},
                     {"table_points", report.table_points},
                     {"table_plane", report.table_plane},
-                    {"plane_share", json_number(report.plane_share())}};
+                    {"plane_share", json_number(report.plane_share())},
+                    {"mean_plane_share", json_number(report.mean_plane_share())},
+                    {"table_away", report.table_away},
+                    {"away_plane_share", json_number(report.away_plane_share())},
+                    {"mean_away_plane_share", json_number(report.mean_away_plane_share())}};
   if (report.object_truth) out["object_truth"] = object_truth_json(*report.object_truth, false);
   return json::dump(out) + "\n";
 }

@@ -12,6 +12,7 @@
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/research/mosd_truth.hpp"
 #include "primlabel/research/truth_check.hpp"
+#include "primlabel/synth/generate.hpp"
 
 namespace primlabel::research {
 
@@ -45,6 +46,10 @@ struct MosdSceneReport {
   std::uint64_t points = 0;        // finite points
   std::uint64_t table_points = 0;  // finite points labelled 1-9 in the file
   std::uint64_t table_plane = 0;   // ... that the model labels plane
+  // Table points farther than kContactBand from every object point, and those labeled plane:
+  // the table away from the contact band, where the taxonomy's rule at scale r makes the table
+  // around an object's foot a concave edge rather than plane.
+  std::uint64_t table_away = 0, table_away_plane = 0;
   std::uint64_t object_points = 0, object_plane = 0;
   std::vector<std::uint64_t> table_predicted;  // table points per predicted taxonomy id
   double feature_seconds = 0, inference_seconds = 0;
@@ -53,8 +58,12 @@ struct MosdSceneReport {
 
   // Table points without a descriptor (unknown) count as not plane.
   double plane_share() const;
+  double away_plane_share() const;  // table_away_plane / table_away
   double object_plane_share() const;
 };
+
+// The contact band: the label radius r of the ground-truth rule.
+inline constexpr float kContactBand = static_cast<float>(synth::kDefaultLabelRadius);
 
 // Labels the scene at `path` with `model` and counts. When `png_path` is not empty, also renders
 // the predicted classes from the sensor's view (class colours, legend) there. With `truth`
@@ -68,8 +77,12 @@ MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& pa
 struct MosdReport {
   std::vector<MosdSceneReport> scenes;
   std::uint64_t table_points = 0, table_plane = 0;
+  std::uint64_t table_away = 0, table_away_plane = 0;
   std::optional<MosdObjectTruth> object_truth;  // over every scene that has one
   double plane_share() const;                   // over all scenes' table points
+  double away_plane_share() const;              // ... away from the contact band
+  double mean_plane_share() const;              // the scenes' shares, averaged
+  double mean_away_plane_share() const;
 };
 
 MosdReport summarize_mosd(std::vector<MosdSceneReport> scenes);
@@ -82,7 +95,8 @@ json::Json object_truth_json(const MosdObjectTruth& truth, bool with_objects);
 // Fixed-width text table, one row per scene and the overall share; with object truth, the fitted
 // models per scene and the model's per-class recall / precision on the object points.
 std::string mosd_report_text(const MosdReport& report);
-// One JSON object: {"scenes":[{...}], "table_points", "table_plane", "plane_share"}, and
+// One JSON object: {"scenes":[{...}], "table_points", "table_plane", "plane_share",
+// "mean_plane_share", "table_away", "away_plane_share", "mean_away_plane_share"}, and
 // "object_truth" (per scene and overall) when fitted.
 std::string mosd_report_json(const MosdReport& report);
 
