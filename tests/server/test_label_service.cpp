@@ -142,6 +142,33 @@ TEST(LabelService, UnaryLabelCloudAndVoxelOption) {
   EXPECT_EQ(answer.labels, pipeline::label_cloud(model, local, options).labels);
 }
 
+// A model's own voxel size (a depth-camera model trained on voxels) is applied by the server
+// when the request names none, and the request's replaces it.
+TEST(LabelService, TheModelsVoxelSizeIsAppliedUnlessTheRequestNamesOne) {
+  LabelModel model = random_label_model("voxels", "1");
+  model.features.voxel_size = 0.01f;
+  TestServer server({model});
+  const PointCloud cloud = table_with_box_cloud(0.005f);
+  PointCloud local = cloud;
+  const pipeline::LabelingResult expected = pipeline::label_cloud(model, local);
+  ASSERT_LT(expected.described_points, cloud.size() / 2);  // the voxels, not every point
+  LabelAnswer answer = label_cloud(*server.stub, cloud, header_for("voxels"));
+  ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+  EXPECT_EQ(answer.labels, expected.labels);
+  EXPECT_EQ(answer.labels.size(), cloud.size());  // every point gets its voxel's label
+
+  v1::ScanHeader header = header_for("voxels");
+  header.mutable_options()->set_voxel_size(0.02f);
+  answer = label_cloud(*server.stub, cloud, header);
+  ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+  local = cloud;
+  pipeline::LabelingOptions coarser;
+  coarser.voxel_size = 0.02f;
+  const std::vector<std::uint32_t> coarse = pipeline::label_cloud(model, local, coarser).labels;
+  EXPECT_EQ(answer.labels, coarse);
+  EXPECT_NE(coarse, expected.labels);
+}
+
 TEST(LabelService, LatestOrPinnedVersionAndExplicitVersions) {
   const LabelModel v2 = random_label_model("m", "2", 11);
   const LabelModel v10 = random_label_model("m", "10", 12);
