@@ -322,6 +322,10 @@ CLI::App* add_features_command(CLI::App& parent, FeaturesBenchOptions& options) 
       ->excludes(feature_radius);
   cmd->add_option("--voxel", options.voxel, "voxel-grid downsample (centroids) first; 0 = off")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--crop", options.crop,
+                  "keep only the N points nearest the centroid (after --voxel); 0 = all");
+  cmd->add_option("--write-cloud", options.write_cloud,
+                  "write the benchmarked points with primlabel's normals here (.ply)");
   cmd->add_option("--threads", options.threads, "threads for every stage, primlabel and PCL")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -372,6 +376,20 @@ int run_features_bench(const FeaturesBenchOptions& options) {
     cloud.xyz = tabletop::voxel_downsample(cloud.xyz, all, options.voxel).centroids;
     cloud.width = static_cast<std::uint32_t>(cloud.size());
     std::cerr << "voxel " << options.voxel << ": " << cloud.size() << " points\n";
+  }
+  if (options.crop > 0 && options.crop < cloud.size()) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const Vec3f& p : cloud.xyz) sum += p.cast<double>();
+    const Vec3f centroid = (sum / double(cloud.size())).cast<float>();
+    NeighborList nearest;
+    NeighborSearch(cloud.xyz).find(centroid, Neighborhood::Knn(int(options.crop)), nearest);
+    std::vector<std::uint32_t> kept = nearest.indices;
+    std::sort(kept.begin(), kept.end());  // the file's order, not the distance order
+    std::vector<Vec3f> cropped;
+    for (std::uint32_t i : kept) cropped.push_back(cloud.xyz[i]);
+    cloud.xyz = std::move(cropped);
+    cloud.width = static_cast<std::uint32_t>(cloud.size());
+    std::cerr << "crop: the " << cloud.size() << " points nearest the centroid\n";
   }
   if (cloud.empty()) throw std::runtime_error("no finite points in " + options.input);
   const std::size_t n = cloud.size();
@@ -429,6 +447,16 @@ int run_features_bench(const FeaturesBenchOptions& options) {
   }
 
   const double rss_mb = peak_rss_mb();
+  if (!options.write_cloud.empty()) {
+    PointCloud out;
+    out.resize_unorganized(n);
+    out.xyz = cloud.xyz;
+    out.normals = cloud.normals;
+    out.viewpoint = cloud.viewpoint;
+    write_ply(options.write_cloud, out);
+    std::cerr << "wrote the " << n << " points and their normals to " << options.write_cloud
+              << "\n";
+  }
 
   JsonLine json;
   json.add("points", n);
@@ -509,6 +537,7 @@ int run_features_bench(const FeaturesBenchOptions& options) {
   json.add("file", options.input);
   json.add("input_points", raw.size());
   json.add("voxel", static_cast<double>(options.voxel));
+  json.add("crop", options.crop);
   if (normal_hood->k > 0)
     json.add("normal_k", normal_hood->k);
   else

@@ -2,6 +2,7 @@
 // `primlabel-bench features`: throughput and peak memory of normals -> FPFH -> PFH on one cloud,
 // optionally against PCL 1.13 (normals and FPFH, with the largest differences).
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
@@ -18,6 +19,12 @@ struct FeaturesBenchOptions {
   float feature_radius = 0.0f;  // exactly one of feature_radius / feature_k
   int feature_k = 0;
   float voxel = 0.0f;  // > 0: voxel-grid downsample (centroid per voxel) before anything else
+  // > 0: keep only the `crop` points nearest the centroid (after --voxel): a small cloud cut
+  // out of a large one, where fixed costs weigh more.
+  std::size_t crop = 0;
+  // When set: the benchmarked points with primlabel's normals, as PLY (x y z nx ny nz), so
+  // another library (bench/fpfh_peers.sh: Open3D) can be timed on exactly the same input.
+  std::string write_cloud;
   int threads = 1;
   bool compare_pcl = false;
   std::string descriptor = "both";  // fpfh | pfh | both
