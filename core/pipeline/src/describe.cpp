@@ -24,6 +24,28 @@ namespace {
 // Memory for the shared neighbour lists (8 bytes a neighbour): a 300k-point frame at ~100
 // neighbours fits; beyond it points are searched again per stage, as without the lists.
 constexpr std::size_t kSharedListBytes = std::size_t(256) << 20;
+// Lists longer than this on average cost more to store and filter than the searches they save
+// (a dense LMS400 scan has ~500 points within 25 mm; a 5 mm voxel frame ~150 within 30 mm).
+constexpr double kMaxSharedListLength = 256;
+
+// Whether sharing pays: the mean list length over an even sample of the points, and the lists
+// of every point within the budget.
+bool sharing_pays(const std::vector<Vec3f>& points, const NeighborSearch& search,
+                  const Neighborhood& hood) {
+  constexpr std::size_t kSample = 256;
+  const std::size_t stride = std::max<std::size_t>(1, points.size() / kSample);
+  NeighborList found;
+  std::size_t sampled = 0, entries = 0;
+  for (std::size_t i = 0; i < points.size(); i += stride) {
+    if (!is_finite(points[i])) continue;
+    search.find(points[i], hood, found, /*sorted=*/false);
+    ++sampled, entries += found.size();
+  }
+  if (sampled == 0) return false;
+  const double mean = double(entries) / double(sampled);
+  return mean <= kMaxSharedListLength &&
+         mean * double(points.size()) * 8.0 <= double(kSharedListBytes);
+}
 
 // The neighbourhood that holds both (radius or hybrid) neighbourhoods, or none.
 std::optional<Neighborhood> shared_neighborhood(const Neighborhood& a, const Neighborhood& b) {
@@ -68,8 +90,9 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   const Neighborhood feature_hood = capped(settings.features);
   const std::optional<Neighborhood> shared =
       shared_neighborhood(options.use_cloud_normals ? feature_hood : normal_hood, feature_hood);
-  if (shared && options.share_neighbor_lists && settings.descriptor == DescriptorKind::kFpfh) {
-    const auto lists_start = std::chrono::steady_clock::now();
+  const auto lists_start = std::chrono::steady_clock::now();
+  if (shared && options.share_neighbor_lists && settings.descriptor == DescriptorKind::kFpfh &&
+      sharing_pays(cloud.xyz, *out.search, *shared)) {
     out.lists =
         std::make_unique<NeighborLists>(cloud.xyz, *out.search, *shared, kSharedListBytes, stage);
     out.lists_seconds = seconds_since(lists_start);
