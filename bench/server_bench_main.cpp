@@ -5,6 +5,10 @@
 //   table : a 22k-point LMS400 table scene (the paper's object + table size)
 //   kinect: a 640x480 synthetic Kinect frame (307,200 points, NaN where the ray missed)
 //   cancel: a 5M-point request cancelled while it is being labeled, at several moments
+//   --frame SENSOR=MODEL (repeatable): the first held-out synthetic scene of that sensor (a
+//     640x480 Kinect frame, a ~87k-point LMS400 scan) labeled with that model file at its own
+//     voxel size; prints frames/s, p50 / p90 and per-stage ms (the server's stages from the
+//     summary, label_cloud's finer split in process) instead of table / kinect.
 //
 // The model is a CRF with seeded random weights and the default feature settings (the same
 // compute as a trained one). One labeling job at a time, 2 OpenMP threads, as the server runs
@@ -15,8 +19,11 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <optional>
 #include <stop_token>
 #include <thread>
 
@@ -84,10 +91,11 @@ PointCloud large_surface(std::size_t points) {
   return cloud;
 }
 
-std::vector<v1::LabelRequest> requests_for(const PointCloud& cloud, std::size_t per_chunk) {
+std::vector<v1::LabelRequest> requests_for(const PointCloud& cloud, std::size_t per_chunk,
+                                           const std::string& model = "bench") {
   std::vector<v1::LabelRequest> requests(1);
   v1::ScanHeader& header = *requests[0].mutable_header();
-  header.set_model("bench");
+  header.set_model(model);
   header.set_scan_id("bench");
   header.set_expected_points(cloud.size());
   header.mutable_viewpoint()->set_x(cloud.viewpoint.origin.x());
@@ -102,16 +110,22 @@ std::vector<v1::LabelRequest> requests_for(const PointCloud& cloud, std::size_t 
   return requests;
 }
 
-// One streamed request; returns the labels it got (empty on failure).
-std::vector<std::uint32_t> label_over_grpc(v1::Labeler::Stub& stub, const PointCloud& cloud) {
+// One streamed request; returns the labels it got (empty on failure) and, when asked, the
+// summary's stage timings.
+std::vector<std::uint32_t> label_over_grpc(v1::Labeler::Stub& stub, const PointCloud& cloud,
+                                           const std::string& model = "bench",
+                                           std::map<std::string, double>* stages = nullptr) {
   grpc::ClientContext context;
   auto stream = stub.Label(&context);
-  for (const v1::LabelRequest& request : requests_for(cloud, 87381))  // 1 MiB of xyz
+  for (const v1::LabelRequest& request : requests_for(cloud, 87381, model))  // 1 MiB of xyz
     if (!stream->Write(request)) break;
   stream->WritesDone();
   std::vector<std::uint32_t> labels;
   v1::LabelResponse response;
   while (stream->Read(&response)) {
+    if (response.has_summary() && stages)
+      for (const v1::StageTiming& t : response.summary().timings())
+        (*stages)[t.stage()] = 1e3 * t.seconds();
     if (!response.has_chunk()) continue;
     const std::size_t n = labels.size();
     labels.resize(n + response.chunk().labels().size() / 4);
@@ -154,6 +168,92 @@ Latency compare(const char* name, const LabelModel& model, const PointCloud& clo
   return latency;
 }
 
+// The stages of label_cloud in ms, in pipeline order, for the in-process split.
+const std::vector<std::pair<const char*, double (*)(const pipeline::LabelingResult&)>>
+    kLocalStages = {
+        {"voxel", [](const pipeline::LabelingResult& r) { return 1e3 * r.voxel_seconds; }},
+        {"index", [](const pipeline::LabelingResult& r) { return 1e3 * r.index_seconds; }},
+        {"lists", [](const pipeline::LabelingResult& r) { return 1e3 * r.lists_seconds; }},
+        {"normals", [](const pipeline::LabelingResult& r) { return 1e3 * r.normal_seconds; }},
+        {"fpfh", [](const pipeline::LabelingResult& r) { return 1e3 * r.descriptor_seconds; }},
+        {"graph", [](const pipeline::LabelingResult& r) { return 1e3 * r.graph_seconds; }},
+        {"infer",
+         [](const pipeline::LabelingResult& r) {
+           return 1e3 * (r.inference_seconds - r.graph_seconds);
+         }},
+        {"fanout", [](const pipeline::LabelingResult& r) { return 1e3 * r.fanout_seconds; }},
+};
+
+struct FrameFigures {
+  std::string name;
+  std::size_t points = 0, described = 0;
+  float voxel = 0;
+  double server_p50 = 0, server_p90 = 0, local_p50 = 0, local_p90 = 0;
+  std::map<std::string, double> server_stages;               // of the run nearest the server p50
+  std::vector<std::pair<std::string, double>> local_stages;  // of the run nearest the local p50
+};
+
+std::size_t nearest_to(const std::vector<double>& values, double target) {
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (std::abs(values[i] - target) < std::abs(values[best] - target)) best = i;
+  return best;
+}
+
+// `reps` requests of `cloud` to model `name` over gRPC and as many label_cloud calls in process
+// (after one warm-up each), labels compared.
+FrameFigures frame_figures(const std::string& label, const std::string& name,
+                           const LabelModel& model, const PointCloud& cloud,
+                           v1::Labeler::Stub& stub, int reps, int threads) {
+  FrameFigures out;
+  out.name = label;
+  out.points = cloud.size();
+  out.voxel = model.features.voxel_size;
+  const RunContext context{threads};
+  std::vector<double> server_ms, local_ms;
+  std::vector<std::map<std::string, double>> server_stages;
+  std::vector<pipeline::LabelingResult> local_results;
+  for (int rep = -1; rep < reps; ++rep) {
+    PointCloud copy = cloud;
+    auto start = Clock::now();
+    pipeline::LabelingResult result = pipeline::label_cloud(model, copy, {}, context);
+    const double local = ms_since(start);
+    std::map<std::string, double> stages;
+    start = Clock::now();
+    const std::vector<std::uint32_t> labels = label_over_grpc(stub, cloud, name, &stages);
+    const double served = ms_since(start);
+    if (labels != result.labels)
+      std::fprintf(stderr, "%s: labels differ from label_cloud!\n", label.c_str());
+    if (rep < 0) continue;
+    out.described = result.described_points;
+    result.labels = {};
+    local_ms.push_back(local);
+    local_results.push_back(std::move(result));
+    server_ms.push_back(served);
+    server_stages.push_back(std::move(stages));
+  }
+  out.server_p50 = percentile(server_ms, 0.5);
+  out.server_p90 = percentile(server_ms, 0.9);
+  out.local_p50 = percentile(local_ms, 0.5);
+  out.local_p90 = percentile(local_ms, 0.9);
+  out.server_stages = server_stages[nearest_to(server_ms, out.server_p50)];
+  const pipeline::LabelingResult& local = local_results[nearest_to(local_ms, out.local_p50)];
+  for (const auto& [stage, ms] : kLocalStages) out.local_stages.emplace_back(stage, ms(local));
+
+  std::printf(
+      "%-24s %7zu points (%6zu described, voxel %.3f m): server p50 %7.1f ms p90 %7.1f ms "
+      "(%5.2f frames/s) | in-process p50 %7.1f ms p90 %7.1f ms  (%d reps)\n",
+      label.c_str(), out.points, out.described, out.voxel, out.server_p50, out.server_p90,
+      1e3 / out.server_p50, out.local_p50, out.local_p90, reps);
+  std::printf("%-24s   server stages ms:", "");
+  for (const auto& [stage, ms] : out.server_stages) std::printf(" %s %.1f", stage.c_str(), ms);
+  std::printf("\n%-24s   in-process stages ms:", "");
+  for (const auto& [stage, ms] : out.local_stages) std::printf(" %s %.1f", stage.c_str(), ms);
+  std::printf("\n");
+  std::fflush(stdout);
+  return out;
+}
+
 double inflight(server::LabelServer& server) {
   const std::string text = server.metrics().serialize();
   return scrape::sum_samples(scrape::parse_exposition(text), "primlabel_inflight_requests");
@@ -184,6 +284,8 @@ int main(int argc, char** argv) {
   int reps_table = 20, reps_kinect = 5, threads = 2;
   std::size_t cancel_points = 5'000'000;
   bool skip_cancel = false, cancel_only = false;
+  std::vector<std::string> frames;  // SENSOR=MODEL
+  int reps_frame = 20;
   // When to stop the cancelled request (ms after it started / after the upload ended).
   std::vector<int> cancel_at = {300, 1500, 4000, 8000};
   CLI::App app{"End-to-end latency of primlabel-server against label_cloud in process."};
@@ -198,6 +300,10 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "OpenMP threads per job")->capture_default_str();
   app.add_option("--cancel-points", cancel_points, "points of the cancelled request")
       ->capture_default_str();
+  app.add_option("--frame", frames,
+                 "SENSOR=MODEL (kinect or lms400; repeatable): the first held-out synthetic scene "
+                 "of that sensor labeled with that model file, instead of table / kinect");
+  app.add_option("--reps-frame", reps_frame, "repetitions per --frame")->capture_default_str();
   app.add_flag("--skip-cancel", skip_cancel, "no cancellation figures");
   app.add_flag("--cancel-only", cancel_only, "only the cancellation figures (no table / kinect)");
   app.add_option("--cancel-at", cancel_at, "moments (ms) at which the 5M request is cancelled")
@@ -215,6 +321,29 @@ int main(int argc, char** argv) {
   const LabelModel model = bench_model();
   fs::create_directories(repo / "bench" / "1");
   save_model((repo / "bench" / "1" / "model.plm").string(), model);
+  // Each --frame model under its own name (frame0, frame1, ...).
+  struct Frame {
+    std::string label, name;
+    synth::SensorKind sensor;
+    LabelModel model;
+  };
+  std::vector<Frame> frame_cases;
+  for (const std::string& spec : frames) {
+    const std::size_t eq = spec.find('=');
+    const auto sensor =
+        eq == std::string::npos ? std::nullopt : synth::sensor_from_name(spec.substr(0, eq));
+    if (!sensor) {
+      std::fprintf(stderr, "primlabel-bench-server: usage error: --frame %s: want SENSOR=MODEL\n",
+                   spec.c_str());
+      return primlabel::kExitUsage;
+    }
+    const std::string file = spec.substr(eq + 1);
+    Frame frame{spec.substr(0, eq) + "/" + fs::path(file).stem().string(),
+                "frame" + std::to_string(frame_cases.size()), *sensor, load_model(file)};
+    fs::create_directories(repo / frame.name / "1");
+    fs::copy_file(file, repo / frame.name / "1" / "model.plm");
+    frame_cases.push_back(std::move(frame));
+  }
   server::ServerConfig config;
   config.models_dir = repo.string();
   config.listen = "127.0.0.1:0";
@@ -231,7 +360,12 @@ int main(int argc, char** argv) {
 
   Latency table, frame;
   PointCloud kinect;
-  if (!cancel_only) {
+  std::vector<FrameFigures> frame_rows;
+  for (const Frame& f : frame_cases)
+    frame_rows.push_back(frame_figures(f.label, f.name, f.model,
+                                       synth::synthetic_scene(synth::SceneSet::kTest, 0, f.sensor),
+                                       *stub, reps_frame, threads));
+  if (!cancel_only && frame_cases.empty()) {
     table = compare("table", model, table_scene(22000), *stub, reps_table, threads);
     kinect = synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kKinect);
     frame = compare("kinect", model, kinect, *stub, reps_kinect, threads);
@@ -299,6 +433,27 @@ int main(int argc, char** argv) {
                            {"cancel_grpc_p99_ms", json::rounded(p99(cancel_ms), "%.1f")},
                            {"cancel_grpc_max_ms", json::rounded(max_of(cancel_ms), "%.1f")},
                            {"cancel_local_max_ms", json::rounded(max_of(local_stop_ms), "%.1f")}};
-  std::printf("%s\n", json::dump(line).c_str());
+  json::Json out = line;
+  json::Json rows = json::Json::array();
+  for (const FrameFigures& f : frame_rows) {
+    json::Json server_stages = json::Json::object(), local_stages = json::Json::object();
+    for (const auto& [stage, ms] : f.server_stages)
+      server_stages[stage + "_ms"] = json::rounded(ms, "%.2f");
+    for (const auto& [stage, ms] : f.local_stages)
+      local_stages[stage + "_ms"] = json::rounded(ms, "%.2f");
+    rows.push_back({{"frame", f.name},
+                    {"points", f.points},
+                    {"described", f.described},
+                    {"voxel_size", json::rounded(f.voxel, "%.4f")},
+                    {"server_p50_ms", json::rounded(f.server_p50, "%.2f")},
+                    {"server_p90_ms", json::rounded(f.server_p90, "%.2f")},
+                    {"frames_per_s", json::rounded(1e3 / f.server_p50, "%.2f")},
+                    {"local_p50_ms", json::rounded(f.local_p50, "%.2f")},
+                    {"local_p90_ms", json::rounded(f.local_p90, "%.2f")},
+                    {"server_stages", std::move(server_stages)},
+                    {"local_stages", std::move(local_stages)}});
+  }
+  if (!frame_rows.empty()) out["frames"] = std::move(rows);
+  std::printf("%s\n", json::dump(out).c_str());
   return 0;
 }

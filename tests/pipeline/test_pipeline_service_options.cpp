@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -56,9 +57,48 @@ TEST(PipelineServiceOptions, TimingsAreSeparatePerStage) {
   EXPECT_GT(result.descriptor_seconds, 0.0);
   EXPECT_GT(result.inference_seconds, 0.0);
   EXPECT_DOUBLE_EQ(result.feature_seconds, result.normal_seconds + result.descriptor_seconds);
+  EXPECT_GT(result.index_seconds, 0.0);
+  EXPECT_GT(result.graph_seconds, 0.0);
+  EXPECT_LE(result.graph_seconds, result.inference_seconds);
   // Every distinct position is described once (the fixture repeats the box's edges).
   EXPECT_EQ(result.described_points, pipeline::find_duplicates(cloud.xyz).representatives.size());
   EXPECT_LT(result.described_points, cloud.size());
+}
+
+// One radius search shared by normals, FPFH and the graph (5 mm spacing: ~80 points within the
+// 25 mm feature radius): the same normals and graph as each stage searching itself, descriptors
+// equal up to summation order, the same labels, and the same for 1 and 2 threads.
+TEST(PipelineServiceOptions, SharedNeighbourListsChangeNothingButTheSearches) {
+  const LabelModel model = random_label_model("crf", "1", 7, 0.5f);
+  pipeline::LabelingOptions shared_options, own_options;
+  shared_options.want_descriptors = own_options.want_descriptors = true;
+  own_options.share_neighbor_lists = false;
+  PointCloud shared_cloud = table_with_box_cloud(0.005f), own_cloud = shared_cloud;
+  const auto shared = pipeline::label_cloud(model, shared_cloud, shared_options, RunContext{1});
+  const auto own = pipeline::label_cloud(model, own_cloud, own_options, RunContext{1});
+  EXPECT_GT(shared.lists_seconds, 0.0);
+  EXPECT_EQ(own.lists_seconds, 0.0);
+  // Too dense to pay (hundreds of points within the radius): each stage searches itself.
+  PointCloud dense = table_with_box_cloud(0.002f);
+  EXPECT_EQ(pipeline::label_cloud(model, dense, shared_options, RunContext{2}).lists_seconds, 0.0);
+  ASSERT_EQ(shared.descriptors.values.size(), own.descriptors.values.size());
+  std::size_t normals_off = 0;
+  for (std::size_t i = 0; i < shared_cloud.size(); ++i)
+    if (!(shared_cloud.normals[i] - own_cloud.normals[i]).isZero(1e-5f)) ++normals_off;
+  EXPECT_EQ(normals_off, 0u);
+  float worst = 0.0f;
+  for (std::size_t i = 0; i < own.descriptors.values.size(); ++i) {
+    const float a = shared.descriptors.values[i], b = own.descriptors.values[i];
+    ASSERT_EQ(std::isnan(a), std::isnan(b)) << i;
+    if (!std::isnan(a)) worst = std::max(worst, std::abs(a - b));
+  }
+  EXPECT_LT(worst, 1e-3f);  // bins sum to 100 per sub-histogram
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < own.labels.size(); ++i) differ += shared.labels[i] != own.labels[i];
+  EXPECT_LE(differ, own.labels.size() / 1000);
+  PointCloud again = table_with_box_cloud(0.005f);
+  EXPECT_EQ(pipeline::label_cloud(model, again, shared_options, RunContext{2}).labels,
+            shared.labels);
 }
 
 TEST(PipelineServiceOptions, ClientNormalsSkipEstimationAndGiveTheSameLabels) {

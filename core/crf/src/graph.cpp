@@ -195,7 +195,7 @@ std::vector<std::uint8_t> valid_descriptor_mask(const Descriptors& descriptors) 
 
 Graph build_graph(const std::vector<Vec3f>& points, const Descriptors& descriptors,
                   const GraphSettings& settings, const RunContext& context,
-                  const NeighborSearch* search) {
+                  const NeighborSearch* search, const NeighborLists* shared) {
   if (!settings.neighborhood.valid())
     throw std::invalid_argument("build_graph: invalid neighbourhood " +
                                 settings.neighborhood.describe());
@@ -246,7 +246,10 @@ Graph build_graph(const std::vector<Vec3f>& points, const Descriptors& descripto
         for (std::size_t i = b * BlockLists::kListBlock; i < last; ++i) {
           if (stop.stop_requested()) return;  // per node: within one neighbourhood's time
           if (active[i]) {
-            find(points[i], query, found, /*sorted=*/cap >= 0);
+            // Shared lists answer a k-nearest query (ties by index) when they hold the k.
+            const bool listed =
+                shared && query.radius == 0.0f && shared->nearest(i, query.k, active, found);
+            if (!listed) find(points[i], query, found, /*sorted=*/cap >= 0);
             for (std::uint32_t j : found.indices) {
               if (j == static_cast<std::uint32_t>(i)) continue;
               if (cap >= 0 && static_cast<int>(lists.list_size(b)) >= cap) break;

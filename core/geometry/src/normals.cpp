@@ -55,7 +55,8 @@ bool fit_normal(const std::vector<Vec3f>& xyz, const Vec3f& query, const Neighbo
 }  // namespace
 
 NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
-                             const RunContext& context, const NeighborSearch* search) {
+                             const RunContext& context, const NeighborSearch* search,
+                             const NeighborLists* lists) {
   const std::stop_token& stop = context.stop;
   if (!options.neighborhood.valid())
     throw std::invalid_argument("normal estimation: invalid neighbourhood " +
@@ -65,6 +66,8 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
     own_search = std::make_unique<NeighborSearch>(cloud.xyz, stop);
     search = own_search.get();
   }
+  const bool use_lists = lists && options.neighborhood.radius > 0.0f &&
+                         options.neighborhood.radius <= lists->neighborhood().radius;
   const Vec3f viewpoint = options.viewpoint.value_or(cloud.viewpoint.origin);
   const std::size_t n = cloud.size();
   detail::assign_checked(cloud.normals, n, Vec3f(Vec3f::Constant(kNaN)), stop, "normal estimation");
@@ -89,7 +92,10 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
             ++block_invalid;
             continue;
           }
-          search->find(p, options.neighborhood, neighbors, /*sorted=*/false);
+          if (use_lists)
+            lists->find(i, options.neighborhood, neighbors);
+          else
+            search->find(p, options.neighborhood, neighbors, /*sorted=*/false);
           Vec3f normal;
           float curvature;
           if (fit_normal(cloud.xyz, p, neighbors, normal, curvature)) {

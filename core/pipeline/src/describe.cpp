@@ -1,8 +1,10 @@
 // Normals and descriptors with a model's FeatureSettings; the neighbour index is built once and
 // shared by normals, descriptors and the graph.
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include "primlabel/geometry/features.hpp"
@@ -15,6 +17,43 @@ namespace primlabel::pipeline {
 namespace {
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+}  // namespace
+
+namespace {
+// Memory for the shared neighbour lists (8 bytes a neighbour): a 300k-point frame at ~100
+// neighbours fits; beyond it points are searched again per stage, as without the lists.
+constexpr std::size_t kSharedListBytes = std::size_t(256) << 20;
+// Lists longer than this on average cost more to store and filter than the searches they save
+// (a dense LMS400 scan has ~500 points within 25 mm; a 5 mm voxel frame ~150 within 30 mm).
+constexpr double kMaxSharedListLength = 256;
+
+// Whether sharing pays: the mean list length over an even sample of the points, and the lists
+// of every point within the budget.
+bool sharing_pays(const std::vector<Vec3f>& points, const NeighborSearch& search,
+                  const Neighborhood& hood) {
+  constexpr std::size_t kSample = 256;
+  const std::size_t stride = std::max<std::size_t>(1, points.size() / kSample);
+  NeighborList found;
+  std::size_t sampled = 0, entries = 0;
+  for (std::size_t i = 0; i < points.size(); i += stride) {
+    if (!is_finite(points[i])) continue;
+    search.find(points[i], hood, found, /*sorted=*/false);
+    ++sampled, entries += found.size();
+  }
+  if (sampled == 0) return false;
+  const double mean = double(entries) / double(sampled);
+  return mean <= kMaxSharedListLength &&
+         mean * double(points.size()) * 8.0 <= double(kSharedListBytes);
+}
+
+// The neighbourhood that holds both (radius or hybrid) neighbourhoods, or none.
+std::optional<Neighborhood> shared_neighborhood(const Neighborhood& a, const Neighborhood& b) {
+  if (!(a.radius > 0.0f) || !(b.radius > 0.0f)) return std::nullopt;
+  const int cap = (a.max_neighbors == 0 || b.max_neighbors == 0)
+                      ? 0
+                      : std::max(a.max_neighbors, b.max_neighbors);
+  return Neighborhood{std::max(a.radius, b.radius), 0, cap};
 }
 }  // namespace
 
@@ -39,18 +78,31 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
     throw std::invalid_argument("the cloud has no normal per point to keep");
   context.throw_if_stopped("describing the cloud");
   DescribedCloud out;
+  const auto index_start = std::chrono::steady_clock::now();
   // The index build checks the token itself (a 5M-point k-d tree takes about a second).
   out.search = std::make_unique<NeighborSearch>(cloud.xyz, context.stop);
   out.point_spacing = median_point_spacing(cloud.xyz, *out.search);
+  out.index_seconds = seconds_since(index_start);
   // The stages' own progress counts (points, then twice the points for FPFH) would not add up to
   // one describe call: only threads and stop go down.
   const RunContext stage{context.threads, context.stop, {}};
+  const Neighborhood normal_hood = capped(settings.normals);
+  const Neighborhood feature_hood = capped(settings.features);
+  const std::optional<Neighborhood> shared =
+      shared_neighborhood(options.use_cloud_normals ? feature_hood : normal_hood, feature_hood);
+  const auto lists_start = std::chrono::steady_clock::now();
+  if (shared && options.share_neighbor_lists && settings.descriptor == DescriptorKind::kFpfh &&
+      sharing_pays(cloud.xyz, *out.search, *shared)) {
+    out.lists =
+        std::make_unique<NeighborLists>(cloud.xyz, *out.search, *shared, kSharedListBytes, stage);
+    out.lists_seconds = seconds_since(lists_start);
+  }
 
   if (!options.use_cloud_normals) {
     const auto start = std::chrono::steady_clock::now();
     NormalOptions normal_options;
-    normal_options.neighborhood = capped(settings.normals);
-    estimate_normals(cloud, normal_options, stage, out.search.get());
+    normal_options.neighborhood = normal_hood;
+    estimate_normals(cloud, normal_options, stage, out.search.get(), out.lists.get());
     out.normal_seconds = seconds_since(start);
     out.surface_variation = median_surface_variation(cloud.curvature);
   } else {
@@ -59,11 +111,12 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
 
   const auto start = std::chrono::steady_clock::now();
   FeatureOptions feature_options;
-  feature_options.neighborhood = capped(settings.features);
+  feature_options.neighborhood = feature_hood;
   feature_options.fpfh_variant = settings.fpfh_variant;
   const bool fpfh = settings.descriptor == DescriptorKind::kFpfh;
-  out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, stage, nullptr, out.search.get())
-                         : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
+  out.descriptors =
+      fpfh ? compute_fpfh(cloud, feature_options, stage, nullptr, out.search.get(), out.lists.get())
+           : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
   out.feature_seconds = seconds_since(start);
   return out;
 }
@@ -73,7 +126,7 @@ crf::Graph build_scene_graph(const PointCloud& cloud, const DescribedCloud& desc
   crf::GraphSettings bounded = settings;
   bounded.neighborhood = capped(settings.neighborhood);
   return crf::build_graph(cloud.xyz, described.descriptors, bounded, context,
-                          described.search.get());
+                          described.search.get(), described.lists.get());
 }
 
 crf::LabeledGraph to_labeled_graph(const PointCloud& cloud, DescribedCloud&& described,

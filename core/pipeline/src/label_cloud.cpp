@@ -54,10 +54,13 @@ LabelingResult label_distinct_points(const LabelModel& model, const FeatureSetti
   result.class_ids = model.class_ids();
   DescribeOptions describe_options;
   describe_options.use_cloud_normals = options.use_cloud_normals;
+  describe_options.share_neighbor_lists = options.share_neighbor_lists;
   DescribedCloud described = describe_cloud(cloud, features, describe_options, context);
   result.normal_seconds = described.normal_seconds;
   result.descriptor_seconds = described.feature_seconds;
   result.feature_seconds = described.normal_seconds + described.feature_seconds;
+  result.index_seconds = described.index_seconds;
+  result.lists_seconds = described.lists_seconds;
   result.described_points = cloud.size();
   result.point_spacing = described.point_spacing;
   result.surface_variation = described.surface_variation;
@@ -72,6 +75,7 @@ LabelingResult label_distinct_points(const LabelModel& model, const FeatureSetti
   // A node-only model ignores edges, so its graph needs none (only the active mask).
   if (model.kind == ModelKind::kNodeOnly) graph_options.neighborhood = Neighborhood::Knn(1);
   const crf::Graph graph = build_scene_graph(cloud, described, graph_options, context);
+  result.graph_seconds = seconds_since(start);
   context.throw_if_stopped("labeling");
   crf::InferenceOutputs outputs;
   outputs.unknown_label = class_id(PrimitiveClass::kUnknown);
@@ -101,6 +105,11 @@ LabelingResult unknown_result(std::size_t points, const LabelingResult& like,
   result.descriptor_seconds = like.descriptor_seconds;
   result.feature_seconds = like.feature_seconds;
   result.inference_seconds = like.inference_seconds;
+  result.voxel_seconds = like.voxel_seconds;
+  result.index_seconds = like.index_seconds;
+  result.lists_seconds = like.lists_seconds;
+  result.graph_seconds = like.graph_seconds;
+  result.fanout_seconds = like.fanout_seconds;
   result.point_spacing = like.point_spacing;
   result.surface_variation = like.surface_variation;
   result.labels.assign(points, class_id(PrimitiveClass::kUnknown));
@@ -131,6 +140,7 @@ void copy_point(const LabelingResult& part, std::size_t from, LabelingResult& wh
 LabelingResult fan_out(const LabelingResult& partial, const PointCloud& part,
                        const std::vector<std::uint32_t>& slot_of, PointCloud& cloud,
                        const LabelingOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   LabelingResult result = unknown_result(cloud.size(), partial, options);
   result.labeled_points = 0;
   if (!options.use_cloud_normals) {
@@ -148,6 +158,7 @@ LabelingResult fan_out(const LabelingResult& partial, const PointCloud& part,
       cloud.curvature[i] = part.curvature[j];
     }
   }
+  result.fanout_seconds += seconds_since(start);
   return result;
 }
 
@@ -247,6 +258,7 @@ LabelingResult label_voxels(const LabelModel& model, const FeatureSettings& feat
   const LabelingResult partial = label_points(model, features, voxels, options, context);
   LabelingResult result = fan_out(partial, voxels, grid.voxel_of_point, cloud, options);
   result.prefilter_seconds = partial.prefilter_seconds + voxel_seconds;
+  result.voxel_seconds = voxel_seconds;
   return result;
 }
 

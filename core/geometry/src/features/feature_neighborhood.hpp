@@ -23,11 +23,8 @@ inline std::vector<char> usable_points(const PointCloud& cloud, const char* desc
   return usable;
 }
 
-// Neighbours of point `i`, without those lacking a normal.
-inline void usable_neighbors(const NeighborSearch& search, const PointCloud& cloud,
-                             const std::vector<char>& usable, std::size_t i,
-                             const Neighborhood& hood, bool sorted, NeighborList& out) {
-  search.find(cloud.xyz[i], hood, out, sorted);
+// `out` without the points lacking a normal.
+inline void keep_usable(const std::vector<char>& usable, NeighborList& out) {
   std::size_t kept = 0;
   for (std::size_t j = 0; j < out.size(); ++j) {
     if (!usable[out.indices[j]]) continue;
@@ -37,6 +34,14 @@ inline void usable_neighbors(const NeighborSearch& search, const PointCloud& clo
   }
   out.indices.resize(kept);
   out.sq_dists.resize(kept);
+}
+
+// Neighbours of point `i`, without those lacking a normal.
+inline void usable_neighbors(const NeighborSearch& search, const PointCloud& cloud,
+                             const std::vector<char>& usable, std::size_t i,
+                             const Neighborhood& hood, bool sorted, NeighborList& out) {
+  search.find(cloud.xyz[i], hood, out, sorted);
+  keep_usable(usable, out);
 }
 
 inline const NeighborSearch& ensure_search(const PointCloud& cloud, const NeighborSearch* given,

@@ -126,7 +126,7 @@ void weight_spfh(const PointCloud& cloud, std::size_t p, const std::vector<float
 
 Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
                          const RunContext& context, FeatureStats* stats,
-                         const NeighborSearch* search) {
+                         const NeighborSearch* search, const NeighborLists* lists) {
   const std::stop_token& stop = context.stop;
   if (!options.neighborhood.valid())
     throw std::invalid_argument("FPFH: invalid neighbourhood " + options.neighborhood.describe());
@@ -140,6 +140,17 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
   // Radius neighbourhoods need no order: every sum below is order-independent up to rounding,
   // and tree order is itself deterministic.
   const bool sorted = false;
+  const bool use_lists = lists && options.neighborhood.radius > 0.0f &&
+                         options.neighborhood.radius <= lists->neighborhood().radius;
+  // Point p's neighbours that have a normal, from the shared lists or a search.
+  const auto neighbors_of = [&](std::size_t p, NeighborList& out) {
+    if (!use_lists) {
+      detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, sorted, out);
+      return;
+    }
+    lists->find(p, options.neighborhood, out);
+    detail::keep_usable(usable, out);
+  };
 
   std::vector<float> spfh;
   std::vector<double> spfh_sums;  // per sub-histogram, for the normalisation
@@ -160,8 +171,7 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
           if (stop.stop_requested()) return;
           if (!usable[p]) continue;
           NeighborList& neighbors = scratch.neighbors;
-          detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, sorted,
-                                   neighbors);
+          neighbors_of(p, neighbors);
           cache.store(p, neighbors);
           if (neighbors.size() < 2) continue;
           float* row = &spfh[p * kFpfhSize];
@@ -188,9 +198,7 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
             std::fill(out, out + kFpfhSize, std::numeric_limits<float>::quiet_NaN());
             continue;
           }
-          if (!cache.load(p, neighbors))
-            detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, sorted,
-                                     neighbors);
+          if (!cache.load(p, neighbors)) neighbors_of(p, neighbors);
           if (neighbors.size() < 2) {
             ++block_isolated;  // stays all zero, as in PCL
             continue;

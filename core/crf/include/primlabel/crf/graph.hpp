@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "primlabel/geometry/descriptors.hpp"
+#include "primlabel/geometry/neighbor_lists.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/run_context.hpp"
@@ -55,10 +56,12 @@ std::vector<std::uint8_t> valid_descriptor_mask(const Descriptors& descriptors);
 // built); points without a valid descriptor are filtered out of its answers, so the graph never
 // depends on whether it was passed. Throws primlabel::Cancelled when context.stop is requested
 // (checked per block of points, and while the graph's own neighbour index is built). The graph
-// is identical for any context.threads.
+// is identical for any context.threads. `shared` (shared radius lists on `points`, with `search`)
+// answer a k-nearest graph where they hold the k nearest: the k nearest with ties broken by
+// index, which may differ from the tree's tie order only between exactly equidistant points.
 Graph build_graph(const std::vector<Vec3f>& points, const Descriptors& descriptors,
                   const GraphSettings& settings = {}, const RunContext& context = {},
-                  const NeighborSearch* search = nullptr);
+                  const NeighborSearch* search = nullptr, const NeighborLists* shared = nullptr);
 
 // A graph from an explicit undirected edge list (tests, synthetic data, other sources). Self
 // loops, duplicates and edges touching inactive nodes are dropped. `active` defaults to all.

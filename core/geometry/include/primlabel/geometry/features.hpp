@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "primlabel/geometry/descriptors.hpp"
+#include "primlabel/geometry/neighbor_lists.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/progress.hpp"
@@ -46,9 +47,12 @@ struct FeatureStats {
 // cloud.size() x 33. Requires cloud.normals. Once context.stop is requested the remaining blocks
 // of points are skipped and the function throws Cancelled; context.progress counts points (twice:
 // both passes).
+// `lists`: shared neighbour lists on cloud.xyz (see estimate_normals), used when the
+// neighbourhood is a radius within theirs.
 Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
                          const RunContext& context = {}, FeatureStats* stats = nullptr,
-                         const NeighborSearch* search = nullptr);
+                         const NeighborSearch* search = nullptr,
+                         const NeighborLists* lists = nullptr);
 
 // cloud.size() x 125. Requires cloud.normals. context as for compute_fpfh.
 Descriptors compute_pfh(const PointCloud& cloud, const FeatureOptions& options,

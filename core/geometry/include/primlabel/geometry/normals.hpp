@@ -5,6 +5,7 @@
 
 #include <optional>
 
+#include "primlabel/geometry/neighbor_lists.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/progress.hpp"
@@ -26,10 +27,12 @@ struct NormalStats {
 
 // Fills cloud.normals and cloud.curvature (one per point). Points that cannot get a normal get NaN
 // normal and NaN curvature and are counted in the returned stats. `search` may be passed to reuse
-// an index built on cloud.xyz. Once context.stop is requested the remaining points are skipped
-// and estimate_normals throws Cancelled; context.progress counts points.
+// an index built on cloud.xyz, and `lists` shared neighbour lists on it (used when the
+// neighbourhood is a radius within theirs; the same neighbours, no second search). Once
+// context.stop is requested the remaining points are skipped and estimate_normals throws Cancelled;
+// context.progress counts points.
 NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
-                             const RunContext& context = {},
-                             const NeighborSearch* search = nullptr);
+                             const RunContext& context = {}, const NeighborSearch* search = nullptr,
+                             const NeighborLists* lists = nullptr);
 
 }  // namespace primlabel

@@ -13,6 +13,7 @@
 #include "primlabel/crf/training.hpp"
 #include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/geometry/descriptors.hpp"
+#include "primlabel/geometry/neighbor_lists.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/run_context.hpp"
@@ -26,7 +27,12 @@ namespace primlabel::pipeline {
 struct DescribedCloud {
   Descriptors descriptors;  // one row per point; NaN rows = invalid
   std::unique_ptr<NeighborSearch> search;
+  // One radius search per point at the larger of the normal and feature radii, shared by
+  // normals, descriptors and the graph (null when the neighbourhoods are not both radii).
+  std::unique_ptr<NeighborLists> lists;
   double normal_seconds = 0, feature_seconds = 0;
+  double index_seconds = 0;     // the neighbour index and the point-spacing measure
+  double lists_seconds = 0;     // the shared neighbour lists
   float point_spacing = 0;      // median_point_spacing of the described cloud (m; NaN: none)
   float surface_variation = 0;  // median_surface_variation of its normals (NaN: its own normals)
 };
@@ -47,6 +53,10 @@ Neighborhood capped(const Neighborhood& hood);
 struct DescribeOptions {
   // Keep cloud.normals (one per point, e.g. from the sensor) instead of estimating them.
   bool use_cloud_normals = false;
+  // Search once at the larger radius and share the lists (DescribedCloud::lists). Off: every
+  // stage searches itself (the same neighbours; FPFH sums them in another order, so descriptors
+  // differ in rounding). For benchmarks and tests that compare the two.
+  bool share_neighbor_lists = true;
 };
 
 // Throws std::invalid_argument for settings describe_cloud cannot honour (voxel downsampling:
@@ -78,6 +88,7 @@ struct LabelingOptions {
   // allow it (radii_overridable), else label_cloud throws std::invalid_argument.
   float normal_radius = 0.0f;
   float feature_radius = 0.0f;
+  bool share_neighbor_lists = true;  // DescribeOptions::share_neighbor_lists
 };
 
 struct LabelingResult {
@@ -93,8 +104,15 @@ struct LabelingResult {
   double descriptor_seconds = 0;     // FPFH / PFH
   double feature_seconds = 0;        // normals + descriptors
   double inference_seconds = 0;      // graph + inference
-  float point_spacing = 0;           // median point spacing of the described cloud (m)
-  float surface_variation = 0;       // median surface variation of its computed normals
+  // Finer splits of the above, for profiles (each also counted in its stage above except
+  // index_seconds, lists_seconds and fanout_seconds, which no stage above includes).
+  double voxel_seconds = 0;     // voxel downsampling (in prefilter_seconds)
+  double index_seconds = 0;     // neighbour index build and point-spacing measure
+  double lists_seconds = 0;     // the radius search shared by normals, descriptors and graph
+  double graph_seconds = 0;     // the CRF graph (in inference_seconds)
+  double fanout_seconds = 0;    // carrying voxel / duplicate / table-top results to every point
+  float point_spacing = 0;      // median point spacing of the described cloud (m)
+  float surface_variation = 0;  // median surface variation of its computed normals
   // Not empty when point_spacing is far outside what the model was trained for (domain.hpp):
   // the labels are then unreliable, and the caller should be told so.
   std::string domain_warning;

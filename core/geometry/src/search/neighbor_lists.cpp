@@ -1,0 +1,166 @@
+#include "primlabel/geometry/neighbor_lists.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <limits>
+#include <stdexcept>
+
+#include "primlabel/geometry/cancellation.hpp"
+#include "primlabel/geometry/parallel.hpp"
+
+namespace primlabel {
+
+namespace {
+// States of a point's list besides an offset.
+constexpr std::uint32_t kNotKept = std::numeric_limits<std::uint32_t>::max();  // over budget
+constexpr std::uint32_t kCut = kNotKept - 1;      // the shared search hit its cap here
+constexpr std::uint32_t kNoPoint = kNotKept - 2;  // non-finite: no neighbours
+constexpr std::size_t kEntryBytes = sizeof(std::uint32_t) + sizeof(float);
+
+bool is_cut(const Neighborhood& hood, const NeighborList& found) {
+  return hood.max_neighbors > 0 && found.size() >= std::size_t(hood.max_neighbors);
+}
+}  // namespace
+
+NeighborLists::NeighborLists(const std::vector<Vec3f>& points, const NeighborSearch& search,
+                             const Neighborhood& hood, std::size_t budget_bytes,
+                             const RunContext& context)
+    : points_(points), search_(search), hood_(hood) {
+  if (!hood.valid() || !(hood.radius > 0.0f))
+    throw std::invalid_argument("neighbour lists need a radius neighbourhood, got " +
+                                hood.describe());
+  const std::stop_token& stop = context.stop;
+  const std::size_t n = points.size();
+  blocks_.resize((n + kBlock - 1) / kBlock);
+  const std::size_t block_budget = blocks_.empty() ? 0 : budget_bytes / blocks_.size();
+  std::atomic<std::size_t> kept{0};
+  detail::for_each_block(
+      static_cast<std::ptrdiff_t>(blocks_.size()), context, [] { return NeighborList(); },
+      [&](NeighborList& found, std::ptrdiff_t b) {
+        Block& block = blocks_[std::size_t(b)];
+        const std::size_t first = std::size_t(b) * kBlock;
+        const std::size_t last = std::min(n, first + kBlock);
+        block.begin.assign(last - first, kNotKept);
+        block.end.assign(last - first, kNotKept);
+        std::size_t block_kept = 0;
+        for (std::size_t i = first; i < last; ++i) {
+          if (stop.stop_requested()) return;  // per point: within one neighbourhood's time
+          const std::size_t slot = i - first;
+          if (!is_finite(points[i])) {
+            block.begin[slot] = kNoPoint;
+            continue;
+          }
+          // Over this block's share: the rest of it is searched again when asked for.
+          if ((block.indices.size() + 1) * kEntryBytes > block_budget) break;
+          search.find(points[i], hood, found, /*sorted=*/false);
+          if (is_cut(hood, found)) {
+            block.begin[slot] = kCut;
+            continue;
+          }
+          if ((block.indices.size() + found.size()) * kEntryBytes > block_budget) break;
+          block.begin[slot] = static_cast<std::uint32_t>(block.indices.size());
+          block.indices.insert(block.indices.end(), found.indices.begin(), found.indices.end());
+          block.sq_dists.insert(block.sq_dists.end(), found.sq_dists.begin(), found.sq_dists.end());
+          block.end[slot] = static_cast<std::uint32_t>(block.indices.size());
+          ++block_kept;
+        }
+        kept += block_kept;
+      });
+  throw_if_stopped(stop, "neighbour lists");
+  kept_points_ = kept.load();
+}
+
+bool NeighborLists::shared(std::size_t i, NeighborList& scratch, const std::uint32_t*& indices,
+                           const float*& sq_dists, std::size_t& count) const {
+  const Block& block = blocks_[i / kBlock];
+  const std::size_t slot = i % kBlock;
+  const std::uint32_t begin = block.begin[slot];
+  if (begin == kCut) return false;
+  if (begin == kNoPoint) {
+    count = 0;
+    return true;
+  }
+  if (begin == kNotKept) {  // the same search again: the same list in the same order
+    search_.find(points_[i], hood_, scratch, /*sorted=*/false);
+    if (is_cut(hood_, scratch)) return false;
+    indices = scratch.indices.data();
+    sq_dists = scratch.sq_dists.data();
+    count = scratch.size();
+    return true;
+  }
+  indices = block.indices.data() + begin;
+  sq_dists = block.sq_dists.data() + begin;
+  count = block.end[slot] - begin;
+  return true;
+}
+
+void NeighborLists::find(std::size_t i, const Neighborhood& hood, NeighborList& out) const {
+  if (!(hood.radius > 0.0f) || hood.radius > hood_.radius)
+    throw std::invalid_argument("neighbour lists of radius " + std::to_string(hood_.radius) +
+                                " cannot answer " + hood.describe());
+  thread_local NeighborList scratch;
+  const std::uint32_t* indices = nullptr;
+  const float* sq_dists = nullptr;
+  std::size_t count = 0;
+  if (shared(i, scratch, indices, sq_dists, count)) {
+    // The same float comparison as the search's (squared distance < radius^2). Written
+    // branch-free into room for all, then cut to what was kept.
+    const float sq_radius = hood.radius * hood.radius;
+    out.indices.resize(count);
+    out.sq_dists.resize(count);
+    std::uint32_t* out_indices = out.indices.data();
+    float* out_sq = out.sq_dists.data();
+    std::size_t kept = 0;
+    for (std::size_t p = 0; p < count; ++p) {
+      out_indices[kept] = indices[p];
+      out_sq[kept] = sq_dists[p];
+      kept += sq_dists[p] < sq_radius;
+    }
+    out.indices.resize(kept);
+    out.sq_dists.resize(kept);
+    // Within the cap the whole radius is the answer; beyond it the nearest are wanted.
+    if (hood.max_neighbors == 0 || kept < std::size_t(hood.max_neighbors)) return;
+  }
+  search_.find(points_[i], hood, out, /*sorted=*/false);
+}
+
+bool NeighborLists::nearest(std::size_t i, int k, const std::vector<std::uint8_t>& allowed,
+                            NeighborList& out) const {
+  if (k <= 0) return false;
+  thread_local NeighborList scratch;
+  const std::uint32_t* indices = nullptr;
+  const float* sq_dists = nullptr;
+  std::size_t count = 0;
+  if (!shared(i, scratch, indices, sq_dists, count)) return false;
+  // The k smallest (squared distance, index) pairs, a total order, so they do not depend on the
+  // stored order: kept sorted by insertion into a local array (k is small, the lists a few
+  // hundred long, and most entries fail the first comparison).
+  using Entry = std::pair<float, std::uint32_t>;
+  constexpr std::size_t kOnStack = 32;
+  Entry on_stack[kOnStack];
+  std::vector<Entry> on_heap;
+  const std::size_t want = std::size_t(k);
+  if (want > kOnStack) on_heap.resize(want);
+  Entry* best = want > kOnStack ? on_heap.data() : on_stack;
+  std::size_t have = 0;
+  for (std::size_t p = 0; p < count; ++p) {
+    const float sq = sq_dists[p];
+    if (have == want && sq > best[want - 1].first) continue;
+    const Entry entry(sq, indices[p]);
+    if (have == want && !(entry < best[want - 1])) continue;
+    if (!allowed[entry.second]) continue;
+    std::size_t j = have < want ? have++ : want - 1;
+    for (; j > 0 && entry < best[j - 1]; --j) best[j] = best[j - 1];
+    best[j] = entry;
+  }
+  if (have < want) return false;
+  out.indices.resize(want);
+  out.sq_dists.resize(want);
+  for (std::size_t j = 0; j < want; ++j) {
+    out.sq_dists[j] = best[j].first;
+    out.indices[j] = best[j].second;
+  }
+  return true;
+}
+
+}  // namespace primlabel
