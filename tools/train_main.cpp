@@ -31,6 +31,7 @@ struct Arguments {
   std::string sensor = "lms400", kind = "crf", objective = "piecewise", descriptor = "fpfh";
   std::string fpfh_variant = "paper", node_basis = "tent";
   double label_radius = synth::kDefaultLabelRadius, l2 = 1e-6, svm_c = 10.0, svm_gamma = 0.0;
+  double class_balance = 0.0;
   std::size_t svm_max_points = 20000;
   std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
   float feature_radius = 0.025f, normal_radius = 0.01f;
@@ -136,6 +137,7 @@ int run(const Arguments& args) {
   options.l2 = args.l2;
   options.iterations = args.iterations;
   options.node_knots = args.node_knots;
+  options.class_balance = args.class_balance;
   std::vector<crf::TrainingIteration> curve;
   if (options.kind != ModelKind::kSvm && (!args.curve_csv.empty() || !args.curve_png.empty()))
     options.on_iteration = [&](const crf::TrainingIteration& it) {
@@ -230,6 +232,10 @@ int main(int argc, char** argv) {
   app.add_option("--node-knots", args.node_knots, cli::kNodeKnotsHelp)->delimiter(',');
   app.add_option("--l2", args.l2, "L2 regularisation (default 1e-6)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--class-balance", args.class_balance,
+                 "CRF / node-only: weight each class's points by (N / (K n_c))^ALPHA, ALPHA in "
+                 "[0, 1] (default 0: unweighted; 1: every class counts as much in total)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--iterations", args.iterations, "L-BFGS iterations (default 200)")
       ->check(CLI::PositiveNumber);
   app.add_option("--feature-radius", args.feature_radius, "descriptor radius (m, default 0.025)")
@@ -274,6 +280,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "primlabel-train: usage error: --curve and --curve-png need an iterative model "
                  "(--kind crf or node)\n");
+    return cli::kExitUsage;
+  }
+  if (args.class_balance > 0.0 && (args.kind == "svm" || args.objective == "bethe")) {
+    std::fprintf(stderr,
+                 "primlabel-train: usage error: --class-balance needs --kind crf or node and a "
+                 "per-point objective (piecewise or pl)\n");
     return cli::kExitUsage;
   }
   try {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -79,6 +80,131 @@ TEST(CrfTraining, PseudoLikelihoodAndNodeOnlyGradientsMatchFiniteDifferences) {
           << (edges ? "PL" : "node-only") << ", " << knots.size() << " knots";
     }
   }
+}
+
+// Class weights scale each point's term by its label's weight: the analytic gradient still matches
+// central differences, for pseudo-likelihood and node-only, in both bases.
+TEST(CrfTraining, WeightedGradientsMatchFiniteDifferences) {
+  const std::vector<LabeledGraph> scenes = {small_scene(1), small_scene(2)};
+  const std::vector<double> weights = {0.3, 1.0, 4.5};
+  for (const auto& knots : {std::vector<float>{}, kKnots}) {
+    const CrfModel like = CrfModel::zeros(ids(3), 5, 0.01f, knots);
+    for (const bool edges : {true, false}) {
+      const auto prepared = detail::prepare_scenes(scenes, like, edges);
+      const detail::ParameterShape shape = shape_of(like, edges);
+      auto weighted = detail::make_pseudo_likelihood(prepared, shape, 2, weights);
+      auto plain = detail::make_pseudo_likelihood(prepared, shape, 2);
+      const Eigen::VectorXd x = random_parameters(shape.size(), 3, 1.0);
+      EXPECT_LT(gradient_error(*weighted, x, 1e-5), 1e-7)
+          << (edges ? "PL" : "node-only") << ", " << knots.size() << " knots";
+      Eigen::VectorXd g(x.size());
+      EXPECT_GT(std::abs(weighted->evaluate(x, g) - plain->evaluate(x, g)), 1e-3);  // it bites
+    }
+  }
+}
+
+// alpha = 0 is today's objective exactly: unit weights give the same value and gradient bit for
+// bit, equal weights of any size within rounding (only ratios matter), and train_crf the same
+// model.
+TEST(CrfTraining, UnitClassWeightsAreTheUnweightedObjective) {
+  const std::vector<LabeledGraph> scenes = {small_scene(1), small_scene(2)};
+  for (const auto& knots : {std::vector<float>{}, kKnots}) {
+    const CrfModel like = CrfModel::zeros(ids(3), 5, 0.01f, knots);
+    for (const bool edges : {true, false}) {
+      const auto prepared = detail::prepare_scenes(scenes, like, edges);
+      const detail::ParameterShape shape = shape_of(like, edges);
+      const Eigen::VectorXd x = random_parameters(shape.size(), 5, 1.0);
+      Eigen::VectorXd g_plain(x.size()), g_unit(x.size()), g_equal(x.size());
+      const double plain = detail::make_pseudo_likelihood(prepared, shape, 2)->evaluate(x, g_plain);
+      const double unit =
+          detail::make_pseudo_likelihood(prepared, shape, 2, {1.0, 1.0, 1.0})->evaluate(x, g_unit);
+      const double equal =
+          detail::make_pseudo_likelihood(prepared, shape, 2, {2.5, 2.5, 2.5})->evaluate(x, g_equal);
+      EXPECT_EQ(plain, unit);
+      EXPECT_TRUE(g_plain.cwiseEqual(g_unit).all());
+      EXPECT_NEAR(plain, equal, 1e-12);
+      EXPECT_LT((g_plain - g_equal).cwiseAbs().maxCoeff(), 1e-12);
+    }
+  }
+  const std::vector<std::uint64_t> counts = {500, 30, 2};
+  TrainingOptions options;
+  options.objective = TrainingObjective::kNodeOnly;
+  options.max_iterations = 20;
+  const TrainingResult plain = train_crf(scenes, {}, ids(3), options);
+  options.class_weights = class_balance_weights(counts, 0.0);
+  const TrainingResult alpha0 = train_crf(scenes, {}, ids(3), options);
+  EXPECT_TRUE(plain.model.node_weights.cwiseEqual(alpha0.model.node_weights).all());
+  EXPECT_EQ(plain.objective, alpha0.objective);
+}
+
+TEST(CrfTraining, ClassBalanceWeights) {
+  const std::vector<std::uint64_t> counts = {900, 90, 0, 10};  // N = 1000, K = 3 with points
+  EXPECT_EQ(class_balance_weights(counts, 0.0), std::vector<double>(4, 1.0));
+  const std::vector<double> full = class_balance_weights(counts, 1.0);
+  EXPECT_NEAR(full[0], 1000.0 / (3 * 900), 1e-15);
+  EXPECT_NEAR(full[1], 1000.0 / (3 * 90), 1e-15);
+  EXPECT_EQ(full[2], 1.0);  // no points, nothing to weight
+  EXPECT_NEAR(full[3], 1000.0 / (3 * 10), 1e-15);
+  // alpha = 1: every class with points weighs N / K in total.
+  for (std::size_t c : {0u, 1u, 3u}) EXPECT_NEAR(full[c] * double(counts[c]), 1000.0 / 3, 1e-9);
+  const std::vector<double> half = class_balance_weights(counts, 0.5);
+  EXPECT_NEAR(half[3], std::sqrt(full[3]), 1e-12);
+  EXPECT_THROW(class_balance_weights(counts, -0.1), std::invalid_argument);
+  EXPECT_THROW(class_balance_weights(counts, 1.5), std::invalid_argument);
+  EXPECT_THROW(class_balance_weights(std::vector<std::uint64_t>{0, 0}, 0.5), std::invalid_argument);
+}
+
+// Two overlapping classes, one 4% of the points: the unweighted likelihood puts the boundary deep
+// inside the rare class (few of its points are worth the errors on the common one); balanced
+// weights move it back to the middle, and the rare class's recall rises.
+LabeledGraph rare_class_scene(std::uint32_t seed, std::size_t n) {
+  std::mt19937 rng(seed);
+  std::bernoulli_distribution rare(0.04);
+  std::normal_distribution<float> common_value(40.0f, 8.0f), rare_value(56.0f, 8.0f);
+  LabeledGraph scene;
+  scene.descriptors.dim = 1;
+  scene.graph = graph_from_edges(n, {});
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool r = rare(rng);
+    scene.descriptors.values.push_back(
+        std::clamp(r ? rare_value(rng) : common_value(rng), 0.f, 100.f));
+    scene.labels.push_back(r ? 1 : 0);
+  }
+  return scene;
+}
+
+double class_recall(const CrfModel& model, const LabeledGraph& scene, int k) {
+  const InferenceResult r = infer(model, scene.descriptors, scene.graph, {});
+  std::size_t support = 0, hits = 0;
+  for (std::size_t i = 0; i < scene.labels.size(); ++i) {
+    if (scene.labels[i] != k) continue;
+    ++support;
+    hits += r.labels[i] == model.class_ids[k] ? 1 : 0;
+  }
+  return double(hits) / double(support);
+}
+
+TEST(CrfTraining, ClassWeightsRaiseTheRecallOfARareClass) {
+  const std::vector<LabeledGraph> train = {rare_class_scene(1, 5000)};
+  const std::vector<LabeledGraph> test = {rare_class_scene(2, 5000)};
+  std::vector<std::uint64_t> counts(2, 0);
+  for (int y : train[0].labels) ++counts[std::size_t(y)];
+  TrainingOptions options;
+  options.objective = TrainingObjective::kNodeOnly;
+  options.l2 = 1e-6;  // as pipeline::train_label_model
+  options.node_knots = {};
+  options.max_iterations = 200;
+  const CrfModel plain = train_crf(train, {}, ids(2), options).model;
+  options.class_weights = class_balance_weights(counts, 1.0);
+  const CrfModel balanced = train_crf(train, {}, ids(2), options).model;
+  const double plain_recall = class_recall(plain, test[0], 1);
+  const double balanced_recall = class_recall(balanced, test[0], 1);
+  std::printf("rare class recall: unweighted %.3f, balanced %.3f; accuracy %.3f, %.3f\n",
+              plain_recall, balanced_recall, labeled_accuracy(plain, test, {}),
+              labeled_accuracy(balanced, test, {}));
+  EXPECT_LT(plain_recall, 0.5);
+  EXPECT_GT(balanced_recall, 0.75);
+  EXPECT_GT(class_recall(balanced, test[0], 0), 0.75);  // not everything called rare
 }
 
 // On a tree the Bethe free energy is exact, so the BP objective is the exact negative
@@ -225,6 +351,14 @@ TEST(CrfTraining, RejectsInconsistentData) {
   bad_knots.node_knots = {0.0f, 0.5f, 0.5f};
   const std::vector<LabeledGraph> good = {small_scene(7)};
   EXPECT_THROW(train_crf(good, {}, ids(3), bad_knots), std::invalid_argument);
+  TrainingOptions bad_weights;
+  bad_weights.class_weights = {1.0, 2.0};  // not one per class
+  EXPECT_THROW(train_crf(good, {}, ids(3), bad_weights), std::invalid_argument);
+  bad_weights.class_weights = {1.0, 0.0, 2.0};
+  EXPECT_THROW(train_crf(good, {}, ids(3), bad_weights), std::invalid_argument);
+  bad_weights.class_weights = {1.0, 1.0, 2.0};
+  bad_weights.objective = TrainingObjective::kBetheBp;  // log Z has no per-point terms
+  EXPECT_THROW(train_crf(good, {}, ids(3), bad_weights), std::invalid_argument);
 }
 
 // One descriptor value whose class is a band in the middle of its range: a single weight per bin

@@ -41,6 +41,8 @@ LabelModel sample_crf() {
   m.training.points = 1750000;
   m.training.class_points = {1000000, 500000, 250000};
   m.training.objective = "pseudo-likelihood";
+  m.training.class_balance = 0.5;
+  m.training.class_weights = {0.25, 0.5, 1.5};
   m.validation.accuracy = 0.975;
   m.validation.per_class = {{0.99, 0.98, 0.985, 100}, {0.9, 0.8, 0.85, 10}, {0.7, 0.6, 0.65, 5}};
   m.created_unix_ms = 1763776800000;
@@ -79,6 +81,8 @@ TEST(LabelModel, CrfRoundTrip) {
   EXPECT_TRUE(loaded.inference.max_product);
   EXPECT_EQ(loaded.inference.max_iterations, 17);
   EXPECT_EQ(loaded.training.class_points, saved.training.class_points);
+  EXPECT_EQ(loaded.training.class_balance, 0.5);
+  EXPECT_EQ(loaded.training.class_weights, saved.training.class_weights);
   EXPECT_EQ(loaded.validation.per_class.size(), 3u);
   EXPECT_DOUBLE_EQ(loaded.validation.per_class[1].f1, 0.85);
   EXPECT_EQ(loaded.created_unix_ms, saved.created_unix_ms);
@@ -125,6 +129,8 @@ TEST(LabelModel, AFileWrittenBeforeTheRunContextLoadsUnchanged) {
   EXPECT_EQ(m.inference.tolerance, 1e-4f);
   EXPECT_EQ(m.weights.node_weights(1, 2), 0.01f * float((37 + 22) % 23) - 0.1f);
   EXPECT_EQ(m.weights.edge_weights(2, 4), 0.002f * float((10 + 12) % 7));
+  EXPECT_EQ(m.training.class_balance, 0.0);  // older files: the unweighted objective
+  EXPECT_TRUE(m.training.class_weights.empty());
   std::ifstream in(path, std::ios::binary);
   const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   EXPECT_EQ(serialize_model(m), bytes);

@@ -10,6 +10,7 @@
 #include <limits>
 #include <random>
 
+#include "crf/synthetic.hpp"
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
@@ -193,6 +194,56 @@ TEST(PipelineLabeling, PiecewiseCrfTrainingKeepsTheCouplingThatValidatesBest) {
   EXPECT_GE(
       chosen,
       pipeline::evaluate_scenes(with_coupling(crf, 1.0f), validation, RunContext{2}).accuracy());
+}
+
+// --class-balance: the weights come from the training scenes' labelled points and are recorded
+// with alpha in the model's training summary; alpha 0 records none; SVMs and alphas outside
+// [0, 1] are refused before any training.
+TEST(PipelineLabeling, ClassBalanceIsRecordedInTheTrainingSummary) {
+  crf::testing::SceneSpec spec;
+  spec.width = 30;
+  spec.height = 20;
+  spec.dim = kFpfhSize;  // the model file checks it against its features
+  spec.region = 5;
+  SceneData scene;
+  scene.source = "grid";
+  scene.graph = crf::testing::make_grid_scene(spec);
+  const std::vector<std::uint32_t> class_ids = {1, 2, 4};
+  std::vector<int>& labels = scene.graph.labels;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (labels[i] == 2 && i % 4 != 0) labels[i] = 0;  // class 4 rarer
+  for (int y : scene.graph.labels) scene.truth.push_back(class_ids[std::size_t(y)]);
+  const std::vector<SceneData> train = {scene};
+  pipeline::ModelTrainingOptions options;
+  options.kind = ModelKind::kNodeOnly;
+  options.iterations = 20;
+  options.class_balance = 0.5;
+  const FeatureSettings features;
+  const crf::GraphSettings graph;
+  const LabelModel balanced =
+      pipeline::train_label_model(train, {}, class_ids, features, graph, options).model;
+  EXPECT_EQ(balanced.training.class_balance, 0.5);
+  EXPECT_EQ(balanced.training.class_weights,
+            crf::class_balance_weights(balanced.training.class_points, 0.5));
+  ASSERT_EQ(balanced.training.class_weights.size(), 3u);
+  EXPECT_GT(balanced.training.class_weights[2], 1.2 * balanced.training.class_weights[0]);
+  const LabelModel loaded = parse_model(serialize_model(balanced), "balanced");
+  EXPECT_EQ(loaded.training.class_weights, balanced.training.class_weights);
+
+  options.class_balance = 0.0;
+  const LabelModel plain =
+      pipeline::train_label_model(train, {}, class_ids, features, graph, options).model;
+  EXPECT_EQ(plain.training.class_balance, 0.0);
+  EXPECT_TRUE(plain.training.class_weights.empty());
+  EXPECT_FALSE(plain.weights.node_weights.isApprox(balanced.weights.node_weights));
+
+  options.class_balance = 1.5;
+  EXPECT_THROW(pipeline::train_label_model(train, {}, class_ids, features, graph, options),
+               std::invalid_argument);
+  options.class_balance = 0.5;
+  options.kind = ModelKind::kSvm;
+  EXPECT_THROW(pipeline::train_label_model(train, {}, class_ids, features, graph, options),
+               std::invalid_argument);
 }
 
 TEST(PipelineLabeling, UnlabelablePointsGetUnknown) {

@@ -139,6 +139,8 @@ v1::Model to_proto(const LabelModel& m) {
   t->set_point_spacing_min(m.training.point_spacing_min);
   t->set_point_spacing_max(m.training.point_spacing_max);
   t->set_surface_variation_max(m.training.surface_variation_max);
+  t->set_class_balance(m.training.class_balance);
+  for (double w : m.training.class_weights) t->add_class_weights(w);
 
   v1::Evaluation* e = out.mutable_validation();
   e->set_points(m.validation.points), e->set_accuracy(m.validation.accuracy);
@@ -239,6 +241,8 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
   m.training.point_spacing_min = t.point_spacing_min();
   m.training.point_spacing_max = t.point_spacing_max();
   m.training.surface_variation_max = t.surface_variation_max();
+  m.training.class_balance = t.class_balance();
+  m.training.class_weights.assign(t.class_weights().begin(), t.class_weights().end());
 
   const v1::Evaluation& e = in.validation();
   m.validation.points = e.points(), m.validation.accuracy = e.accuracy();

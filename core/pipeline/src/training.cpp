@@ -181,8 +181,13 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
                                       const crf::GraphSettings& graph,
                                       const ModelTrainingOptions& options,
                                       const RunContext& context) {
-  if (options.kind == ModelKind::kSvm)
+  if (!(options.class_balance >= 0.0 && options.class_balance <= 1.0))
+    throw std::invalid_argument("class balance must be in [0, 1]");
+  if (options.kind == ModelKind::kSvm) {
+    if (options.class_balance > 0.0)
+      throw std::invalid_argument("class balance applies to CRF and node-only models, not svm");
     return train_svm_model(training, validation, class_ids, features, graph, options.svm, context);
+  }
   if (training.empty()) throw std::invalid_argument("no training scenes");
   const std::vector<crf::LabeledGraph> train_graphs = graphs_of(training);
   const std::vector<crf::LabeledGraph> val_graphs = graphs_of(validation);
@@ -194,6 +199,10 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
   training_options.max_iterations = options.iterations;
   training_options.node_knots = options.node_knots;
   training_options.on_iteration = options.on_iteration;
+  const TrainingSummary counted = summarize_training(training, class_ids.size());
+  if (options.class_balance > 0.0)
+    training_options.class_weights =
+        crf::class_balance_weights(counted.class_points, options.class_balance);
 
   ModelTrainingResult out;
   const auto start = std::chrono::steady_clock::now();
@@ -212,7 +221,9 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
   m.created_by = "primlabel-train";
 
   TrainingSummary& summary = m.training;
-  summary = summarize_training(training, class_ids.size());
+  summary = counted;
+  summary.class_balance = options.class_balance;
+  summary.class_weights = training_options.class_weights;
   summary.objective = objective_name(options.kind, options.objective);
   summary.l2 = options.l2;
   summary.iterations = std::uint32_t(out.details.iterations);

@@ -204,7 +204,7 @@ class BetheLikelihood final : public Objective {
           partial_loss_(b) = loss;
         });
     context_.throw_if_stopped("Bethe training");
-    return sum_blocks(partial_grad_, partial_loss_, labelled_, gradient);
+    return sum_blocks(partial_grad_, partial_loss_, double(labelled_), gradient);
   }
 
  private:

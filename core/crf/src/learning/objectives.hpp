@@ -1,6 +1,7 @@
 #pragma once
 // The training objectives behind train_crf. Each returns the negated log-(pseudo-)likelihood of
-// the labelled points divided by their number, and its gradient; the L2 term is added by the
+// the labelled points divided by their number (or, with class weights, the weighted sum divided
+// by the weighted count), and its gradient; the L2 term is added by the
 // driver. Parameters are one vector: [W row-major (K x node_row), V row-major (K x (d+1))], V
 // absent for the node-only objective (node_row = node_feature_dim of crf/model.hpp).
 //
@@ -60,8 +61,11 @@ class Objective {
 };
 
 // Pseudo-likelihood; with shape.edges == false, multinomial logistic regression (node-only).
+// `class_weights`: one per class (the term of a point labelled y is weighted by class_weights[y])
+// or empty (unweighted).
 std::unique_ptr<Objective> make_pseudo_likelihood(const std::vector<PreparedScene>& scenes,
-                                                  const ParameterShape& shape, int threads);
+                                                  const ParameterShape& shape, int threads,
+                                                  std::vector<double> class_weights = {});
 
 // Log-likelihood with the Bethe approximation of log Z from loopy sum-product BP (the kernel
 // inference uses), warm-started from the previous evaluation's messages. `context` (threads,
@@ -79,9 +83,9 @@ struct NodeBlock {
 std::vector<NodeBlock> node_blocks(const std::vector<PreparedScene>& scenes);
 
 // The objective from per-block partial results (one gradient column and loss per block), added in
-// block order, not thread order, so it is identical for any thread count; divided by the number
-// of labelled points. Writes `gradient`, returns the value.
+// block order, not thread order, so it is identical for any thread count; divided by the
+// (weighted) number of labelled points. Writes `gradient`, returns the value.
 double sum_blocks(const Eigen::MatrixXd& partial_grad, const Eigen::VectorXd& partial_loss,
-                  std::size_t labelled, Eigen::VectorXd& gradient);
+                  double labelled, Eigen::VectorXd& gradient);
 
 }  // namespace primlabel::crf::detail

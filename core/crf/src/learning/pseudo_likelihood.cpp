@@ -5,9 +5,12 @@
 // (A_i(k) = sum_{j: y_j = k} e_ij) and each class costs one dot product. Without edges a block
 // of nodes is two matrix products (scores, then the gradient) in the identity basis, or 2d short
 // axpy's per node in the tent basis: the fast path of node-only and piecewise training.
+// Class weights scale a point's loss and its residual by the weight of its label; the sum is then
+// divided by the weighted count (with all weights 1, the same numbers bit for bit).
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "learning/objectives.hpp"
 #include "primlabel/geometry/parallel.hpp"
@@ -18,10 +21,19 @@ namespace {
 class PseudoLikelihood final : public Objective {
  public:
   PseudoLikelihood(const std::vector<PreparedScene>& scenes, const ParameterShape& shape,
-                   int threads)
-      : scenes_(scenes), shape_(shape), threads_(threads), blocks_(node_blocks(scenes)) {
+                   int threads, std::vector<double> class_weights)
+      : scenes_(scenes),
+        shape_(shape),
+        threads_(threads),
+        blocks_(node_blocks(scenes)),
+        weights_(std::move(class_weights)) {
+    if (weights_.empty()) weights_.assign(std::size_t(shape_.classes), 1.0);
+    // Per class, then in class order: the same sum for any scene layout.
+    std::vector<std::size_t> counts(weights_.size(), 0);
     for (const auto& s : scenes_)
-      for (int y : s.labels) labelled_ += y >= 0 ? 1 : 0;
+      for (int y : s.labels)
+        if (y >= 0) ++counts[std::size_t(y)];
+    for (std::size_t c = 0; c < counts.size(); ++c) labelled_ += weights_[c] * double(counts[c]);
   }
 
   double evaluate(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) override {
@@ -36,8 +48,9 @@ class PseudoLikelihood final : public Objective {
   }
 
  private:
-  // Scores in, -log p(y_i) out; the row becomes p - [k == y_i] (zeros for an ignored node).
-  static double softmax_residual(Eigen::Ref<Eigen::RowVectorXd> scores, int yi) {
+  // Scores in, -w_{y_i} log p(y_i) out; the row becomes w_{y_i} (p - [k == y_i]) (zeros for an
+  // ignored node).
+  double softmax_residual(Eigen::Ref<Eigen::RowVectorXd> scores, int yi) const {
     if (yi < 0) {
       scores.setZero();
       return 0.0;
@@ -48,7 +61,9 @@ class PseudoLikelihood final : public Objective {
     const double z = scores.sum();
     scores /= z;
     scores(yi) -= 1.0;  // d(-log p(y_i)) / d score = p - [k == y_i]
-    return -(yi_score - top - std::log(z));
+    const double w = weights_[std::size_t(yi)];
+    scores *= w;
+    return -w * (yi_score - top - std::log(z));
   }
 
   // Node-only over one block in the tent basis: each bin touches two rows of w_t (node_row x K),
@@ -172,8 +187,10 @@ class PseudoLikelihood final : public Objective {
             prob = (scores.array() - top).exp();
             const double z = prob.sum();
             prob /= z;
-            loss -= scores(yi) - top - std::log(z);
+            const double weight = weights_[std::size_t(yi)];
+            loss -= weight * (scores(yi) - top - std::log(z));
             prob(yi) -= 1.0;  // d(-log p(y_i)) / d score = p - [k == y_i]
+            prob *= weight;
             grad_w.noalias() += prob * xi;
             for (int l : present) grad_v.row(l) += prob(l) * summed.row(l);
           }
@@ -187,7 +204,8 @@ class PseudoLikelihood final : public Objective {
   ParameterShape shape_;
   int threads_;
   std::vector<NodeBlock> blocks_;
-  std::size_t labelled_ = 0;
+  std::vector<double> weights_;   // per class index
+  double labelled_ = 0.0;         // the weighted number of labelled points
   Eigen::MatrixXd partial_grad_;  // one column per block
   Eigen::VectorXd partial_loss_;
 };
@@ -195,8 +213,9 @@ class PseudoLikelihood final : public Objective {
 }  // namespace
 
 std::unique_ptr<Objective> make_pseudo_likelihood(const std::vector<PreparedScene>& scenes,
-                                                  const ParameterShape& shape, int threads) {
-  return std::make_unique<PseudoLikelihood>(scenes, shape, threads);
+                                                  const ParameterShape& shape, int threads,
+                                                  std::vector<double> class_weights) {
+  return std::make_unique<PseudoLikelihood>(scenes, shape, threads, std::move(class_weights));
 }
 
 }  // namespace primlabel::crf::detail

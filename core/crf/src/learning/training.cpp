@@ -78,14 +78,14 @@ std::vector<NodeBlock> node_blocks(const std::vector<PreparedScene>& scenes) {
 }
 
 double sum_blocks(const Eigen::MatrixXd& partial_grad, const Eigen::VectorXd& partial_loss,
-                  std::size_t labelled, Eigen::VectorXd& gradient) {
+                  double labelled, Eigen::VectorXd& gradient) {
   gradient.setZero(partial_grad.rows());
   double loss = 0.0;
   for (Eigen::Index b = 0; b < partial_grad.cols(); ++b) {
     gradient += partial_grad.col(b);
     loss += partial_loss(b);
   }
-  const double scale = labelled > 0 ? 1.0 / double(labelled) : 0.0;
+  const double scale = labelled > 0 ? 1.0 / labelled : 0.0;
   gradient *= scale;
   return loss * scale;
 }
@@ -182,6 +182,25 @@ class ReportingLineSearch {
 
 }  // namespace
 
+std::vector<double> class_balance_weights(std::span<const std::uint64_t> class_points,
+                                          double alpha) {
+  if (!(alpha >= 0.0 && alpha <= 1.0))
+    throw std::invalid_argument("class balance: alpha must be in [0, 1]");
+  double total = 0.0;
+  int present = 0;
+  for (std::uint64_t n : class_points) {
+    total += double(n);
+    present += n > 0 ? 1 : 0;
+  }
+  if (present == 0) throw std::invalid_argument("class balance: no labelled point");
+  std::vector<double> weights(class_points.size(), 1.0);
+  if (alpha == 0.0) return weights;  // exactly the unweighted objective
+  for (std::size_t c = 0; c < class_points.size(); ++c)
+    if (class_points[c] > 0)
+      weights[c] = std::pow(total / (double(present) * double(class_points[c])), alpha);
+  return weights;
+}
+
 double labeled_accuracy(const CrfModel& model, std::span<const LabeledGraph> scenes,
                         const InferenceSettings& inference, const RunContext& context) {
   std::size_t labelled = 0, correct = 0;
@@ -212,6 +231,17 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
   check_scenes(validation, dim, classes, "validation");
   if (!(options.l2 >= 0.0)) throw std::invalid_argument("train_crf: l2 < 0");
   if (options.max_iterations < 1) throw std::invalid_argument("train_crf: max_iterations < 1");
+  if (!options.class_weights.empty()) {
+    if (options.class_weights.size() != class_ids.size())
+      throw std::invalid_argument("train_crf: class_weights are not one per class");
+    for (double w : options.class_weights)
+      if (!(w > 0.0 && std::isfinite(w)))
+        throw std::invalid_argument("train_crf: a class weight is not positive and finite");
+    if (options.objective == TrainingObjective::kBetheBp)
+      throw std::invalid_argument(
+          "train_crf: class weights need a per-point objective (piecewise, node-only, "
+          "pseudo-likelihood), not bethe");
+  }
   std::size_t total_nodes = 0;
   for (const auto& scene : training) total_nodes += scene.graph.num_nodes();
   const int threads = detail::useful_threads(context.threads, total_nodes);
@@ -245,7 +275,7 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
     bp.tolerance = std::min(options.inference.tolerance, 1e-4f);
     objective = detail::make_bethe(scenes, shape, bp, context.with_threads(threads));
   } else {
-    objective = detail::make_pseudo_likelihood(scenes, shape, threads);
+    objective = detail::make_pseudo_likelihood(scenes, shape, threads, options.class_weights);
   }
 
   TrainingResult result;

@@ -12,6 +12,11 @@
 //                      true neighbour labels, which nearly always agree) and Bethe is slow.
 // The minimised function is  -(1 / P) * objective + (l2 / 2) * |weights without biases|^2, with
 // P the number of labelled points, so l2 means the same for any amount of data.
+// Class weights (TrainingOptions::class_weights, not for kBetheBp) weight every point's term by
+// the weight w_y of its label, and P becomes the weighted count sum_i w_{y_i}: only the ratios of
+// the weights matter. Rare classes (corners are ~0.5% of a table scene) then cost what their
+// errors are worth instead of what their point count is; class_balance_weights gives the usual
+// choice.
 
 #include <cstdint>
 #include <functional>
@@ -56,6 +61,9 @@ struct TrainingOptions {
   float feature_scale = 0.01f;
   // The node feature basis (crf/model.hpp): tent knots, or empty for the paper's identity.
   std::vector<float> node_knots = default_node_knots();
+  // One positive, finite weight per class index, or empty for the unweighted objective (see the
+  // top of this file). Not for kBetheBp, whose log Z does not split into per-point terms.
+  std::vector<double> class_weights;
   // BP used by kBetheBp (sum-product) and to measure accuracies for on_iteration.
   InferenceSettings inference;
   // Called after every L-BFGS iteration with accuracies measured by inference; when empty, no
@@ -81,6 +89,14 @@ TrainingResult train_crf(std::span<const LabeledGraph> training,
                          std::span<const LabeledGraph> validation,
                          const std::vector<std::uint32_t>& class_ids,
                          const TrainingOptions& options = {}, const RunContext& context = {});
+
+// Class weights balancing the labelled point counts n_c (N in all, K classes with points):
+// w_c = (N / (K * n_c))^alpha, alpha in [0, 1]. alpha = 0 gives all ones (the unweighted
+// objective, exactly), alpha = 1 makes every class count as much as any other in total. A class
+// without points gets 1 (it has no terms to weight). Throws std::invalid_argument for alpha
+// outside [0, 1] or no point at all.
+std::vector<double> class_balance_weights(std::span<const std::uint64_t> class_points,
+                                          double alpha);
 
 // Fraction of labelled points (label >= 0) whose predicted class index equals the label.
 double labeled_accuracy(const CrfModel& model, std::span<const LabeledGraph> scenes,

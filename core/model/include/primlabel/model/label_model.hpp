@@ -61,6 +61,10 @@ struct TrainingSummary {
   // The greatest median surface variation of the training scenes' normals (a measure of their
   // range noise at the model's normal radius); 0 when not recorded.
   float surface_variation_max = 0;
+  // The class balance alpha of the objective (crf::class_balance_weights; 0 = unweighted, as in
+  // older files) and the resulting weight per model class (empty when unweighted).
+  double class_balance = 0;
+  std::vector<double> class_weights;
 };
 
 struct EvaluationSummary {

@@ -46,6 +46,9 @@ struct ModelTrainingOptions {
   int iterations = 200;
   // CRF and node-only: the tent basis of the node features (crf/model.hpp); empty = identity.
   std::vector<float> node_knots = crf::default_node_knots();
+  // CRF and node-only: class balance alpha in [0, 1] (crf::class_balance_weights over the
+  // training scenes' labelled points); 0 = the unweighted objective. Not for kSvm or Bethe.
+  double class_balance = 0.0;
   // CRF: scale the learnt couplings down to what labels the validation scenes (or, without them,
   // the training scenes) best, as pseudo-likelihood overestimates them; and keep instead
   // node-only terms with a calibrated Potts coupling when that validates better (training.cpp).
