@@ -76,12 +76,12 @@ build() {
 #   0.42 / 0.45 / 0.32 with 25 mm FPFH and no class balance: 98.35%, 97.45%, 97.22%); without
 #   augmentation and with 10 mm normals 98.5%, 78.9%, 91.8%. About 112 s and 1.03 GB peak.
 # tabletop-kinect: trained and served on 5 mm voxels (the model records the size and the server
-#   applies it, so a 640x480 frame is labeled in a fraction of a second), normals over 30 mm, no
-#   augmentation (it did not help on the real mOSD scenes); see the README's "Depth cameras" for
-#   its figures there, its time and memory. About 30 s and 0.4 GB peak on 2 cores.
+#   applies it, so a 640x480 frame is labeled in a fraction of a second), normals over 30 mm,
+#   class balance 0.25, no augmentation (it did not help on the real mOSD scenes); see the
+#   README's "Depth cameras" for its figures there, its time and memory. About 50 s and 0.5 GB.
 LMS400_RECIPE=(--sensor lms400 --normal-radius 0.015 --feature-radius 0.03 --class-balance 0.25
   --augment "$DEFAULT_AUGMENT")
-KINECT_RECIPE=(--sensor kinect --voxel-size 0.005 --normal-radius 0.03)
+KINECT_RECIPE=(--sensor kinect --voxel-size 0.005 --normal-radius 0.03 --class-balance 0.25)
 
 train_model() {  # REPO NAME RECIPE...: REPO/NAME/1/model.plm unless it exists
   local repo=$1 name=$2
