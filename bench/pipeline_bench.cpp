@@ -28,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "label_stages.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/json_text.hpp"
@@ -243,25 +244,6 @@ int run_stop_latency(const Arguments& args) {
   return 0;
 }
 
-// The stages of label_cloud in ms, in pipeline order (voxel and table-top make up prefilter).
-struct StageColumn {
-  const char* name;
-  double (*ms)(const pipeline::LabelingResult&);
-};
-constexpr StageColumn kStageColumns[] = {
-    {"voxel", [](const pipeline::LabelingResult& r) { return 1e3 * r.voxel_seconds; }},
-    {"index", [](const pipeline::LabelingResult& r) { return 1e3 * r.index_seconds; }},
-    {"lists", [](const pipeline::LabelingResult& r) { return 1e3 * r.lists_seconds; }},
-    {"normals", [](const pipeline::LabelingResult& r) { return 1e3 * r.normal_seconds; }},
-    {"fpfh", [](const pipeline::LabelingResult& r) { return 1e3 * r.descriptor_seconds; }},
-    {"graph", [](const pipeline::LabelingResult& r) { return 1e3 * r.graph_seconds; }},
-    {"infer",
-     [](const pipeline::LabelingResult& r) {
-       return 1e3 * (r.inference_seconds - r.graph_seconds);
-     }},
-    {"fanout", [](const pipeline::LabelingResult& r) { return 1e3 * r.fanout_seconds; }},
-};
-
 int run(const Arguments& args) {
   if (args.stop_latency > 0) return run_stop_latency(args);
   std::optional<LabelModel> given;
@@ -269,7 +251,7 @@ int run(const Arguments& args) {
   std::vector<Row> rows;
   std::printf("%-7s %-10s %3s %6s %8s %8s %8s %8s %7s %8s", "sensor", "model", "thr", "voxel",
               "points", "voxels", "p50 ms", "p90 ms", "frame/s", "cpu ms");
-  for (const StageColumn& c : kStageColumns) std::printf(" %7s", c.name);
+  for (const bench::LabelStage& c : bench::kLabelStages) std::printf(" %7s", c.name);
   std::printf("\n");
   for (const std::string& name : args.sensors) {
     const synth::SensorKind sensor = *synth::sensor_from_name(name);
@@ -287,7 +269,8 @@ int run(const Arguments& args) {
           std::printf("%-7s %-10s %3d %6.3f %8zu %8zu %8.1f %8.1f %7.2f %8.1f", row.sensor.c_str(),
                       row.model.c_str(), row.threads, row.voxel, row.points, row.described,
                       row.p50_ms, row.p90_ms, 1e3 / row.p50_ms, row.cpu_p50_ms);
-          for (const StageColumn& c : kStageColumns) std::printf(" %7.1f", c.ms(row.stages));
+          for (const bench::LabelStage& c : bench::kLabelStages)
+            std::printf(" %7.1f", c.ms(row.stages));
           std::printf("\n");
           std::fflush(stdout);
           rows.push_back(std::move(row));
@@ -297,7 +280,7 @@ int run(const Arguments& args) {
   json::Json out_rows = json::Json::array();
   for (const Row& r : rows) {
     json::Json stages = json::Json::object();
-    for (const StageColumn& c : kStageColumns)
+    for (const bench::LabelStage& c : bench::kLabelStages)
       stages[std::string(c.name) + "_ms"] = json::rounded(c.ms(r.stages), "%.2f");
     out_rows.push_back({{"sensor", r.sensor},
                         {"model", r.model},

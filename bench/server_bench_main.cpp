@@ -28,6 +28,7 @@
 #include <thread>
 
 #include "label_server.hpp"
+#include "label_stages.hpp"
 #include "logging.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
@@ -168,22 +169,6 @@ Latency compare(const char* name, const LabelModel& model, const PointCloud& clo
   return latency;
 }
 
-// The stages of label_cloud in ms, in pipeline order, for the in-process split.
-const std::vector<std::pair<const char*, double (*)(const pipeline::LabelingResult&)>>
-    kLocalStages = {
-        {"voxel", [](const pipeline::LabelingResult& r) { return 1e3 * r.voxel_seconds; }},
-        {"index", [](const pipeline::LabelingResult& r) { return 1e3 * r.index_seconds; }},
-        {"lists", [](const pipeline::LabelingResult& r) { return 1e3 * r.lists_seconds; }},
-        {"normals", [](const pipeline::LabelingResult& r) { return 1e3 * r.normal_seconds; }},
-        {"fpfh", [](const pipeline::LabelingResult& r) { return 1e3 * r.descriptor_seconds; }},
-        {"graph", [](const pipeline::LabelingResult& r) { return 1e3 * r.graph_seconds; }},
-        {"infer",
-         [](const pipeline::LabelingResult& r) {
-           return 1e3 * (r.inference_seconds - r.graph_seconds);
-         }},
-        {"fanout", [](const pipeline::LabelingResult& r) { return 1e3 * r.fanout_seconds; }},
-};
-
 struct FrameFigures {
   std::string name;
   std::size_t points = 0, described = 0;
@@ -238,7 +223,8 @@ FrameFigures frame_figures(const std::string& label, const std::string& name,
   out.local_p90 = percentile(local_ms, 0.9);
   out.server_stages = server_stages[nearest_to(server_ms, out.server_p50)];
   const pipeline::LabelingResult& local = local_results[nearest_to(local_ms, out.local_p50)];
-  for (const auto& [stage, ms] : kLocalStages) out.local_stages.emplace_back(stage, ms(local));
+  for (const bench::LabelStage& stage : bench::kLabelStages)
+    out.local_stages.emplace_back(stage.name, stage.ms(local));
 
   std::printf(
       "%-24s %7zu points (%6zu described, voxel %.3f m): server p50 %7.1f ms p90 %7.1f ms "
