@@ -68,10 +68,41 @@ class NeighborCache {
   std::atomic<std::size_t> used_{0};
 };
 
+// The value of a bin that `c` pairs fell in, for each c <= neighbours: 100 / (neighbours - 1)
+// added c times, as PCL adds it (c * increment rounds differently). Computed once per neighbour
+// count and thread: a long chain of dependent additions per bin otherwise.
+class IncrementSums {
+ public:
+  const float* for_neighbors(std::size_t neighbors) {
+    // Kept per count up to kKept (at most ~8 MB a thread); larger lists rebuild theirs, which
+    // costs less than their pairs.
+    constexpr std::size_t kKept = 2048;
+    if (neighbors > kKept) {
+      fill(neighbors, uncached_);
+      return uncached_.data();
+    }
+    if (neighbors >= tables_.size()) tables_.resize(neighbors + 1);
+    std::vector<float>& table = tables_[neighbors];
+    if (table.empty()) fill(neighbors, table);
+    return table.data();
+  }
+
+ private:
+  static void fill(std::size_t neighbors, std::vector<float>& table) {
+    const float increment = 100.0f / static_cast<float>(neighbors - 1);
+    table.resize(neighbors + 1);  // a point missing from its own list pairs with all
+    float sum = 0.0f;
+    for (std::size_t c = 0; c <= neighbors; ++c, sum += increment) table[c] = sum;
+  }
+  std::vector<std::vector<float>> tables_;  // by neighbour count; filled when first needed
+  std::vector<float> uncached_;
+};
+
 // Scratch space of one thread for compute_spfh.
 struct SpfhScratch {
   detail::PairTargets targets;
   std::vector<std::uint8_t> alpha, phi, theta;
+  IncrementSums sums;
 };
 
 void compute_spfh(const PointCloud& cloud, std::size_t p, const NeighborList& neighbors,
@@ -91,9 +122,8 @@ void compute_spfh(const PointCloud& cloud, std::size_t p, const NeighborList& ne
     ++counts[2 * kBins + scratch.theta[j]];
   }
   // Repeated float additions, not count * increment: the rounding then matches PCL's bit for bit.
-  const float increment = 100.0f / static_cast<float>(neighbors.size() - 1);
-  for (int b = 0; b < kFpfhSize; ++b)
-    for (std::uint32_t c = 0; c < counts[b]; ++c) spfh[b] += increment;
+  const float* sum_of = scratch.sums.for_neighbors(neighbors.size());
+  for (int b = 0; b < kFpfhSize; ++b) spfh[b] = sum_of[counts[b]];
 }
 
 // Squared distance, recomputed the same way for cached and searched lists so that the weights

@@ -124,27 +124,18 @@ void NeighborLists::find(std::size_t i, const Neighborhood& hood, NeighborList& 
   search_.find(points_[i], hood, out, /*sorted=*/false);
 }
 
-bool NeighborLists::nearest(std::size_t i, int k, const std::vector<std::uint8_t>& allowed,
-                            NeighborList& out) const {
-  if (k <= 0) return false;
-  thread_local NeighborList scratch;
-  const std::uint32_t* indices = nullptr;
-  const float* sq_dists = nullptr;
-  std::size_t count = 0;
-  if (!shared(i, scratch, indices, sq_dists, count)) return false;
-  // The k smallest (squared distance, index) pairs, a total order, so they do not depend on the
-  // stored order: kept sorted by insertion into a local array (k is small, the lists a few
-  // hundred long, and most entries fail the first comparison).
-  using Entry = std::pair<float, std::uint32_t>;
-  constexpr std::size_t kOnStack = 32;
-  Entry on_stack[kOnStack];
-  std::vector<Entry> on_heap;
-  const std::size_t want = std::size_t(k);
-  if (want > kOnStack) on_heap.resize(want);
-  Entry* best = want > kOnStack ? on_heap.data() : on_stack;
+namespace {
+using Entry = std::pair<float, std::uint32_t>;  // (squared distance, index): a total order
+
+// The `want` smallest entries among those with sq <= bound and allowed[index], kept sorted by
+// insertion into `best` (k is small and most entries fail the first comparison); how many.
+std::size_t smallest_within(const std::uint32_t* indices, const float* sq_dists, std::size_t count,
+                            float bound, const std::vector<std::uint8_t>& allowed, Entry* best,
+                            std::size_t want) {
   std::size_t have = 0;
   for (std::size_t p = 0; p < count; ++p) {
     const float sq = sq_dists[p];
+    if (!(sq <= bound)) continue;
     if (have == want && sq > best[want - 1].first) continue;
     const Entry entry(sq, indices[p]);
     if (have == want && !(entry < best[want - 1])) continue;
@@ -153,7 +144,38 @@ bool NeighborLists::nearest(std::size_t i, int k, const std::vector<std::uint8_t
     for (; j > 0 && entry < best[j - 1]; --j) best[j] = best[j - 1];
     best[j] = entry;
   }
+  return have;
+}
+}  // namespace
+
+bool NeighborLists::nearest(std::size_t i, int k, const std::vector<std::uint8_t>& allowed,
+                            NeighborList& out) const {
+  if (k <= 0) return false;
+  thread_local NeighborList scratch;
+  const std::uint32_t* indices = nullptr;
+  const float* sq_dists = nullptr;
+  std::size_t count = 0;
+  if (!shared(i, scratch, indices, sq_dists, count)) return false;
+  constexpr std::size_t kOnStack = 32;
+  Entry on_stack[kOnStack];
+  std::vector<Entry> on_heap;
+  const std::size_t want = std::size_t(k);
+  if (want > kOnStack) on_heap.resize(want);
+  Entry* best = want > kOnStack ? on_heap.data() : on_stack;
+  // The lists are a few hundred long and the k nearest a few dozen: first only the entries
+  // within twice the k-th squared distance of this thread's previous point (neighbouring points
+  // have similar densities). Every entry left out is farther than all that were taken, so when
+  // k of them are allowed they are the answer; otherwise the whole list decides. The bound
+  // changes only the work, never the result, so the thread count cannot change it either.
+  thread_local float previous_kth = 0.0f;
+  std::size_t have = 0;
+  if (previous_kth > 0.0f)
+    have = smallest_within(indices, sq_dists, count, 2.0f * previous_kth, allowed, best, want);
+  if (have < want)
+    have = smallest_within(indices, sq_dists, count, std::numeric_limits<float>::infinity(),
+                           allowed, best, want);
   if (have < want) return false;
+  previous_kth = best[want - 1].first;
   out.indices.resize(want);
   out.sq_dists.resize(want);
   for (std::size_t j = 0; j < want; ++j) {
