@@ -1,9 +1,11 @@
 #include "primlabel/tabletop/voxel_grid.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "primlabel/geometry/cancellation.hpp"
 
@@ -40,6 +42,29 @@ void sort_checked(std::vector<T>& v, const std::stop_token& stop) {
     }
 }
 
+// Stable LSD radix sort of (key, index) pairs by key, 11 bits a pass over the `key_bits` that
+// the keys use: 3 passes for a depth frame where std::sort needs ~18 comparisons a pair. With the
+// indices ascending on input this is the order std::sort gives the pairs.
+void radix_sort_checked(std::vector<std::pair<std::uint64_t, std::uint32_t>>& v, int key_bits,
+                        const std::stop_token& stop) {
+  constexpr int kDigitBits = 11;
+  constexpr std::size_t kBuckets = std::size_t(1) << kDigitBits;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> other(v.size());
+  std::vector<std::size_t> counts(kBuckets);
+  for (int shift = 0; shift < key_bits; shift += kDigitBits) {
+    throw_if_stopped(stop, kWhat);
+    std::fill(counts.begin(), counts.end(), 0);
+    for (const auto& entry : v) ++counts[(entry.first >> shift) & (kBuckets - 1)];
+    std::size_t total = 0;
+    for (std::size_t& c : counts) total += std::exchange(c, total);
+    for (std::size_t k = 0; k < v.size(); ++k) {
+      if (k % kCheckEvery == 0) throw_if_stopped(stop, kWhat);
+      other[counts[(v[k].first >> shift) & (kBuckets - 1)]++] = v[k];
+    }
+    v.swap(other);
+  }
+}
+
 }  // namespace
 
 VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
@@ -70,6 +95,11 @@ VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
                                 " m: a point far from the others?)");
 
   // Sorting (key, index) pairs makes the voxel order and member order independent of the input.
+  // The key orders cells by (z, y, x) and uses only the bits the extent needs.
+  std::uint64_t cells[3];
+  for (int axis = 0; axis < 3; ++axis)
+    cells[axis] =
+        static_cast<std::uint64_t>(std::floor((double(hi[axis]) - double(lo[axis])) * inv)) + 1;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
   keyed.reserve(indices.size());
   for (std::size_t k = 0; k < indices.size(); ++k) {
@@ -77,11 +107,16 @@ VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
     const std::uint32_t i = indices[k];
     const Vec3f& p = points[i];
     const auto cell = [&](int axis) {
-      return static_cast<std::uint64_t>(std::floor((double(p[axis]) - lo[axis]) * inv));
+      return std::min(cells[axis] - 1,
+                      static_cast<std::uint64_t>(std::floor((double(p[axis]) - lo[axis]) * inv)));
     };
-    keyed.emplace_back((cell(2) << 42) | (cell(1) << 21) | cell(0), i);
+    keyed.emplace_back((cell(2) * cells[1] + cell(1)) * cells[0] + cell(0), i);
   }
-  sort_checked(keyed, stop);
+  const std::uint64_t largest_key = cells[0] * cells[1] * cells[2] - 1;
+  if (std::is_sorted(indices.begin(), indices.end()))
+    radix_sort_checked(keyed, std::bit_width(largest_key), stop);
+  else
+    sort_checked(keyed, stop);
 
   grid.members.reserve(keyed.size());
   for (std::size_t begin = 0; begin < keyed.size();) {

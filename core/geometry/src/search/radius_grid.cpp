@@ -40,7 +40,6 @@ std::unique_ptr<RadiusGrid> RadiusGrid::build(const FinitePoints& points, float 
   if (cells > max_cells) return nullptr;
 
   auto grid = std::unique_ptr<RadiusGrid>(new RadiusGrid);
-  grid->cloud_ = points.cloud();
   grid->origin_ = lo;
   grid->inv_cell_ = 1.0f / radius;
   for (int d = 0; d < 3; ++d) grid->dims_[d] = dims[d];
@@ -53,10 +52,13 @@ std::unique_ptr<RadiusGrid> RadiusGrid::build(const FinitePoints& points, float 
   }
   std::partial_sum(grid->starts_.begin(), grid->starts_.end(), grid->starts_.begin());
   grid->index_.resize(n);
+  grid->points_.resize(n);
   std::vector<std::size_t> fill(grid->starts_.begin(), grid->starts_.end() - 1);
   for (std::size_t i = 0; i < n; ++i) {  // stable: points keep their cloud order within a cell
     if (stop_at(i)) return nullptr;
-    grid->index_[fill[cell_of[i]]++] = points.cloud_index(i);
+    const std::size_t slot = fill[cell_of[i]]++;
+    grid->index_[slot] = points.cloud_index(i);
+    grid->points_[slot] = points[i];
   }
   return grid;
 }

@@ -2,9 +2,9 @@
 // Fixed-radius queries on dense scans return hundreds of points; walking the k-d tree for them
 // costs more than scanning the few grid cells that can hold them. Cells are as wide as the
 // radius and ordered x-fastest, so the <= 3 cells along x of each (y, z) row are one contiguous
-// run: at most 9 runs per query. The grid keeps only cloud indices in cell order and reads the
-// caller's points through them. Distances are computed in nanoflann's order, so a grid query
-// returns exactly the set the k-d tree would.
+// run: at most 9 runs per query. The grid keeps the points and their cloud indices in cell order.
+// Distances are computed in nanoflann's order, so a grid query returns exactly the set the k-d tree
+// would.
 
 #include <array>
 #include <cstddef>
@@ -46,7 +46,7 @@ class RadiusGrid {
         out.sq_dists.resize(count + (last - first));
         for (std::size_t i = first; i < last; ++i) {
           const std::uint32_t index = index_[i];
-          const Vec3f& p = cloud_[index];
+          const Vec3f& p = points_[i];
           // nanoflann's L2_Simple_Adaptor: ((0 + dx^2) + dy^2) + dz^2.
           const float dx = q.x() - p.x(), dy = q.y() - p.y(), dz = q.z() - p.z();
           const float sq = (dx * dx + dy * dy) + dz * dz;
@@ -69,7 +69,9 @@ class RadiusGrid {
     return static_cast<std::size_t>((c[2] * dims_[1] + c[1]) * dims_[0] + c[0]);
   }
 
-  const Vec3f* cloud_ = nullptr;  // the caller's points, by cloud index
+  // The points in cell order: a query reads its runs contiguously instead of gathering them
+  // from the cloud (12 bytes a point; the gathers were most of a dense query's time).
+  std::vector<Vec3f> points_;
   Vec3f origin_;
   float inv_cell_ = 1.0f;
   std::int64_t dims_[3] = {1, 1, 1};
