@@ -1,8 +1,13 @@
 // The `primlabel` CLI as a script runs it, against the in-process fake server: output files and
-// the documented exit codes (0 ok, 1 usage, 2 file, 3 unavailable, 4 rejected).
+// the documented exit codes (0 ok, 1 file, 2 usage, 3 unavailable, 4 rejected); the server
+// address from --server or $PRIMLABEL_SERVER; what `info` prints for people.
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
+#include "common/server_address.hpp"
 #include "fake_labeler.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "test_util.hpp"
@@ -137,6 +142,31 @@ TEST(ClientCli, RejectedRequestExitsFourWithTheStatus) {
   r = test::run_command(cli() + " --server " + server.address() + " --token-file " +
                         dir.file("token") + " label " + dir.file("scan.pcd"));
   EXPECT_EQ(r.exit_code, 0) << r.output;
+}
+
+TEST(ClientCli, ServerAddressWithoutAPortGetsTheServersDefaultPort) {
+  using client::tools::server_address_with_port;
+  EXPECT_EQ(client::tools::kDefaultServerPort, 50051);  // primlabel-server --listen's default
+  EXPECT_EQ(server_address_with_port("labeler"), "labeler:50051");
+  EXPECT_EQ(server_address_with_port("127.0.0.1"), "127.0.0.1:50051");
+  EXPECT_EQ(server_address_with_port("labeler:7000"), "labeler:7000");
+  EXPECT_EQ(server_address_with_port("[::1]"), "[::1]:50051");
+  EXPECT_EQ(server_address_with_port("[::1]:7000"), "[::1]:7000");
+  EXPECT_EQ(server_address_with_port("::1"), "[::1]:50051");
+  EXPECT_EQ(server_address_with_port("dns:///labeler:7000"), "dns:///labeler:7000");
+  EXPECT_EQ(server_address_with_port("unix:/run/primlabel.sock"), "unix:/run/primlabel.sock");
+  for (const char* bad : {"", "labeler:", "labeler:0", "labeler:x", "labeler:70000", ":50051",
+                          "[::1", "[::1]x", "a b", "labeler:-1"})
+    EXPECT_THROW(server_address_with_port(bad), std::invalid_argument) << bad;
+}
+
+TEST(ClientCli, ABadServerAddressIsAUsageErrorNamingIt) {
+  for (const std::string address : {"labeler:", "labeler:0", "labeler:http"}) {
+    const auto r = test::run_command(cli() + " --server " + address + " health");
+    EXPECT_EQ(r.exit_code, 2) << address << ": " << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("'" + address + "'"), std::string::npos) << r.output;
+  }
 }
 
 }  // namespace
