@@ -167,6 +167,23 @@ TEST(ClientCli, ABadServerAddressIsAUsageErrorNamingIt) {
     EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find("'" + address + "'"), std::string::npos) << r.output;
   }
+  const auto r = test::run_command("PRIMLABEL_SERVER=labeler: " + cli() + " health");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+// $PRIMLABEL_SERVER stands in for --server; the flag wins over it.
+TEST(ClientCli, PrimlabelServerFromTheEnvironmentAndTheFlagWins) {
+  FakeServer server;
+  auto r = test::run_command("PRIMLABEL_SERVER=" + server.address() + " " + cli() + " health");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output, "SERVING\n");
+  r = test::run_command("PRIMLABEL_SERVER=" + dead_address() + " " + cli() + " --server " +
+                        server.address() + " health");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_command("PRIMLABEL_SERVER=" + dead_address() + " " + cli() + " --retries 1 health");
+  EXPECT_EQ(r.exit_code, 3) << r.output;  // the environment is used when the flag is absent
+  r = test::run_command("PRIMLABEL_SERVER=" + server.address() + " " + cli() + " --help");
+  EXPECT_NE(r.output.find("PRIMLABEL_SERVER"), std::string::npos) << r.output;
 }
 
 }  // namespace

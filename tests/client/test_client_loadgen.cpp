@@ -199,6 +199,22 @@ TEST(LoadgenCli, SweepReportsMatchTheServersCounters) {
   EXPECT_EQ(matches, 2u) << r.output;
 }
 
+// The load generator takes $PRIMLABEL_SERVER like the CLI, and HOST alone means port 50051.
+TEST(LoadgenCli, ServerFromTheEnvironmentAndTheDefaultPort) {
+  FakeServer server;
+  test::TempDir dir;
+  write_cloud(dir.file("a.pcd"), test::random_box(100, 1.0f, 5));
+  const std::string tool = test::binary("primlabel-loadgen");
+  auto r = test::run_command("PRIMLABEL_SERVER=" + server.address() + " " + tool + " " +
+                             dir.file("a.pcd") + " --requests 2 --format json");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(server.service.label_calls, 2);
+  // Whatever listens on 50051 here (or nothing), the address it dials is the default port's.
+  r = test::run_command(tool + " --server 127.0.0.1 " + dir.file("a.pcd") +
+                        " --requests 1 --deadline 1 --format json");
+  EXPECT_NE(r.output.find("points on average, 127.0.0.1:50051"), std::string::npos) << r.output;
+}
+
 TEST(LoadgenCli, SynthCloudsOpenLoopJsonAndUsageErrors) {
   FakeServer server;
   const std::string tool = test::binary("primlabel-loadgen");

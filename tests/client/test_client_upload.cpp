@@ -523,6 +523,17 @@ TEST(UploadCli, AFullSpoolDiskRejectsWithExitFiveAndARestartDrainsBeforeTakingMo
   EXPECT_EQ(files_in(disk.path("spool/scans")), 0u);
 }
 
+TEST(UploadCli, TheServerComesFromPrimlabelServerWhenNoFlagGivesIt) {
+  FakeServer server;
+  test::TempDir dir;
+  write_bytes(dir.file("a.pcd"), scan_bytes(62));
+  const auto r = test::run_command("PRIMLABEL_SERVER=" + server.address() + " " + upload_tool() +
+                                   " -q --spool " + dir.file("spool") + " -o " + dir.file("out") +
+                                   " " + dir.file("a.pcd"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(server.service.label_calls, 1);
+}
+
 TEST(UploadCli, ACorruptSpoolEntryIsReportedAndExitsFour) {
   FakeServer server;
   test::TempDir dir;

@@ -35,6 +35,7 @@ void ConnectionFlags::add_to(CLI::App& app) {
   app.add_option(
          "--server", server,
          "Server address HOST:PORT; HOST alone means port " + std::to_string(kDefaultServerPort))
+      ->envname("PRIMLABEL_SERVER")
       ->transform(address)
       ->capture_default_str();
   app.add_option("--token-file", token_file,
