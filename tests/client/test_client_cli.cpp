@@ -186,5 +186,18 @@ TEST(ClientCli, PrimlabelServerFromTheEnvironmentAndTheFlagWins) {
   EXPECT_NE(r.output.find("PRIMLABEL_SERVER"), std::string::npos) << r.output;
 }
 
+TEST(ClientCli, APassedDeadlineNamesTheDeadlineFlag) {
+  FakeServer server;
+  server.service.delay_ms = 5000;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  const auto r = test::run_command(cli() + " --deadline 0.3 --server " + server.address() +
+                                   " label " + dir.file("scan.pcd"));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("DEADLINE_EXCEEDED"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--deadline is 0.3 s"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace primlabel
