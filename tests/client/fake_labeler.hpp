@@ -27,6 +27,7 @@ class FakeLabeler final : public v1::Labeler::Service {
  public:
   static constexpr int kDescriptorDim = 33;
   static constexpr int kClasses = 3;
+  static constexpr std::int64_t kCreatedUnixMs = 1767323045123;  // 2026-01-02 03:04:05.123 UTC
 
   std::atomic<int> unavailable_calls{0};  // fail this many next calls with UNAVAILABLE
   std::atomic<bool> skip_a_point{false};  // answer without the last point
@@ -132,11 +133,18 @@ class FakeLabeler final : public v1::Labeler::Service {
       return {grpc::StatusCode::NOT_FOUND, "no model '" + request->model() + "'"};
     response->set_name("fake");
     response->set_version("1");
+    response->set_created_unix_ms(kCreatedUnixMs);
+    response->set_created_by("fake-trainer");
     for (int c = 0; c < kClasses; ++c) {
       auto* cls = response->add_classes();
       cls->set_id(c);
       cls->set_name("class-" + std::to_string(c));
     }
+    // Class 1 had no validation points (F1 undefined); class 2 has no score entry.
+    response->mutable_validation()->set_points(100);
+    response->mutable_validation()->set_accuracy(0.9);
+    response->mutable_validation()->add_per_class()->set_f1(0.5);
+    response->mutable_validation()->add_per_class()->set_f1(std::nan(""));
     return grpc::Status::OK;
   }
 

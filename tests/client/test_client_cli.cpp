@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "common/human_format.hpp"
 #include "common/server_address.hpp"
 #include "fake_labeler.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
@@ -197,6 +198,35 @@ TEST(ClientCli, APassedDeadlineNamesTheDeadlineFlag) {
   EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("DEADLINE_EXCEEDED"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("--deadline is 0.3 s"), std::string::npos) << r.output;
+}
+
+TEST(ClientCli, InfoPrintsTheCreationDateAndNaForUndefinedScores) {
+  FakeServer server;
+  const auto r = test::run_command(cli() + " --server " + server.address() + " info fake");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("created    2026-01-02 03:04:05 UTC ("), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" ago) by fake-trainer"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("1767323045"), std::string::npos) << r.output;  // no raw milliseconds
+  EXPECT_NE(r.output.find("class-0            F1 0.500"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("class-1            F1 n/a"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("class-2            F1 n/a"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("nan"), std::string::npos) << r.output;
+}
+
+TEST(ClientCli, HumanUnitsForTimesAndScores) {
+  using namespace client::tools;
+  const std::int64_t t = 1767323045123;  // 2026-01-02 03:04:05.123 UTC
+  EXPECT_EQ(describe_unix_ms(t, t + 45'000), "2026-01-02 03:04:05 UTC (45 s ago)");
+  EXPECT_EQ(describe_unix_ms(t, t + 3 * 60'000 + 5'000), "2026-01-02 03:04:05 UTC (3 min ago)");
+  EXPECT_EQ(describe_unix_ms(t, t + 5 * 3'600'000LL), "2026-01-02 03:04:05 UTC (5 h ago)");
+  EXPECT_EQ(describe_unix_ms(t, t + 3 * 86'400'000LL), "2026-01-02 03:04:05 UTC (3 days ago)");
+  EXPECT_EQ(describe_unix_ms(t, t - 1000), "2026-01-02 03:04:05 UTC (in the future)");
+  EXPECT_EQ(describe_unix_ms(0, t), "unknown");
+  EXPECT_EQ(describe_age_ms(-5000), "0 s");
+  EXPECT_EQ(score_or_na(0.98765), "0.988");
+  EXPECT_EQ(score_or_na(0.98765, 4), "0.9877");
+  EXPECT_EQ(score_or_na(std::nan("")), "n/a");
+  EXPECT_EQ(score_or_na(std::numeric_limits<double>::infinity()), "n/a");
 }
 
 }  // namespace
