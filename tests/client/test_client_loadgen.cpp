@@ -77,7 +77,12 @@ TEST(LoadgenStats, MetricsUrlTakesUrlsAndHostPort) {
   EXPECT_EQ(metrics_url_from("labeler:9464"), "http://labeler:9464/metrics");
   EXPECT_EQ(metrics_url_from("http://labeler:9464/metrics"), "http://labeler:9464/metrics");
   EXPECT_EQ(metrics_url_from("https://labeler/prom/metrics"), "https://labeler/prom/metrics");
-  for (const char* bad : {"", "ftp://labeler/metrics", "file:///etc/passwd", "a b:1", "h:1\n"})
+  // A URL without a path scrapes /metrics, as HOST:PORT does; a path is kept.
+  EXPECT_EQ(metrics_url_from("http://127.0.0.1:9464"), "http://127.0.0.1:9464/metrics");
+  EXPECT_EQ(metrics_url_from("http://127.0.0.1:9464/"), "http://127.0.0.1:9464/metrics");
+  EXPECT_EQ(metrics_url_from("labeler:9464/prom/metrics"), "http://labeler:9464/prom/metrics");
+  for (const char* bad : {"", "ftp://labeler/metrics", "file:///etc/passwd", "a b:1", "h:1\n",
+                          "http://", "http:///metrics"})
     EXPECT_THROW(metrics_url_from(bad), std::invalid_argument) << bad;
   // Nothing listens on port 1: a clear error, not a hang.
   EXPECT_THROW(read_server_counts("127.0.0.1:1", "Label", 2000), std::runtime_error);
