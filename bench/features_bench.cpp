@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "pcl_availability.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/features.hpp"
@@ -353,8 +354,8 @@ int run_features_bench(const FeaturesBenchOptions& options) {
   if (!normal_hood || !feature_hood) return kExitUsage;
 #ifndef PRIMLABEL_HAVE_PCL
   if (options.compare_pcl) {
-    std::cerr << "primlabel-bench features: --compare-pcl needs a build with PCL "
-                 "(libpcl-dev installed and -DPRIMLABEL_WITH_PCL=ON)\n";
+    std::cerr << "primlabel-bench features: --compare-pcl needs PCL: "
+              << pcl_unavailable_reason("PCL 1.13 (common, features, kdtree, search, io)") << "\n";
     return kExitUsage;
   }
 #endif

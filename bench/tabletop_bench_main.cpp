@@ -12,6 +12,7 @@
 #include <limits>
 #include <sstream>
 
+#include "pcl_availability.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
@@ -169,9 +170,10 @@ int main(int argc, char** argv) {
   }
 #ifndef PRIMLABEL_HAVE_PCL
   if (args.compare_pcl) {
-    std::fprintf(stderr,
-                 "primlabel-bench-tabletop: error: built without PCL (install libpcl-dev and "
-                 "rebuild) for --compare-pcl\n");
+    std::fprintf(stderr, "primlabel-bench-tabletop: error: --compare-pcl needs PCL: %s\n",
+                 primlabel::bench::pcl_unavailable_reason(
+                     "PCL 1.13 with its segmentation and surface components")
+                     .c_str());
     return primlabel::kExitFailure;
   }
 #endif

@@ -5,6 +5,8 @@
 //   primlabel-render features.pcd -o curvature.png --field curvature --view top
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 
@@ -110,7 +112,17 @@ int main(int argc, char** argv) {
   app.name("primlabel-render");
   Arguments args;
   app.add_option("input", args.input, "input cloud (.pcd or .ply)")->required();
-  app.add_option("-o,--output", args.output, "output image (.png)")->required();
+  // Only PNG is written: a .jpg name would get PNG bytes that viewers mistake or refuse.
+  const CLI::Validator png_name(
+      [](std::string& name) {
+        std::string ext = std::filesystem::path(name).extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(),
+                       [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+        if (ext == ".png") return std::string();
+        return "'" + name + "': primlabel-render writes PNG only; name the output *.png";
+      },
+      "FILE.png");
+  app.add_option("-o,--output", args.output, "output image (.png)")->required()->check(png_name);
   app.add_option("--field", args.field,
                  "colour by: label (default when present), rgb, x, y, z, curvature or any "
                  "float field (first value)");

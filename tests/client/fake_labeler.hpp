@@ -27,8 +27,10 @@ class FakeLabeler final : public v1::Labeler::Service {
  public:
   static constexpr int kDescriptorDim = 33;
   static constexpr int kClasses = 3;
+  static constexpr std::int64_t kCreatedUnixMs = 1767323045123;  // 2026-01-02 03:04:05.123 UTC
 
   std::atomic<int> unavailable_calls{0};  // fail this many next calls with UNAVAILABLE
+  std::atomic<int> exhausted_calls{0};    // then this many with RESOURCE_EXHAUSTED (admission)
   std::atomic<bool> skip_a_point{false};  // answer without the last point
   std::atomic<bool> repeat_a_point{false};
   std::atomic<bool> reversed_chunks{false};  // send chunks last first (still a valid answer)
@@ -132,11 +134,18 @@ class FakeLabeler final : public v1::Labeler::Service {
       return {grpc::StatusCode::NOT_FOUND, "no model '" + request->model() + "'"};
     response->set_name("fake");
     response->set_version("1");
+    response->set_created_unix_ms(kCreatedUnixMs);
+    response->set_created_by("fake-trainer");
     for (int c = 0; c < kClasses; ++c) {
       auto* cls = response->add_classes();
       cls->set_id(c);
       cls->set_name("class-" + std::to_string(c));
     }
+    // Class 1 had no validation points (F1 undefined); class 2 has no score entry.
+    response->mutable_validation()->set_points(100);
+    response->mutable_validation()->set_accuracy(0.9);
+    response->mutable_validation()->add_per_class()->set_f1(0.5);
+    response->mutable_validation()->add_per_class()->set_f1(std::nan(""));
     return grpc::Status::OK;
   }
 
@@ -154,11 +163,18 @@ class FakeLabeler final : public v1::Labeler::Service {
           std::string(it->second.data(), it->second.size()) != "Bearer " + required_token)
         return {grpc::StatusCode::UNAUTHENTICATED, "missing or wrong bearer token"};
     }
-    int expected = unavailable_calls.load();
-    while (expected > 0 && !unavailable_calls.compare_exchange_weak(expected, expected - 1)) {
-    }
-    if (expected > 0) return {grpc::StatusCode::UNAVAILABLE, "fake: try again"};
+    if (take_one(unavailable_calls)) return {grpc::StatusCode::UNAVAILABLE, "fake: try again"};
+    if (take_one(exhausted_calls))
+      return {grpc::StatusCode::RESOURCE_EXHAUSTED, "fake: all workers busy (--queue)"};
     return grpc::Status::OK;
+  }
+
+  // Decrements `budget` when it is positive; true when it was.
+  static bool take_one(std::atomic<int>& budget) {
+    int expected = budget.load();
+    while (expected > 0 && !budget.compare_exchange_weak(expected, expected - 1)) {
+    }
+    return expected > 0;
   }
 
   grpc::Status answer(const v1::ScanHeader& header, const std::vector<Vec3f>& points,

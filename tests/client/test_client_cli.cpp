@@ -1,8 +1,14 @@
 // The `primlabel` CLI as a script runs it, against the in-process fake server: output files and
-// the documented exit codes (0 ok, 1 usage, 2 file, 3 unavailable, 4 rejected).
+// the documented exit codes (0 ok, 1 file, 2 usage, 3 unavailable, 4 rejected); the server
+// address from --server or $PRIMLABEL_SERVER; what `info` prints for people.
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
+#include "common/human_format.hpp"
+#include "common/server_address.hpp"
 #include "fake_labeler.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "test_util.hpp"
@@ -137,6 +143,90 @@ TEST(ClientCli, RejectedRequestExitsFourWithTheStatus) {
   r = test::run_command(cli() + " --server " + server.address() + " --token-file " +
                         dir.file("token") + " label " + dir.file("scan.pcd"));
   EXPECT_EQ(r.exit_code, 0) << r.output;
+}
+
+TEST(ClientCli, ServerAddressWithoutAPortGetsTheServersDefaultPort) {
+  using client::tools::server_address_with_port;
+  EXPECT_EQ(client::tools::kDefaultServerPort, 50051);  // primlabel-server --listen's default
+  EXPECT_EQ(server_address_with_port("labeler"), "labeler:50051");
+  EXPECT_EQ(server_address_with_port("127.0.0.1"), "127.0.0.1:50051");
+  EXPECT_EQ(server_address_with_port("labeler:7000"), "labeler:7000");
+  EXPECT_EQ(server_address_with_port("[::1]"), "[::1]:50051");
+  EXPECT_EQ(server_address_with_port("[::1]:7000"), "[::1]:7000");
+  EXPECT_EQ(server_address_with_port("::1"), "[::1]:50051");
+  EXPECT_EQ(server_address_with_port("dns:///labeler:7000"), "dns:///labeler:7000");
+  EXPECT_EQ(server_address_with_port("unix:/run/primlabel.sock"), "unix:/run/primlabel.sock");
+  for (const char* bad : {"", "labeler:", "labeler:0", "labeler:x", "labeler:70000", ":50051",
+                          "[::1", "[::1]x", "a b", "labeler:-1"})
+    EXPECT_THROW(server_address_with_port(bad), std::invalid_argument) << bad;
+}
+
+TEST(ClientCli, ABadServerAddressIsAUsageErrorNamingIt) {
+  for (const std::string address : {"labeler:", "labeler:0", "labeler:http"}) {
+    const auto r = test::run_command(cli() + " --server " + address + " health");
+    EXPECT_EQ(r.exit_code, 2) << address << ": " << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("'" + address + "'"), std::string::npos) << r.output;
+  }
+  const auto r = test::run_command("PRIMLABEL_SERVER=labeler: " + cli() + " health");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+// $PRIMLABEL_SERVER stands in for --server; the flag wins over it.
+TEST(ClientCli, PrimlabelServerFromTheEnvironmentAndTheFlagWins) {
+  FakeServer server;
+  auto r = test::run_command("PRIMLABEL_SERVER=" + server.address() + " " + cli() + " health");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output, "SERVING\n");
+  r = test::run_command("PRIMLABEL_SERVER=" + dead_address() + " " + cli() + " --server " +
+                        server.address() + " health");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  r = test::run_command("PRIMLABEL_SERVER=" + dead_address() + " " + cli() + " --retries 1 health");
+  EXPECT_EQ(r.exit_code, 3) << r.output;  // the environment is used when the flag is absent
+  r = test::run_command("PRIMLABEL_SERVER=" + server.address() + " " + cli() + " --help");
+  EXPECT_NE(r.output.find("PRIMLABEL_SERVER"), std::string::npos) << r.output;
+}
+
+TEST(ClientCli, APassedDeadlineNamesTheDeadlineFlag) {
+  FakeServer server;
+  server.service.delay_ms = 5000;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  const auto r = test::run_command(cli() + " --deadline 0.3 --server " + server.address() +
+                                   " label " + dir.file("scan.pcd"));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("DEADLINE_EXCEEDED"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--deadline is 0.3 s"), std::string::npos) << r.output;
+}
+
+TEST(ClientCli, InfoPrintsTheCreationDateAndNaForUndefinedScores) {
+  FakeServer server;
+  const auto r = test::run_command(cli() + " --server " + server.address() + " info fake");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("created    2026-01-02 03:04:05 UTC ("), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" ago) by fake-trainer"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("1767323045"), std::string::npos) << r.output;  // no raw milliseconds
+  EXPECT_NE(r.output.find("class-0            F1 0.500"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("class-1            F1 n/a"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("class-2            F1 n/a"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("nan"), std::string::npos) << r.output;
+}
+
+TEST(ClientCli, HumanUnitsForTimesAndScores) {
+  using namespace client::tools;
+  const std::int64_t t = 1767323045123;  // 2026-01-02 03:04:05.123 UTC
+  EXPECT_EQ(describe_unix_ms(t, t + 45'000), "2026-01-02 03:04:05 UTC (45 s ago)");
+  EXPECT_EQ(describe_unix_ms(t, t + 3 * 60'000 + 5'000), "2026-01-02 03:04:05 UTC (3 min ago)");
+  EXPECT_EQ(describe_unix_ms(t, t + 5 * 3'600'000LL), "2026-01-02 03:04:05 UTC (5 h ago)");
+  EXPECT_EQ(describe_unix_ms(t, t + 3 * 86'400'000LL), "2026-01-02 03:04:05 UTC (3 days ago)");
+  EXPECT_EQ(describe_unix_ms(t, t - 1000), "2026-01-02 03:04:05 UTC (in the future)");
+  EXPECT_EQ(describe_unix_ms(0, t), "unknown");
+  EXPECT_EQ(describe_age_ms(-5000), "0 s");
+  EXPECT_EQ(score_or_na(0.98765), "0.988");
+  EXPECT_EQ(score_or_na(0.98765, 4), "0.9877");
+  EXPECT_EQ(score_or_na(std::nan("")), "n/a");
+  EXPECT_EQ(score_or_na(std::numeric_limits<double>::infinity()), "n/a");
 }
 
 }  // namespace

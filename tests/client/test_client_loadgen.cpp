@@ -77,7 +77,12 @@ TEST(LoadgenStats, MetricsUrlTakesUrlsAndHostPort) {
   EXPECT_EQ(metrics_url_from("labeler:9464"), "http://labeler:9464/metrics");
   EXPECT_EQ(metrics_url_from("http://labeler:9464/metrics"), "http://labeler:9464/metrics");
   EXPECT_EQ(metrics_url_from("https://labeler/prom/metrics"), "https://labeler/prom/metrics");
-  for (const char* bad : {"", "ftp://labeler/metrics", "file:///etc/passwd", "a b:1", "h:1\n"})
+  // A URL without a path scrapes /metrics, as HOST:PORT does; a path is kept.
+  EXPECT_EQ(metrics_url_from("http://127.0.0.1:9464"), "http://127.0.0.1:9464/metrics");
+  EXPECT_EQ(metrics_url_from("http://127.0.0.1:9464/"), "http://127.0.0.1:9464/metrics");
+  EXPECT_EQ(metrics_url_from("labeler:9464/prom/metrics"), "http://labeler:9464/prom/metrics");
+  for (const char* bad : {"", "ftp://labeler/metrics", "file:///etc/passwd", "a b:1", "h:1\n",
+                          "http://", "http:///metrics"})
     EXPECT_THROW(metrics_url_from(bad), std::invalid_argument) << bad;
   // Nothing listens on port 1: a clear error, not a hang.
   EXPECT_THROW(read_server_counts("127.0.0.1:1", "Label", 2000), std::runtime_error);
@@ -127,6 +132,39 @@ TEST(LoadgenRunner, OpenLoopIssuesAtItsRateAndCountsErrorsByStatus) {
   EXPECT_EQ(server.service.label_calls, 12);
 }
 
+// A server at its admission limit answers RESOURCE_EXHAUSTED at once. Callers back off (50 ms
+// doubling, capped at 2 s) instead of resending at once: in 1.5 s each caller can make at most
+// 1 + 5 calls (50 + 100 + 200 + 400 + 800 ms of backoff, less 20% jitter, fit), where resending
+// at once made thousands.
+TEST(LoadgenRunner, ClosedLoopBacksOffWhenTheServerRejectsAtAdmission) {
+  FakeServer server;
+  server.service.exhausted_calls = 1'000'000;
+  client::Client client(options_for(server));
+  LoadSpec spec;
+  spec.concurrency = 2;
+  spec.duration_s = 1.5;
+  const StepResult r = run_step(client, small_clouds(), spec);
+  EXPECT_EQ(r.stats.ok(), 0u);
+  EXPECT_EQ(r.stats.rejected(), static_cast<std::uint64_t>(server.service.label_calls.load()));
+  EXPECT_EQ(r.stats.failed(), 0u);
+  EXPECT_GE(server.service.label_calls, 2);
+  EXPECT_LE(server.service.label_calls, 2 * 7);
+}
+
+TEST(LoadgenRunner, ARejectedCallerResumesOnceTheServerAdmitsAgain) {
+  FakeServer server;
+  server.service.exhausted_calls = 3;
+  client::Client client(options_for(server));
+  LoadSpec spec;
+  spec.requests = 10;
+  spec.duration_s = 0;
+  const StepResult r = run_step(client, small_clouds(), spec);
+  EXPECT_EQ(r.stats.ok(), 7u);
+  EXPECT_EQ(r.stats.rejected(), 3u);
+  EXPECT_EQ(r.stats.errors(), 3u);
+  EXPECT_EQ(r.stats.failed(), 0u);
+}
+
 TEST(LoadgenRunner, DurationBoundsAStep) {
   FakeServer server;
   client::Client client(options_for(server));
@@ -160,7 +198,7 @@ TEST(LoadgenReport, CsvAndJsonCarryEveryStep) {
   std::free(buffer);
   EXPECT_NE(text.find("mode,calls,concurrency,rate,elapsed_s,ok,errors"), std::string::npos);
   EXPECT_NE(text.find("closed,stream,1,0,2.000,1,1,0,0.500,50,10.00"), std::string::npos) << text;
-  EXPECT_NE(text.find(",UNAVAILABLE=1,2,OK=1;UNAVAILABLE=1\n"), std::string::npos) << text;
+  EXPECT_NE(text.find(",UNAVAILABLE=1,2,OK=1;UNAVAILABLE=1,0\n"), std::string::npos) << text;
   EXPECT_NE(text.find("\"latency_ms\":{\"p50\":10.0,"), std::string::npos) << text;
   EXPECT_NE(text.find("\"server\":{\"requests\":2,\"by_status\":{\"OK\":1,\"UNAVAILABLE\":1}}"),
             std::string::npos)
@@ -194,9 +232,55 @@ TEST(LoadgenCli, SweepReportsMatchTheServersCounters) {
   EXPECT_EQ(server.service.label_calls, 14);
   // Each step: 7 sent, 7 counted by the server, all OK.
   std::size_t matches = 0;
-  for (std::size_t at = 0; (at = r.output.find(",7,OK=7\n", at)) != std::string::npos; ++at)
+  for (std::size_t at = 0; (at = r.output.find(",7,OK=7,0\n", at)) != std::string::npos; ++at)
     ++matches;
   EXPECT_EQ(matches, 2u) << r.output;
+}
+
+// Rejections at admission are a figure of the report, not a failed run, unless --strict.
+TEST(LoadgenCli, RejectionsAreReportedAndFailTheRunOnlyWithStrict) {
+  FakeServer server;
+  test::TempDir dir;
+  write_cloud(dir.file("a.pcd"), test::random_box(200, 1.0f, 4));
+  const std::string run = test::binary("primlabel-loadgen") + " --server " + server.address() +
+                          " " + dir.file("a.pcd") + " --requests 6";
+  server.service.exhausted_calls = 2;
+  auto r = test::run_command("( " + run + " --format json 2>/dev/null )");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("\"ok\":4,\"errors\":2,\"rejected\":2,"), std::string::npos) << r.output;
+  server.service.exhausted_calls = 2;
+  r = test::run_command("( " + run + " --format csv 2>/dev/null )");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(",server_by_status,rejected\n"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(",RESOURCE_EXHAUSTED=2,,,2\n"), std::string::npos) << r.output;
+  server.service.exhausted_calls = 2;
+  r = test::run_command("( " + run + " 2>/dev/null )");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("conc 1: 2 calls rejected at admission (RESOURCE_EXHAUSTED"),
+            std::string::npos)
+      << r.output;
+  server.service.exhausted_calls = 2;
+  r = test::run_command("( " + run + " --strict 2>/dev/null )");
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  server.service.unavailable_calls = 1;  // another error still fails the run
+  r = test::run_command("( " + run + " 2>/dev/null )");
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+}
+
+// The load generator takes $PRIMLABEL_SERVER like the CLI, and HOST alone means port 50051.
+TEST(LoadgenCli, ServerFromTheEnvironmentAndTheDefaultPort) {
+  FakeServer server;
+  test::TempDir dir;
+  write_cloud(dir.file("a.pcd"), test::random_box(100, 1.0f, 5));
+  const std::string tool = test::binary("primlabel-loadgen");
+  auto r = test::run_command("PRIMLABEL_SERVER=" + server.address() + " " + tool + " " +
+                             dir.file("a.pcd") + " --requests 2 --format json");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(server.service.label_calls, 2);
+  // Whatever listens on 50051 here (or nothing), the address it dials is the default port's.
+  r = test::run_command(tool + " --server 127.0.0.1 " + dir.file("a.pcd") +
+                        " --requests 1 --deadline 1 --format json");
+  EXPECT_NE(r.output.find("points on average, 127.0.0.1:50051"), std::string::npos) << r.output;
 }
 
 TEST(LoadgenCli, SynthCloudsOpenLoopJsonAndUsageErrors) {

@@ -523,6 +523,38 @@ TEST(UploadCli, AFullSpoolDiskRejectsWithExitFiveAndARestartDrainsBeforeTakingMo
   EXPECT_EQ(files_in(disk.path("spool/scans")), 0u);
 }
 
+// A file of the caller's that does not parse is an input error (1, as documented), named in one
+// line and never spooled or sent; it is not a scan the server refused (4).
+TEST(UploadCli, AnUnreadableInputFileExitsOneWithOneLineAndIsNotSpooled) {
+  FakeServer server;
+  test::TempDir dir;
+  write_bytes(dir.file("broken.pcd"), "VERSION 0.7\nFIELDS x y z\nnot a header\n");
+  write_bytes(dir.file("good.pcd"), scan_bytes(61));
+  const auto r =
+      test::run_command("( " + upload_tool() + " -q --server " + server.address() + " --spool " +
+                        dir.file("spool") + " -o " + dir.file("out") + " " +
+                        dir.file("broken.pcd") + " " + dir.file("good.pcd") + " >/dev/null )");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 2) << r.output;  // the reason, and the summary
+  EXPECT_NE(r.output.find("summary: accepted 1 new"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(dir.file("broken.pcd") + ": not spooled, unreadable"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(server.service.label_calls, 1);  // the good file only
+  EXPECT_EQ(files_in(dir.file("out")), 1u);
+  EXPECT_EQ(files_in(dir.file("spool/failed")), 0u);
+}
+
+TEST(UploadCli, TheServerComesFromPrimlabelServerWhenNoFlagGivesIt) {
+  FakeServer server;
+  test::TempDir dir;
+  write_bytes(dir.file("a.pcd"), scan_bytes(62));
+  const auto r = test::run_command("PRIMLABEL_SERVER=" + server.address() + " " + upload_tool() +
+                                   " -q --spool " + dir.file("spool") + " -o " + dir.file("out") +
+                                   " " + dir.file("a.pcd"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(server.service.label_calls, 1);
+}
+
 TEST(UploadCli, ACorruptSpoolEntryIsReportedAndExitsFour) {
   FakeServer server;
   test::TempDir dir;

@@ -6,6 +6,7 @@
 
 #include "png_decode.hpp"
 #include "primlabel/render/colorize.hpp"
+#include "primlabel/render/raster.hpp"
 #include "primlabel/render/render.hpp"
 #include "test_util.hpp"
 
@@ -67,6 +68,27 @@ TEST(Render, ViewsDifferAndNearPointsHideFarOnes) {
   const Decoded sensor = decode_png(dir.file("sensor.png"));
   EXPECT_GT(sensor.count_mostly(0, 0, 0, 256, 256), 5000u);
   EXPECT_EQ(sensor.count_mostly(16, 0, 0, 256, 256), 0u);
+}
+
+// The lowest row with ink when `s` is drawn at the top-left of a white raster; -1 for none.
+int lowest_ink_row(const std::string& s) {
+  Raster raster(16, 16);
+  raster.text(0, 0, s, 0x000000);
+  for (int y = raster.height() - 1; y >= 0; --y)
+    for (int x = 0; x < raster.width(); ++x)
+      if (raster.at(x, y) != 0xFFFFFF) return y;
+  return -1;
+}
+
+TEST(RenderFont, DescendersReachBelowTheBaseline) {
+  const int baseline = lowest_ink_row("H");  // capitals stand on the baseline: row 6 of 5x7
+  ASSERT_EQ(baseline, 6);
+  for (const char* flat : {"a", "x", "o", "n", "E"})
+    EXPECT_EQ(lowest_ink_row(flat), baseline) << flat;
+  for (const char* descending : {"g", "j", "p", "q", "y"}) {
+    EXPECT_GT(lowest_ink_row(descending), baseline) << descending;
+    EXPECT_LT(lowest_ink_row(descending), Raster::text_height()) << descending;  // laid out
+  }
 }
 
 TEST(Render, ClearErrors) {

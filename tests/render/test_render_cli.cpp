@@ -86,6 +86,22 @@ TEST_F(RenderCli, UsageErrorsExitWith2AndOneLine) {
   }
 }
 
+// The tool writes PNG only: another extension is refused before anything is written.
+TEST_F(RenderCli, ANonPngOutputNameIsAUsageErrorAndWritesNothing) {
+  for (const std::string name : {"x.jpg", "x.JPEG", "x", "x.png.gz"}) {
+    const std::string out = dir_->file(name);
+    const Result r = run(render_tool() + " " + scene() + " -o " + out);
+    EXPECT_EQ(r.exit_code, 2) << name << ": " << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("writes PNG only"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << out;
+  }
+  const Result upper = run(render_tool() + " " + scene() + " -o " + dir_->file("X.PNG") +
+                           " --width 320 --height 240");
+  EXPECT_EQ(upper.exit_code, 0) << upper.output;
+  EXPECT_TRUE(std::filesystem::exists(dir_->file("X.PNG")));
+}
+
 TEST_F(RenderCli, RuntimeErrorsExitWith1AndNameTheFile) {
   Result r = run(render_tool() + " /nonexistent/scan.pcd -o " + dir_->file("x.png"));
   EXPECT_EQ(r.exit_code, 1);

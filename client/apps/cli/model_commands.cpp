@@ -1,11 +1,21 @@
 // health, models and info: small reads of the server's state, printed for people on stdout.
 
+#include <chrono>
 #include <cstdio>
 
 #include "commands.hpp"
+#include "common/human_format.hpp"
 #include "exit_codes.hpp"
 
 namespace primlabel::client::tools {
+
+namespace {
+std::int64_t now_unix_ms() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+}  // namespace
 
 int run_health(Client& client, const std::string& service) {
   HealthStatus status;
@@ -23,11 +33,15 @@ int run_health(Client& client, const std::string& service) {
 int run_models(Client& client) {
   const auto models = client.list_models();
   std::printf("%-24s %-20s %7s %8s %s\n", "MODEL", "VERSION", "CLASSES", "VAL-ACC", "LOADED");
+  const std::int64_t now = now_unix_ms();
   for (const auto& m : models) {
     std::string loaded;
     for (const auto& v : m.loaded_versions()) loaded += (loaded.empty() ? "" : ",") + v;
-    std::printf("%-24s %-20s %7u %8.3f %s%s\n", m.name().c_str(), m.version().c_str(), m.classes(),
-                m.validation_accuracy(), loaded.c_str(), m.is_default() ? " (default)" : "");
+    if (m.loaded_unix_ms() != 0)
+      loaded += " (loaded " + describe_age_ms(now - m.loaded_unix_ms()) + " ago)";
+    std::printf("%-24s %-20s %7u %8s %s%s\n", m.name().c_str(), m.version().c_str(), m.classes(),
+                score_or_na(m.validation_accuracy()).c_str(), loaded.c_str(),
+                m.is_default() ? " (default)" : "");
   }
   if (models.empty()) std::fprintf(stderr, "primlabel: the server serves no models\n");
   return kExitOk;
@@ -38,8 +52,8 @@ int run_info(Client& client, const std::string& model, const std::string& versio
   std::printf("model      %s\nversion    %s\nkind       %s\n", m.name().c_str(),
               m.version().c_str(), v1::ModelKind_Name(m.kind()).c_str());
   std::printf("file       %s (crc32 %08x)\n", m.path().c_str(), m.model_crc32());
-  std::printf("created    %lld by %s\n", static_cast<long long>(m.created_unix_ms()),
-              m.created_by().c_str());
+  std::printf("created    %s by %s\n", describe_unix_ms(m.created_unix_ms(), now_unix_ms()).c_str(),
+              m.created_by().empty() ? "unknown" : m.created_by().c_str());
   const auto& f = m.features();
   std::printf(
       "features   %s, %u values; normal radius %g (k %u); feature radius %g (k %u); "
@@ -48,13 +62,19 @@ int run_info(Client& client, const std::string& model, const std::string& versio
       f.normal_k(), f.feature_radius(), f.feature_k(), f.voxel_size(),
       f.radii_overridable() ? "yes" : "no");
   std::printf("graph      k %u, radius %g\n", m.graph().k(), m.graph().radius());
-  std::printf("validation %.4f accuracy on %llu points\n", m.validation().accuracy(),
+  // No validation points: no accuracy and no F1 to show, not 0 or nan.
+  const bool validated = m.validation().points() > 0;
+  std::printf("validation %s accuracy on %llu points\n",
+              validated ? score_or_na(m.validation().accuracy(), 4).c_str() : "n/a",
               static_cast<unsigned long long>(m.validation().points()));
-  std::printf("classes    (probability columns in this order)\n");
+  std::printf(
+      "classes    (probability columns in this order; F1 n/a: undefined, no validation points of "
+      "the class)\n");
   for (int i = 0; i < m.classes_size(); ++i) {
     const auto& c = m.classes(i);
-    const double f1 = i < m.validation().per_class_size() ? m.validation().per_class(i).f1() : 0;
-    std::printf("  %2u %-18s F1 %.3f\n", c.id(), c.name().c_str(), f1);
+    const bool scored = validated && i < m.validation().per_class_size();
+    std::printf("  %2u %-18s F1 %s\n", c.id(), c.name().c_str(),
+                scored ? score_or_na(m.validation().per_class(i).f1()).c_str() : "n/a");
   }
   return kExitOk;
 }

@@ -98,7 +98,14 @@ int main(int argc, char** argv) {
     label_args.quiet = quiet;
     return run_label(*client, label_args);
   } catch (const ClientError& e) {
-    std::fprintf(stderr, "primlabel: %s\n", e.what());
+    // The client's own deadline is the usual cause for a large scan or a busy server.
+    char hint[160] = "";
+    if (e.code() == grpc::StatusCode::DEADLINE_EXCEEDED)
+      std::snprintf(hint, sizeof hint,
+                    " (--deadline is %g s, retries included; raise it for large scans or a busy "
+                    "server)",
+                    connection.deadline_s);
+    std::fprintf(stderr, "primlabel: %s%s\n", e.what(), hint);
     return exit_code_for(e.code());
   }
 }

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "server_address.hpp"
+
 namespace primlabel::client::tools {
 
 namespace {
@@ -19,7 +21,23 @@ std::string trimmed(std::string text) {
 }  // namespace
 
 void ConnectionFlags::add_to(CLI::App& app) {
-  app.add_option("--server", server, "Server address HOST:PORT")->capture_default_str();
+  // A bad address is a usage error at parse time, from the flag or the environment alike.
+  const CLI::Validator address(
+      [](std::string& value) {
+        try {
+          value = server_address_with_port(value);
+          return std::string();
+        } catch (const std::invalid_argument& e) {
+          return std::string(e.what());
+        }
+      },
+      "HOST[:PORT]");
+  app.add_option(
+         "--server", server,
+         "Server address HOST:PORT; HOST alone means port " + std::to_string(kDefaultServerPort))
+      ->envname("PRIMLABEL_SERVER")
+      ->transform(address)
+      ->capture_default_str();
   app.add_option("--token-file", token_file,
                  "File holding the bearer token (default: $PRIMLABEL_TOKEN when set)");
   app.add_flag("--tls", tls, "Use TLS with the system's root certificates");

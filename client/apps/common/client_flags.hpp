@@ -1,6 +1,6 @@
 #pragma once
-// The connection flags every client tool shares (--server, --token-file, --tls-*, --deadline,
-// --retries) and their translation into ClientOptions.
+// The connection flags every client tool shares (--server, else $PRIMLABEL_SERVER; --token-file,
+// --tls-*, --deadline, --retries) and their translation into ClientOptions.
 
 #include <CLI/CLI.hpp>
 #include <string>

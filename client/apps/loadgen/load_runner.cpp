@@ -33,6 +33,8 @@ StepResult run_closed(Client& client, const std::vector<PointCloud>& clouds, con
   std::vector<std::thread> callers;
   for (std::size_t c = 0; c < per_caller.size(); ++c) {
     callers.emplace_back([&, c] {
+      // Seeded by the caller's index: the same run draws the same delays.
+      Backoff backoff(spec.rejection_backoff, c + 1);
       while (Clock::now() < end) {
         const std::uint64_t ticket = tickets++;
         if (spec.requests > 0 && ticket >= spec.requests) break;
@@ -42,8 +44,12 @@ StepResult run_closed(Client& client, const std::vector<PointCloud>& clouds, con
           const LabelResult result =
               spec.unary ? client.label_unary(cloud, spec.label) : client.label(cloud, spec.label);
           per_caller[c].record_ok(seconds_between(sent, Clock::now()), result.size());
+          backoff.reset();
         } catch (const ClientError& e) {
           per_caller[c].record_error(status_code_name(e.code()));
+          // A full server answers at once; resending at once would only measure rejections.
+          if (e.code() == grpc::StatusCode::RESOURCE_EXHAUSTED)
+            std::this_thread::sleep_until(std::min(end, Clock::now() + backoff.next()));
         }
       }
     });

@@ -3,6 +3,7 @@
 // last one is answered) or open loop (calls issued at a fixed rate whatever the answers do, with
 // latency measured from the scheduled send time, so a slow server cannot hide its queueing).
 // A step ends after its duration or request count, and never runs longer than max_duration.
+// Closed-loop callers back off after an admission rejection (LoadSpec::rejection_backoff).
 
 #include <chrono>
 #include <cstdint>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "load_stats.hpp"
+#include "primlabel/client/backoff.hpp"
 #include "primlabel/client/client.hpp"
 
 namespace primlabel::client::loadgen {
@@ -26,6 +28,11 @@ struct LoadSpec {
   double max_duration_s = 600;  // hard cap on a step
   bool unary = false;           // LabelCloud instead of the Label stream
   LabelOptions label;
+  // Closed loop: a caller whose call was rejected at admission (RESOURCE_EXHAUSTED) waits this
+  // backoff before its next call (reset by a success), so a full server is not flooded with
+  // instant rejections. The open loop keeps its rate whatever the answers.
+  BackoffPolicy rejection_backoff{std::chrono::milliseconds(50), 2.0,
+                                  std::chrono::milliseconds(2000), 0.2};
 };
 
 struct StepResult {

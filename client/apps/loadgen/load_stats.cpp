@@ -28,6 +28,11 @@ std::uint64_t LoadStats::errors() const {
   return n;
 }
 
+std::uint64_t LoadStats::rejected() const {
+  const auto it = errors_.find(kRejectedStatus);
+  return it == errors_.end() ? 0 : it->second;
+}
+
 double LoadStats::percentile(double p) const {
   if (latencies_s_.empty()) return 0;
   if (!sorted_) {

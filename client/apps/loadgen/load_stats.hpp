@@ -1,6 +1,6 @@
 #pragma once
-// What one load step measured: latencies of successful calls, errors by status, points labeled,
-// and the summary figures (throughput, percentiles) derived from them.
+// What one load step measured: latencies of successful calls, errors by status (admission
+// rejections apart), points labeled, and the summary figures (throughput, percentiles).
 
 #include <cstdint>
 #include <map>
@@ -8,6 +8,9 @@
 #include <vector>
 
 namespace primlabel::client::loadgen {
+
+// The status of an admission rejection, as status_code_name spells it.
+inline constexpr const char* kRejectedStatus = "RESOURCE_EXHAUSTED";
 
 class LoadStats {
  public:
@@ -17,7 +20,11 @@ class LoadStats {
   void merge(const LoadStats& other);
 
   std::uint64_t ok() const { return latencies_s_.size(); }
-  std::uint64_t errors() const;
+  std::uint64_t errors() const;  // every failed call, rejections included
+  // Calls the server turned away at admission (RESOURCE_EXHAUSTED: its workers and queue were
+  // full): a figure of the load, not a failure of the server.
+  std::uint64_t rejected() const;
+  std::uint64_t failed() const { return errors() - rejected(); }  // the other errors
   std::uint64_t skipped() const { return skipped_; }
   std::uint64_t points() const { return points_; }
   const std::map<std::string, std::uint64_t>& errors_by_status() const { return errors_; }

@@ -62,6 +62,13 @@ void write_text(std::FILE* out, const std::vector<ReportRow>& rows) {
     if (r.stats.errors() > 0)
       std::fprintf(out, "conc %d: errors %s\n", r.spec.concurrency,
                    errors_text(r.stats, ", ", " ").c_str());
+    if (r.stats.rejected() > 0)
+      std::fprintf(out,
+                   "conc %d: %llu calls rejected at admission (%s: the server's workers and "
+                   "queue were full)%s\n",
+                   r.spec.concurrency, static_cast<unsigned long long>(r.stats.rejected()),
+                   kRejectedStatus,
+                   r.spec.mode == LoadMode::kClosed ? "; callers backed off before resending" : "");
     if (r.stats.skipped() > 0)
       std::fprintf(out, "conc %d: %llu calls not sent (client had --max-outstanding in flight)\n",
                    r.spec.concurrency, static_cast<unsigned long long>(r.stats.skipped()));
@@ -79,7 +86,7 @@ void write_csv(std::FILE* out, const std::vector<ReportRow>& rows) {
   std::fprintf(out,
                "mode,calls,concurrency,rate,elapsed_s,ok,errors,skipped,clouds_per_s,points_per_s,"
                "p50_ms,p90_ms,p95_ms,p99_ms,max_ms,errors_by_status,server_requests,"
-               "server_by_status\n");
+               "server_by_status,rejected\n");
   for (const auto& row : rows) {
     const StepResult& r = row.step;
     const Figures f = figures_of(r);
@@ -90,15 +97,15 @@ void write_csv(std::FILE* out, const std::vector<ReportRow>& rows) {
         server_by += (server_by.empty() ? "" : ";") + status + "=" +
                      std::to_string(static_cast<long long>(n));
     }
-    std::fprintf(out,
-                 "%s,%s,%d,%g,%.3f,%llu,%llu,%llu,%.3f,%.0f,%.2f,%.2f,%.2f,%.2f,%.2f,%s,%s,%s\n",
-                 f.mode.c_str(), f.transport.c_str(), r.spec.concurrency,
-                 r.spec.mode == LoadMode::kOpen ? r.spec.rate : 0.0, r.elapsed_s,
-                 static_cast<unsigned long long>(r.stats.ok()),
-                 static_cast<unsigned long long>(r.stats.errors()),
-                 static_cast<unsigned long long>(r.stats.skipped()), f.clouds_per_s, f.points_per_s,
-                 f.p50, f.p90, f.p95, f.p99, f.max, errors_text(r.stats, ";", "=").c_str(),
-                 server_total.c_str(), server_by.c_str());
+    std::fprintf(
+        out, "%s,%s,%d,%g,%.3f,%llu,%llu,%llu,%.3f,%.0f,%.2f,%.2f,%.2f,%.2f,%.2f,%s,%s,%s,%llu\n",
+        f.mode.c_str(), f.transport.c_str(), r.spec.concurrency,
+        r.spec.mode == LoadMode::kOpen ? r.spec.rate : 0.0, r.elapsed_s,
+        static_cast<unsigned long long>(r.stats.ok()),
+        static_cast<unsigned long long>(r.stats.errors()),
+        static_cast<unsigned long long>(r.stats.skipped()), f.clouds_per_s, f.points_per_s, f.p50,
+        f.p90, f.p95, f.p99, f.max, errors_text(r.stats, ";", "=").c_str(), server_total.c_str(),
+        server_by.c_str(), static_cast<unsigned long long>(r.stats.rejected()));
   }
 }
 
@@ -118,6 +125,7 @@ void write_json(std::FILE* out, const std::vector<ReportRow>& rows) {
         {"elapsed_s", json::rounded(r.elapsed_s, "%.3f")},
         {"ok", r.stats.ok()},
         {"errors", r.stats.errors()},
+        {"rejected", r.stats.rejected()},
         {"skipped", r.stats.skipped()},
         {"clouds_per_s", json::rounded(f.clouds_per_s, "%.3f")},
         {"points_per_s", json::whole(f.points_per_s)},

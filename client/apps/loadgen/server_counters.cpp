@@ -50,11 +50,20 @@ std::string metrics_url_from(const std::string& flag) {
   if (std::any_of(flag.begin(), flag.end(), is_blank_or_control))
     throw std::invalid_argument("blank or control character in the metrics URL");
   const auto scheme_end = flag.find("://");
-  if (scheme_end == std::string::npos) return "http://" + flag + "/metrics";  // HOST:PORT
-  const std::string scheme = flag.substr(0, scheme_end);
-  if (scheme != "http" && scheme != "https")
-    throw std::invalid_argument("metrics URL scheme '" + scheme + "' is not http or https");
-  return flag;
+  std::string url = scheme_end == std::string::npos ? "http://" + flag : flag;  // HOST:PORT[/PATH]
+  if (scheme_end != std::string::npos) {
+    const std::string scheme = flag.substr(0, scheme_end);
+    if (scheme != "http" && scheme != "https")
+      throw std::invalid_argument("metrics URL scheme '" + scheme + "' is not http or https");
+  }
+  const auto authority = url.find("://") + 3;
+  if (authority == url.size() || url[authority] == '/')
+    throw std::invalid_argument("no host in the metrics URL");
+  // No path, or "/": the exposer's /metrics (its "/" answers 404).
+  const auto path = url.find('/', authority);
+  if (path == std::string::npos) return url + "/metrics";
+  if (path + 1 == url.size()) return url + "metrics";
+  return url;
 }
 
 ServerCounts read_server_counts(const std::string& where, const std::string& method,

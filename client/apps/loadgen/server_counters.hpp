@@ -15,8 +15,9 @@ struct ServerCounts {
 };
 
 // The URL to scrape for a --metrics-url value: a URL ("http://host:port/metrics") as given,
-// "HOST:PORT" as http://HOST:PORT/metrics. Throws std::invalid_argument on an empty value, a
-// scheme other than http(s), or blanks and control characters.
+// "HOST:PORT" as http://HOST:PORT/metrics, "HOST:PORT/PATH" as http://HOST:PORT/PATH; a URL
+// without a path (or with "/" alone) gets /metrics. Throws std::invalid_argument on an empty
+// value, no host, a scheme other than http(s), or blanks and control characters.
 std::string metrics_url_from(const std::string& flag);
 
 // Sums primlabel_requests_total over models for `method` ("Label" or "LabelCloud"; a method label

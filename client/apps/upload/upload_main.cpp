@@ -17,6 +17,7 @@
 #include "framing.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "uploader.hpp"
 
 using namespace primlabel::client;
@@ -99,6 +100,16 @@ struct Intake {
     std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
     if (ext != ".pcd" && ext != ".ply") {
       std::fprintf(stderr, "primlabel-upload: %s: not a .pcd or .ply file\n", path.c_str());
+      raise(kExitInput);
+      return true;
+    }
+    // A file that does not parse is the caller's input error (exit 1), found here before it is
+    // spooled, not a scan the server refused (exit 4) once the upload parses it.
+    try {
+      (void)primlabel::read_cloud(path.string());
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "primlabel-upload: %s: not spooled, unreadable: %s\n", path.c_str(),
+                   e.what());
       raise(kExitInput);
       return true;
     }

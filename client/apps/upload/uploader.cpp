@@ -199,8 +199,15 @@ bool Uploader::upload(const SpooledScan& scan) {
       return true;
     }
     server_down_ = true;
-    std::fprintf(stderr, "primlabel-upload: %s: %s; will retry\n", scan.id.c_str(),
-                 status.message.c_str());
+    std::string hint;  // the client's deadline is the usual cause for a large scan
+    if (status.code == grpc::StatusCode::DEADLINE_EXCEEDED)
+      hint = " (--deadline is " +
+             std::to_string(
+                 std::chrono::duration_cast<std::chrono::seconds>(client_.options().deadline)
+                     .count()) +
+             " s; raise it for large scans)";
+    std::fprintf(stderr, "primlabel-upload: %s: %s%s; will retry\n", scan.id.c_str(),
+                 status.message.c_str(), hint.c_str());
     return false;
   }
   const std::size_t points = result.size();

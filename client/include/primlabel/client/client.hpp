@@ -2,7 +2,7 @@
 // The C++ client of the primlabel labeling service (api/primlabel/v1/labeling.proto).
 //
 //   primlabel::client::Client client({.address = "127.0.0.1:50051"});
-//   primlabel::client::LabelResult r = client.label(cloud, {.model = "tabletop"});
+//   primlabel::client::LabelResult r = client.label(cloud, {.model = "tabletop-lms400"});
 //   // r.labels[i] is the taxonomy class of cloud.xyz[i]
 //
 // Every call has a deadline (ClientOptions::deadline unless the call gives one). Calls that fail

@@ -1,5 +1,6 @@
 #pragma once
-// An RGB picture to draw charts on (rectangles, lines, text in the built-in 5x7 font) and write
+// An RGB picture to draw charts on (rectangles, lines, text in the built-in 5x7 font, whose
+// g, j, p, q and y descend one row below the baseline: text_height covers them) and write
 // as PNG with libpng. The point-cloud renderer, the training curve, the confusion matrix and the
 // Fig. 4 plots all draw on it.
 

@@ -1,0 +1,50 @@
+// --compare-pcl in a build without PCL says why: the CMake option turned off, or (the usual
+// case, the option being ON by default) PCL not found at configure time. In a build with PCL
+// the comparison runs.
+
+#include <gtest/gtest.h>
+
+#include "pcl_availability.hpp"
+#include "test_util.hpp"
+
+namespace primlabel {
+namespace {
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+TEST(BenchPcl, TheReasonNamesTheOptionOnlyWhenItIsOff) {
+  const std::string off = bench::pcl_unavailable_reason(false, "PCL 1.13");
+  EXPECT_TRUE(contains(off, "-DPRIMLABEL_WITH_PCL=OFF")) << off;
+  const std::string missing = bench::pcl_unavailable_reason(true, "PCL 1.13");
+  EXPECT_TRUE(contains(missing, "PCL 1.13 was not found")) << missing;
+  EXPECT_TRUE(contains(missing, "libpcl-dev")) << missing;
+  EXPECT_FALSE(contains(missing, "=OFF")) << missing;
+  EXPECT_FALSE(contains(missing, "-DPRIMLABEL_WITH_PCL=ON")) << missing;  // it is on already
+}
+
+TEST(BenchPcl, ComparePclRunsOrSaysWhyInOneLine) {
+  if (!std::filesystem::exists(test::binary("primlabel-bench")))
+    GTEST_SKIP() << "benchmarks not built";
+  const auto r = test::run_command(
+      test::binary("primlabel-bench") + " features " + test::test_data("samples/bun0.pcd") +
+      " --normal-k 10 --feature-k 10 --threads 1 --repeat 1 --descriptor fpfh "
+      "--compare-pcl");
+  if (r.exit_code == 0) {
+    EXPECT_TRUE(contains(r.output, "pcl")) << r.output;  // built with PCL: it compared
+    return;
+  }
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+  EXPECT_TRUE(contains(
+      r.output,
+      bench::pcl_unavailable_reason(PRIMLABEL_WITH_PCL_OPTION != 0, "PCL 1.13").substr(0, 20)))
+      << r.output;
+  if (PRIMLABEL_WITH_PCL_OPTION) {
+    EXPECT_TRUE(contains(r.output, "was not found")) << r.output;
+  }
+}
+
+}  // namespace
+}  // namespace primlabel
