@@ -45,6 +45,21 @@ TEST_F(FeaturesCli, WritesNormalsCurvatureAndFpfh) {
   EXPECT_NE(r.output.find("fpfh: 397 computed, 0 isolated"), std::string::npos) << r.output;
 }
 
+TEST_F(FeaturesCli, ThePapersVariantIsNamedAsSuch) {
+  const std::string out = dir_.file("bunny_fpfh_paper.pcd");
+  const Result r = run(features_tool() + " " + bunny_ + " -o " + out +
+                       " --normal-k 10 --feature-radius 0.02 --fpfh-variant paper");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const PointCloud cloud = read_pcd(out);
+  EXPECT_EQ(cloud.find_field("fpfh"), nullptr);
+  const FloatField* paper = cloud.find_field("fpfh_paper");
+  ASSERT_NE(paper, nullptr);
+  // PCL's rows sum to 300 (three sub-histograms of 100); the paper's add the point's own SPFH.
+  double sum = 0;
+  for (int b = 0; b < kFpfhSize; ++b) sum += paper->row(5)[b];
+  EXPECT_NEAR(sum, 600.0, 0.1);
+}
+
 TEST_F(FeaturesCli, PfhToPlyWithInputNormals) {
   const std::string out = dir_.file("bunny_pfh.ply");
   const Result r = run(features_tool() + " " + bunny_ + " -o " + out +

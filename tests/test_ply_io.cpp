@@ -109,7 +109,7 @@ TEST(PlyWrite, HeaderDeclaresStandardProperties) {
                                           "property float ny",
                                           "property float nz",
                                           "property float curvature",
-                                          "property uint label",
+                                          "property uint label",  // a label beyond int range
                                           "property uchar red",
                                           "property uchar green",
                                           "property uchar blue",
@@ -119,6 +119,23 @@ TEST(PlyWrite, HeaderDeclaresStandardProperties) {
   EXPECT_EQ(std::vector<std::string>(lines.begin(), lines.begin() + start.size()), start);
   EXPECT_EQ(lines[start.size() + 31], "property float fpfh_32");
   EXPECT_EQ(lines.back(), "property float intensity");
+}
+
+TEST(PlyWrite, LabelsBeyondIntRangeStayUintAndEveryLabelRoundTrips) {
+  test::TempDir dir;
+  PointCloud cloud;
+  cloud.resize_unorganized(3);
+  for (const std::uint32_t big : {0x7fffffffu, 0x80000000u}) {
+    cloud.labels = {0u, 7u, big};
+    const std::string path = dir.file("labels.ply");
+    write_ply(path, cloud, PlyEncoding::kBinaryLittleEndian);
+    std::ifstream in(path, std::ios::binary);
+    std::string header, line;
+    while (std::getline(in, line) && line != "end_header") header += line + "\n";
+    const char* expected = big <= 0x7fffffffu ? "property int label\n" : "property uint label\n";
+    EXPECT_NE(header.find(expected), std::string::npos) << header;
+    EXPECT_EQ(read_ply(path).labels, cloud.labels);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

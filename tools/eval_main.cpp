@@ -146,7 +146,11 @@ int evaluate_files(const Arguments& args) {
     }
     if (!args.out.empty()) {
       cloud.labels = result.labels;
-      write_tagged_cloud(args.out, cloud, {{"classes", class_map_tag(ClassMap::taxonomy())}});
+      write_tagged_cloud(args.out, cloud,
+                         {{"classes", class_map_tag(ClassMap::taxonomy())},
+                          {"model", model.name},
+                          {"model_version", model.version},
+                          {"descriptor", model.features.descriptor_name()}});
     }
   }
   if (!args.confusion_png.empty()) {

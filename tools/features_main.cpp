@@ -82,7 +82,8 @@ int run(const Arguments& args) {
                                  : compute_pfh(cloud, options, context, &stats, &search);
   progress.done();
   const double feature_seconds = seconds_since(features_start);
-  FloatField& field = cloud.set_field(args.descriptor, descriptors.dim);
+  FloatField& field =
+      cloud.set_field(fpfh ? fpfh_field_name(options.fpfh_variant) : "pfh", descriptors.dim);
   field.values = std::move(descriptors.values);
 
   write_cloud(args.output, cloud);

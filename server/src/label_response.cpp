@@ -1,7 +1,7 @@
 #include "label_response.hpp"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "primlabel/geometry/taxonomy.hpp"
@@ -97,6 +97,7 @@ void fill_summary(const RequestRecord& record, const ModelEntry& entry,
     timing->set_seconds(seconds);
   }
   summary.set_descriptor_dim(static_cast<std::uint32_t>(result.descriptors.dim));
+  if (entry.model) summary.set_descriptor_name(entry.model->features.descriptor_name());
   if (std::isfinite(result.point_spacing)) summary.set_point_spacing(result.point_spacing);
   summary.set_domain_warning(result.domain_warning);
   *summary.mutable_classes() = entry.metadata.classes();

@@ -218,7 +218,10 @@ class FakeLabeler final : public v1::Labeler::Service {
     summary.set_model("fake");
     summary.set_model_version("1");
     summary.set_points_received(n);
-    if (header.options().return_descriptors()) summary.set_descriptor_dim(kDescriptorDim);
+    if (header.options().return_descriptors()) {
+      summary.set_descriptor_dim(kDescriptorDim);
+      summary.set_descriptor_name("fpfh_paper");
+    }
     for (int k = 0; k < kClasses; ++k) {
       auto* cls = summary.add_classes();
       cls->set_id(k);

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -11,6 +12,7 @@
 #include "common/server_address.hpp"
 #include "fake_labeler.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -75,12 +77,37 @@ TEST(ClientCli, LabelWritesLabelsDescriptorsProbabilitiesAndPng) {
   const PointCloud out = read_cloud(dir.file("out.pcd"));
   ASSERT_EQ(out.labels.size(), 300u);
   for (std::size_t i = 0; i < 300; ++i) ASSERT_EQ(out.labels[i], i % 5);
-  ASSERT_NE(out.find_field("fpfh"), nullptr);
-  EXPECT_EQ(out.find_field("fpfh")->count, 33);
+  // The field is named as the server names its descriptors (the fake serves the paper's).
+  EXPECT_EQ(out.find_field("fpfh"), nullptr);
+  ASSERT_NE(out.find_field("fpfh_paper"), nullptr);
+  EXPECT_EQ(out.find_field("fpfh_paper")->count, 33);
   ASSERT_NE(out.find_field("probability"), nullptr);
   EXPECT_EQ(out.find_field("probability")->count, 3);
   EXPECT_TRUE(std::filesystem::exists(dir.file("out.png")));
   EXPECT_NE(r.output.find("300 points"), std::string::npos) << r.output;
+}
+
+TEST(ClientCli, LabeledFilesDescribeThemselvesInTheirHeader) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  for (const char* name : {"out.pcd", "out.ply"}) {
+    const auto r = test::run_command(cli() + " -q --server " + server.address() + " label " +
+                                     dir.file("scan.pcd") + " -o " + dir.file(name) +
+                                     " --descriptors --probabilities");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const CloudTags tags = read_cloud_tags(dir.file(name));
+    EXPECT_EQ(tags.at("model"), "fake") << name;
+    EXPECT_EQ(tags.at("model_version"), "1") << name;
+    EXPECT_EQ(tags.at("descriptor"), "fpfh_paper") << name;
+    // The label field's class map is the taxonomy's, readable back as a ClassMap.
+    const ClassMap map = class_map_from_tag(tags.at("classes"));
+    EXPECT_EQ(map.to_text(), ClassMap::taxonomy().to_text()) << name;
+    // One id:name per probability column, in the columns' order.
+    const std::string& columns = tags.at("probability_columns");
+    EXPECT_EQ(std::count(columns.begin(), columns.end(), ':'), 3) << columns;
+    EXPECT_EQ(read_cloud(dir.file(name)).labels.size(), 300u);
+  }
 }
 
 TEST(ClientCli, SeveralFilesGoToTheOutputDirectory) {

@@ -87,6 +87,7 @@ TEST(LabelService, DescriptorsProbabilitiesAndSmallResponseChunks) {
   for (std::size_t c = 0; c + 1 < answer.chunks.size(); ++c)
     EXPECT_EQ(answer.chunks[c].point_count(), 777u);
   ASSERT_EQ(answer.summary->descriptor_dim(), 33u);
+  EXPECT_EQ(answer.summary->descriptor_name(), model.features.descriptor_name());
   ASSERT_EQ(answer.summary->classes_size(), 5);
   ASSERT_EQ(answer.descriptors.size(), cloud.size() * 33);
   ASSERT_EQ(answer.probabilities.size(), cloud.size() * 5);

@@ -77,7 +77,7 @@ int run_label(Client& client, LabelCommand command) {
     const std::string out = output_path(command, input);
     try {
       const PointCloud labeled = labeled_cloud(std::move(cloud), result);
-      write_cloud(out, labeled);
+      write_tagged_cloud(out, labeled, labeled_cloud_tags(result));
       if (command.png)
         write_label_png(labeled, fs::path(out).replace_extension(".png").string(),
                         fs::path(input).filename().string() + " - " + result.summary.model() + " " +

@@ -10,15 +10,36 @@
 
 namespace primlabel::client::tools {
 
+std::string descriptor_field(const LabelResult& result) {
+  if (!result.summary.descriptor_name().empty()) return result.summary.descriptor_name();
+  // A server that does not name its descriptors: only the width is known.
+  return result.descriptor_dim == 125 ? "pfh" : "descriptor";
+}
+
+CloudTags labeled_cloud_tags(const LabelResult& result) {
+  CloudTags tags;
+  tags["model"] = result.summary.model();
+  tags["model_version"] = result.summary.model_version();
+  tags["classes"] = class_map_tag(ClassMap::taxonomy());  // what the label field holds
+  if (result.descriptor_dim > 0) tags["descriptor"] = descriptor_field(result);
+  if (!result.probabilities.empty()) {
+    std::string columns;
+    for (std::size_t k = 0; k < result.class_ids.size(); ++k) {
+      const auto cls = class_from_id(result.class_ids[k]);
+      columns += (k ? " " : "") + std::to_string(result.class_ids[k]) + ":" +
+                 (cls ? std::string(name(*cls)) : "class");
+    }
+    tags["probability_columns"] = columns;
+  }
+  if (!result.summary.scan_id().empty()) tags["scan_id"] = result.summary.scan_id();
+  if (!result.summary.request_id().empty()) tags["request_id"] = result.summary.request_id();
+  return tags;
+}
+
 PointCloud labeled_cloud(PointCloud cloud, const LabelResult& result) {
   cloud.labels = result.labels;
-  if (result.descriptor_dim > 0) {
-    // 33 columns are PCL's FPFHSignature33; other widths (PFH) keep a neutral name.
-    const std::string name = result.descriptor_dim == 33    ? "fpfh"
-                             : result.descriptor_dim == 125 ? "pfh"
-                                                            : "descriptor";
-    cloud.set_field(name, result.descriptor_dim).values = result.descriptors;
-  }
+  if (result.descriptor_dim > 0)
+    cloud.set_field(descriptor_field(result), result.descriptor_dim).values = result.descriptors;
   if (!result.probabilities.empty() && !result.labels.empty()) {
     const int classes = static_cast<int>(result.probabilities.size() / result.labels.size());
     cloud.set_field("probability", classes).values = result.probabilities;

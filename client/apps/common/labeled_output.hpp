@@ -6,6 +6,7 @@
 #include <string>
 
 #include "primlabel/client/client.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 
 namespace primlabel::client::tools {
@@ -13,6 +14,15 @@ namespace primlabel::client::tools {
 // The input cloud with the result's labels (replacing any label field it had), descriptors and
 // probabilities as float fields.
 PointCloud labeled_cloud(PointCloud input, const LabelResult& result);
+
+// The descriptor field's name: the server's ("fpfh" is PCL's FPFH, "fpfh_paper" the paper's
+// variant, "pfh"), else "pfh" or "descriptor" by width.
+std::string descriptor_field(const LabelResult& result);
+
+// What a labeled file says about itself in its header (labeled_cloud.hpp's tags, which PCL's and
+// Open3D's readers skip): model and version, the class map of `label`, the descriptor's name, the
+// probability columns in order ("id:name ..."), scan and request ids.
+CloudTags labeled_cloud_tags(const LabelResult& result);
 
 // Renders `cloud` coloured by its labels with the taxonomy's colours and a legend.
 void write_label_png(const PointCloud& cloud, const std::string& path, const std::string& title);

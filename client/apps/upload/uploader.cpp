@@ -211,7 +211,8 @@ bool Uploader::upload(const SpooledScan& scan) {
     return false;
   }
   const std::size_t points = result.size();
-  write_pcd(output_path(scan.id).string(), tools::labeled_cloud(std::move(cloud), result));
+  write_tagged_cloud(output_path(scan.id).string(), tools::labeled_cloud(std::move(cloud), result),
+                     tools::labeled_cloud_tags(result));
   // write_pcd returns once the file and its directory entry are durable (atomic_write_file), so
   // the spool may forget the scan now.
   spool_.complete(scan.id);

@@ -632,7 +632,12 @@ std::vector<OutputProperty> output_properties(const PointCloud& cloud) {
           {normal_axes[axis], "float", 4, bytes(cloud.normals.data()), 4u * axis, sizeof(Vec3f)});
   if (cloud.has_curvature())
     out.push_back({"curvature", "float", 4, bytes(cloud.curvature.data()), 0, 4});
-  if (cloud.has_labels()) out.push_back({"label", "uint", 4, bytes(cloud.labels.data()), 0, 4});
+  if (cloud.has_labels()) {
+    // "int" while every label fits: Open3D's PLY reader refuses "uint" attributes. Same bytes.
+    const bool fits_int = std::all_of(cloud.labels.begin(), cloud.labels.end(),
+                                      [](std::uint32_t l) { return l <= 0x7fffffffu; });
+    out.push_back({"label", fits_int ? "int" : "uint", 4, bytes(cloud.labels.data()), 0, 4});
+  }
   if (cloud.has_rgba()) {
     // Byte offsets of the channels of a little-endian 0xAARRGGBB word.
     const auto* rgba = bytes(cloud.rgba.data());

@@ -30,6 +30,13 @@ enum class FpfhVariant {
   kWithOwnSpfh,  // the paper's formula as Open3D implements it: PCL's result + the point's own SPFH
 };
 
+// The descriptor's field name in written clouds: PCL's FPFHSignature33 is "fpfh" (rows sum to
+// 300); the paper's variant is "fpfh_paper" (rows sum to 600), so no file passes one off as the
+// other.
+inline const char* fpfh_field_name(FpfhVariant variant) {
+  return variant == FpfhVariant::kPcl ? "fpfh" : "fpfh_paper";
+}
+
 struct FeatureOptions {
   Neighborhood neighborhood = Neighborhood::Knn(10);
   FpfhVariant fpfh_variant = FpfhVariant::kPcl;

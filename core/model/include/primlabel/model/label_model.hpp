@@ -40,6 +40,10 @@ struct FeatureSettings {
   bool radii_overridable = false;  // whether a request may change the radii
 
   int descriptor_dim() const { return descriptor == DescriptorKind::kFpfh ? kFpfhSize : kPfhSize; }
+  // "fpfh", "fpfh_paper" or "pfh": the field name of these descriptors in written clouds.
+  std::string descriptor_name() const {
+    return descriptor == DescriptorKind::kPfh ? "pfh" : fpfh_field_name(fpfh_variant);
+  }
 };
 
 struct ClassScore {
