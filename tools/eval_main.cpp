@@ -2,6 +2,7 @@
 // or re-measures the paper's Table I and Fig. 4.
 //
 //   primlabel-eval --model table.plm scene.pcd [--json] [--out labeled.pcd]
+//   primlabel-eval --model table.plm scene.pcd --primitives scene_primitives.json  # instances
 //   primlabel-eval --model table.plm --no-truth mosd_scene.pcd     # predicted label histogram
 //   primlabel-eval --model table.plm --confusion-png confusion.png a.pcd b.pcd   # over all files
 //   primlabel-eval --table1 [--json]
@@ -30,6 +31,7 @@
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/primitives/primitives_json.hpp"
 #include "primlabel/research/confusion_plot.hpp"
 #include "primlabel/research/fig4.hpp"
 #include "primlabel/research/kinect_calibration.hpp"
@@ -42,12 +44,11 @@ namespace {
 using namespace primlabel;
 
 struct Arguments {
-  std::string model, classes, out, confusion_png, fig4_dir, mosd_dir, truth_dir, calibrate_dir,
-      calibration_json;
+  std::string model, classes, out, primitives_json, confusion_png, fig4_dir, mosd_dir, truth_dir,
+      calibrate_dir, calibration_json;
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
-  bool table1 = false, no_pfh = false, no_svm = false, object_truth = false,
-       fit_simulation = false;
+  bool table1 = false, no_pfh = false, no_svm = false, object_truth = false, fit_simulation = false;
   int truth_check = 0;
   double truth_radius = research::ObjectTruthOptions{}.label_radius;
   std::string node_basis = "tent";
@@ -128,8 +129,16 @@ int evaluate_files(const Arguments& args) {
       cloud = args.classes.empty() ? load_labeled_cloud(path) : load_labeled_cloud(path, map);
     pipeline::LabelingOptions options;
     options.tabletop_only = args.tabletop_only;
+    options.want_primitives = !args.primitives_json.empty();
     const pipeline::LabelingResult result =
         pipeline::label_cloud(model, cloud, options, RunContext{args.threads});
+    if (result.primitives) {
+      const auto& instances = result.primitives->primitives;
+      atomic_write_file(args.primitives_json, primitives::primitives_json(instances));
+      if (!args.quiet)
+        std::fprintf(stderr, "%s: %zu primitives in %.3f s, wrote %s\n", path.c_str(),
+                     instances.size(), result.primitive_seconds, args.primitives_json.c_str());
+    }
     if (!args.quiet)
       std::fprintf(stderr, "%s: %zu points, features %.2f s, inference %.2f s\n", path.c_str(),
                    cloud.size(), result.feature_seconds, result.inference_seconds);
@@ -355,13 +364,18 @@ int main(int argc, char** argv) {
                    "predicted label histogram");
   app.add_option("--classes", args.classes, "class map of the files' labels (id name per line)");
   auto* out = app.add_option("--out", args.out, "write the predicted labels (one input file)");
+  auto* primitives_out = app.add_option(
+      "--primitives", args.primitives_json,
+      "group the predicted labels into connected segments, fit each with its class's primitive "
+      "(plane, cylinder, sphere, torus, edge line) and write them as JSON (one input file)");
   auto* mosd =
       app.add_option("--mosd-report", args.mosd_dir,
                      "mOSD scenes (label 1-9 table): share of table points labeled plane, and a "
                      "labeled PNG per scene, into DIR (with mosd_report.json)")
           ->needs(model)
           ->excludes(no_truth)
-          ->excludes(out);
+          ->excludes(out)
+          ->excludes(primitives_out);
   auto* object_truth =
       app.add_flag("--object-truth", args.object_truth,
                    "--mosd-report: also fit box / cylinder models to the object segments, label "
@@ -446,8 +460,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "primlabel-eval: usage error: %s\n", e.what());
     return cli::kExitUsage;
   }
-  const bool study = args.table1 || !args.fig4_dir.empty() || args.truth_check > 0 ||
-                     !args.calibrate_dir.empty();
+  const bool study =
+      args.table1 || !args.fig4_dir.empty() || args.truth_check > 0 || !args.calibrate_dir.empty();
   const bool truth_only = !args.truth_dir.empty() && args.model.empty();
   if (!args.truth_dir.empty() && !args.model.empty() && args.mosd_dir.empty()) {
     std::fprintf(stderr,
@@ -466,6 +480,11 @@ int main(int argc, char** argv) {
   }
   if (!args.out.empty() && args.files.size() != 1) {
     std::fprintf(stderr, "primlabel-eval: usage error: --out takes exactly one input file\n");
+    return cli::kExitUsage;
+  }
+  if (!args.primitives_json.empty() && args.files.size() != 1) {
+    std::fprintf(stderr,
+                 "primlabel-eval: usage error: --primitives takes exactly one input file\n");
     return cli::kExitUsage;
   }
   try {

@@ -13,6 +13,7 @@
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/pipeline/training.hpp"
+#include "primlabel/primitives/primitives_json.hpp"
 #include "primlabel/synth/generate.hpp"
 #include "test_util.hpp"
 
@@ -95,6 +96,33 @@ TEST_F(PipelineCli, WritesPredictedLabelsAndHistogramWithoutTruth) {
   EXPECT_NE(r.output.find("predicted labels"), std::string::npos) << r.output;
   const PointCloud labeled = load_labeled_cloud(out);
   EXPECT_TRUE(labeled.has_labels());
+}
+
+// The all-zero model labels every point plane, so the largest instance is the table top, the
+// plane z = 0 of the synthetic scene.
+TEST_F(PipelineCli, WritesPrimitivesAsJson) {
+  const std::string out = (*dir_ / "primitives.json").string();
+  const Result r = run(eval() + " --model " + zero_model_path() + " --no-truth -q --primitives " +
+                       out + " " + scene_path());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::vector<primitives::Primitive> read = primitives::parse_primitives_json(text);
+  ASSERT_FALSE(read.empty()) << text.substr(0, 400);
+  const primitives::Primitive& table = read.front();
+  ASSERT_EQ(table.kind(), primitives::PrimitiveKind::kPlane);
+  EXPECT_EQ(table.class_id, class_id(PrimitiveClass::kPlane));
+  const auto& plane = std::get<primitives::PlaneModel>(table.model);
+  EXPECT_GT(std::abs(plane.normal.z()), 0.9999);
+  EXPECT_LT(std::abs(plane.offset), 0.001);
+  EXPECT_LT(std::abs(plane.center.z()), 0.001);
+  EXPECT_GT(table.inliers, table.points / 2);
+  EXPECT_LT(table.rms, 0.001);
+  // Usage: one input file only.
+  EXPECT_EQ(run(eval() + " --model " + zero_model_path() + " -q --primitives " + out + " " +
+                scene_path() + " " + scene_path())
+                .exit_code,
+            2);
 }
 
 TEST_F(PipelineCli, WritesTheConfusionMatrixAsPng) {

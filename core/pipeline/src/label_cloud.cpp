@@ -272,6 +272,7 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
                                 std::to_string(cloud.size()) + " points");
   if (!(options.voxel_size >= 0.0f) || !std::isfinite(options.voxel_size))
     throw std::invalid_argument("voxel size must be finite and >= 0");
+  if (options.want_primitives) options.primitives.validate();  // before the costly part
   const FeatureSettings features = effective_features(model, options);
   const float voxel_size =
       options.voxel_size > 0.0f ? options.voxel_size : model.features.voxel_size;
@@ -281,6 +282,12 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
                               : label_points(model, features, cloud, options, context);
   result.domain_warning =
       domain_warning(model.training, result.point_spacing, result.surface_variation);
+  if (options.want_primitives) {
+    const auto start = std::chrono::steady_clock::now();
+    result.primitives = primitives::fit_primitives(cloud.xyz, cloud.normals, result.labels,
+                                                   options.primitives, context);
+    result.primitive_seconds = seconds_since(start);
+  }
   return result;
 }
 

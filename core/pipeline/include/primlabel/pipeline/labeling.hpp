@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,6 +19,7 @@
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/run_context.hpp"
 #include "primlabel/model/label_model.hpp"
+#include "primlabel/primitives/fit_primitives.hpp"
 
 namespace primlabel::pipeline {
 
@@ -89,6 +91,10 @@ struct LabelingOptions {
   float normal_radius = 0.0f;
   float feature_radius = 0.0f;
   bool share_neighbor_lists = true;  // DescribeOptions::share_neighbor_lists
+  // Also group the labels into connected segments and fit each with its class's primitive
+  // (LabelingResult::primitives), from the labels and the normals label_cloud leaves in the cloud.
+  bool want_primitives = false;
+  primitives::PrimitiveOptions primitives;
 };
 
 struct LabelingResult {
@@ -116,6 +122,9 @@ struct LabelingResult {
   // Not empty when point_spacing is far outside what the model was trained for (domain.hpp):
   // the labels are then unreliable, and the caller should be told so.
   std::string domain_warning;
+  // With want_primitives: the fitted instances and every point's segment (primitive) id.
+  std::optional<primitives::PrimitiveSet> primitives;
+  double primitive_seconds = 0;  // segmentation and fitting (in no stage above)
 };
 
 // Labels every point with the model's own feature, graph and inference settings (and the
@@ -125,8 +134,8 @@ struct LabelingResult {
 // Throws ModelError when an SVM model's libsvm text does not load, std::invalid_argument for
 // overrides the model does not allow or missing normals, and Cancelled when context.stop is
 // requested (checked between stages and per point inside them, the table-top stage, the voxel
-// filter and the index builds included: within milliseconds). The labels do not depend on
-// context.threads.
+// filter and the index builds included: within milliseconds). The labels (and primitives) do not
+// depend on context.threads.
 LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
                            const LabelingOptions& options = {}, const RunContext& context = {});
 

@@ -117,6 +117,8 @@ class CanShape : public Shape {
   double distance_outside(const Vec3d& p) const override;
   double footprint_inset(const Vec3d& p) const override;
   double footprint_radius() const override { return radius_; }
+  double radius() const { return radius_; }
+  double height() const { return height_; }
 
  private:
   double radius_, height_;
@@ -169,6 +171,8 @@ class MugShape : public Shape {
   double distance_outside(const Vec3d& p) const override;
   double footprint_inset(const Vec3d& p) const override;
   double footprint_radius() const override;
+  double outer_radius() const { return radius_; }
+  double inner_radius() const { return inner_radius_; }
 
  private:
   bool intersect_handle(const Ray& ray, double t_min, double t_max, SurfaceHit& hit) const;
@@ -192,6 +196,10 @@ class BowlShape : public Shape {
   double footprint_inset(const Vec3d& p) const override;
   double footprint_radius() const override { return outer_rim_radius_max_; }
   double rim_height() const { return rim_z_; }
+  // The two spheres' radii and their common centre's height above the table.
+  double outer_radius() const { return radius_; }
+  double inner_radius() const { return inner_radius_; }
+  double center_height() const { return center_z_; }
 
  private:
   double radius_, inner_radius_, center_z_, rim_z_, foot_;
@@ -209,6 +217,7 @@ class BallShape : public Shape {
   }
   double distance_outside(const Vec3d& p) const override;
   double footprint_radius() const override { return radius_; }
+  double radius() const { return radius_; }
 
  private:
   double radius_;
@@ -224,6 +233,8 @@ class TorusShape : public Shape {
   PrimitiveClass surface_class(int, const Vec3d& p) const override;
   double distance_outside(const Vec3d& p) const override;
   double footprint_radius() const override { return major_ + tube_; }
+  double major_radius() const { return major_; }
+  double tube_radius() const { return tube_; }
 
  private:
   double major_, tube_;
