@@ -36,8 +36,9 @@ PACKAGES=(
 )
 # Only the tests need these: the deployment checks (YAML, nginx -t, promtool, the local
 # three-replica proof), TLS certificates made on the fly, and clang with libFuzzer for the fuzz
-# targets (tests/fuzz).
-TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl clang-14 libclang-rt-14-dev)
+# targets (tests/fuzz), Open3D for the interoperability check (tests/interop).
+TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl clang-14 libclang-rt-14-dev
+  python3-open3d)
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev)
 [[ "${1:-}" == test ]] && PACKAGES+=("${TEST_PACKAGES[@]}")
 
