@@ -35,6 +35,7 @@ v1::LabelRequest header_request(const PointCloud& cloud, const LabelOptions& o) 
   v1::LabelOptions& options = *header.mutable_options();
   options.set_return_descriptors(o.descriptors);
   options.set_return_probabilities(o.probabilities);
+  options.set_return_primitives(o.primitives);
   options.set_tabletop_only(o.tabletop_only);
   options.set_voxel_size(o.voxel_size);
   options.set_normal_radius(o.normal_radius);
@@ -165,7 +166,7 @@ struct Client::Impl {
     const std::size_t chunk_points = std::max<std::size_t>(1, o.chunk_points);
     LabelResult result;
     result.attempts = with_retries(timeout_of(o), control, [&](grpc::ClientContext& context) {
-      LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities);
+      LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities, o.primitives);
       auto stream = labeler->Label(&context);
       // Writes stop at the first failure: the server has ended the call, Finish says why.
       bool writing = stream->Write(header_request(cloud, o));
@@ -214,7 +215,7 @@ struct Client::Impl {
       v1::LabelCloudResponse response;
       grpc::Status status = labeler->LabelCloud(&context, request, &response);
       if (!status.ok()) return status;
-      LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities);
+      LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities, o.primitives);
       assembler.add(response.result());
       result = assembler.finish(response.summary());
       return status;

@@ -8,13 +8,16 @@
 namespace primlabel::client {
 
 namespace {
+constexpr std::uint32_t kNoSegment = 0xFFFFFFFFu;  // LabelChunk.segments: in no segment
 std::string at(std::uint64_t first) { return "chunk at point " + std::to_string(first); }
 }  // namespace
 
-LabelAssembler::LabelAssembler(std::size_t points, bool want_descriptors, bool want_probabilities)
+LabelAssembler::LabelAssembler(std::size_t points, bool want_descriptors, bool want_probabilities,
+                               bool want_segments)
     : points_(points),
       want_descriptors_(want_descriptors),
       want_probabilities_(want_probabilities),
+      want_segments_(want_segments),
       covered_(points, 0) {
   result_.labels.assign(points, 0);
 }
@@ -69,6 +72,17 @@ void LabelAssembler::add(const v1::LabelChunk& chunk) {
     wire::unpack_f32(chunk.probabilities(), result_.probabilities.data() + first * classes);
   }
 
+  const int segment_columns = columns(chunk.segments().size(), count, "segments", first);
+  if (want_segments_ && count > 0 && segment_columns < 0)
+    throw ProtocolError(at(first) + ": primitives were asked for but the segment ids are missing");
+  if (segment_columns > 1)
+    throw ProtocolError(at(first) + ": " + std::to_string(segment_columns) +
+                        " segment ids a point, not 1");
+  if (segment_columns == 1) {
+    if (result_.segments.empty()) result_.segments.assign(points_, kNoSegment);
+    wire::unpack_u32(chunk.segments(), result_.segments.data() + first);
+  }
+
   wire::unpack_u32(chunk.labels(), result_.labels.data() + first);
   for (std::uint64_t i = first; i < first + count; ++i) covered_[i] = 1;
   covered_count_ += count;
@@ -96,6 +110,13 @@ LabelResult LabelAssembler::finish(const v1::LabelSummary& summary) {
                           " classes, the chunks carried " + std::to_string(probability_columns_) +
                           " probabilities a point");
   }
+  // Every segment id names one of the summary's primitives.
+  const auto primitive_count = std::uint32_t(summary.primitives_size());
+  for (std::size_t i = 0; i < result_.segments.size(); ++i)
+    if (result_.segments[i] != kNoSegment && result_.segments[i] >= primitive_count)
+      throw ProtocolError("point " + std::to_string(i) + " is in segment " +
+                          std::to_string(result_.segments[i]) + ", the summary has " +
+                          std::to_string(primitive_count) + " primitives");
   for (const auto& c : summary.classes()) {
     result_.class_ids.push_back(c.id());
     result_.class_names.push_back(c.name());

@@ -20,7 +20,8 @@ class ProtocolError : public std::runtime_error {
 
 class LabelAssembler {
  public:
-  LabelAssembler(std::size_t points, bool want_descriptors, bool want_probabilities);
+  LabelAssembler(std::size_t points, bool want_descriptors, bool want_probabilities,
+                 bool want_segments = false);
 
   void add(const v1::LabelChunk& chunk);
   // Checks coverage and column counts against the summary and hands the result over.
@@ -35,6 +36,7 @@ class LabelAssembler {
   std::size_t points_;
   bool want_descriptors_;
   bool want_probabilities_;
+  bool want_segments_;
   std::vector<char> covered_;
   std::size_t covered_count_ = 0;
   LabelResult result_;

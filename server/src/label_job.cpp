@@ -30,6 +30,7 @@ std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelReg
   plan.options.normal_radius = options.normal_radius();
   plan.options.feature_radius = options.feature_radius();
   plan.options.use_cloud_normals = header.layout().normals();
+  plan.options.want_primitives = options.return_primitives();
   return std::nullopt;
 }
 
@@ -39,7 +40,13 @@ std::uint64_t answer_bytes_per_point(const LabelPlan& plan) {
   if (plan.options.want_descriptors)
     bytes += sizeof(float) * std::uint64_t(model.features.descriptor_dim());
   if (plan.options.want_probabilities) bytes += sizeof(float) * model.class_ids().size();
+  if (plan.options.want_primitives) bytes += sizeof(std::uint32_t);  // LabelChunk.segments
   return bytes;
+}
+
+std::uint64_t answer_summary_bytes(const LabelPlan& plan) {
+  if (!plan.options.want_primitives) return 0;
+  return std::uint64_t(plan.options.primitives.segments.max_segments) * kMaxPrimitiveMessageBytes;
 }
 
 std::optional<ServiceError> run_label_job(const LabelPlan& plan, PointCloud& cloud,

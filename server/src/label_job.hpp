@@ -26,9 +26,16 @@ struct LabelPlan {
 std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelRegistry& registry,
                                           LabelPlan& plan);
 
-// Bytes per point of the answer the plan asks for (labels, descriptors, probabilities), known
-// before labeling.
+// Bytes per point of the answer the plan asks for (labels, descriptors, probabilities, segment
+// ids), known before labeling.
 std::uint64_t answer_bytes_per_point(const LabelPlan& plan);
+
+// A bound on one encoded v1::Primitive (a plane, the largest: 16 doubles and 4 scalars with their
+// tags, about 300 bytes); test_server_service checks real messages against it.
+inline constexpr std::uint64_t kMaxPrimitiveMessageBytes = 400;
+// Bytes the summary may carry on top of its fixed part, whatever the cloud size: the primitives
+// (at most PrimitiveOptions::segments.max_segments of them).
+std::uint64_t answer_summary_bytes(const LabelPlan& plan);
 
 // Runs label_cloud; never throws. CANCELLED when context.stop was requested.
 std::optional<ServiceError> run_label_job(const LabelPlan& plan, PointCloud& cloud,

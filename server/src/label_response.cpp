@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 
+#include "primitive_messages.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/wire/packing.hpp"
 #include "stage_times.hpp"
@@ -18,7 +19,7 @@ LabelResponder::LabelResponder(const pipeline::LabelingResult& result,
   bytes_per_point_ =
       wire::kLabelBytesPerPoint +
       sizeof(float) * std::uint64_t(result.descriptors.dim) * (result.descriptors.empty() ? 0 : 1) +
-      sizeof(float) * classes_;
+      sizeof(float) * classes_ + (result.primitives ? sizeof(std::uint32_t) : 0);
   const std::uint64_t fitting = std::max<std::uint64_t>(1, max_bytes / bytes_per_point_);
   chunk_points_ =
       requested_points > 0 ? std::min<std::uint64_t>(requested_points, fitting) : fitting;
@@ -52,6 +53,10 @@ void LabelResponder::fill_range(std::uint64_t first, std::uint64_t count,
         rows[i * classes_ + k] = result_.probabilities(Eigen::Index(first + i), Eigen::Index(k));
     wire::append_le(*chunk.mutable_probabilities(), std::span<const float>(rows));
   }
+  if (result_.primitives)
+    wire::append_le(
+        *chunk.mutable_segments(),
+        std::span<const std::uint32_t>(result_.primitives->point_segment.data() + first, count));
 }
 
 namespace {
@@ -101,6 +106,7 @@ void fill_summary(const RequestRecord& record, const ModelEntry& entry,
   if (std::isfinite(result.point_spacing)) summary.set_point_spacing(result.point_spacing);
   summary.set_domain_warning(result.domain_warning);
   *summary.mutable_classes() = entry.metadata.classes();
+  if (result.primitives) add_primitives(result.primitives->primitives, summary);
 }
 
 }  // namespace primlabel::server

@@ -101,6 +101,7 @@ std::optional<ServiceError> LabelSession::outcome() {
   record_.stages.normals = result_.normal_seconds;
   record_.stages.features = result_.descriptor_seconds;
   record_.stages.inference = result_.inference_seconds;
+  if (result_.primitives) record_.stages.primitives = result_.primitive_seconds;
   return std::nullopt;
 }
 

@@ -45,7 +45,9 @@ class LabelSession {
   const LabelPlan& plan() const { return plan_; }
   std::uint64_t points() const { return assembler_ ? assembler_->points() : 0; }
   // The answer's per-point arrays in bytes, from the point count and the options.
-  std::uint64_t answer_bytes() const { return points() * answer_bytes_per_point(plan_); }
+  std::uint64_t answer_bytes() const {
+    return points() * answer_bytes_per_point(plan_) + answer_summary_bytes(plan_);
+  }
   const pipeline::LabelingResult& result() const { return result_; }
   void free_result();
 

@@ -9,7 +9,8 @@ namespace primlabel::server {
 
 // Seconds per stage; negative = the stage did not run.
 struct StageTimes {
-  double receive = -1, prefilter = -1, normals = -1, features = -1, inference = -1, send = -1;
+  double receive = -1, prefilter = -1, normals = -1, features = -1, inference = -1, primitives = -1,
+         send = -1;
 };
 
 struct StageField {
@@ -17,12 +18,13 @@ struct StageField {
   double StageTimes::*seconds;
 };
 
-inline constexpr std::array<StageField, 6> kStages = {{
+inline constexpr std::array<StageField, 7> kStages = {{
     {"receive", &StageTimes::receive},
     {"prefilter", &StageTimes::prefilter},
     {"normals", &StageTimes::normals},
     {"features", &StageTimes::features},
     {"inference", &StageTimes::inference},
+    {"primitives", &StageTimes::primitives},  // only with return_primitives
     {"send", &StageTimes::send},
 }};
 

@@ -177,6 +177,50 @@ class FakeLabeler final : public v1::Labeler::Service {
     return expected > 0;
   }
 
+  // Known instances: a plane z = 0.3 (normal +z, offset -0.3), a cylinder of radius 0.04 about
+  // +z, a sphere of radius 0.05 and a line along +y, 0.5 long.
+  static void fake_primitives(v1::LabelSummary& summary) {
+    const auto set = [](v1::Vec3d* v, double x, double y, double z) {
+      v->set_x(x), v->set_y(y), v->set_z(z);
+    };
+    const v1::PrimitiveKind kinds[] = {v1::PRIMITIVE_PLANE, v1::PRIMITIVE_CYLINDER,
+                                       v1::PRIMITIVE_SPHERE, v1::PRIMITIVE_LINE};
+    for (std::uint32_t s = 0; s < 4; ++s) {
+      v1::Primitive& p = *summary.add_primitives();
+      p.set_segment_id(s);
+      p.set_kind(kinds[s]);
+      p.set_class_id(s + 1);
+      p.set_point_count(60);
+      p.set_first_point(s + 1);
+      p.set_inliers(50 + s);
+      p.set_rms(0.001 * (s + 1));
+      p.set_confidence(0.9);
+      set(p.mutable_centroid(), s + 1, 1.5, 0.3);
+      set(p.mutable_bounds_min(), s + 1, 0.0, 0.3);
+      set(p.mutable_bounds_max(), s + 1, 3.0, 0.3);
+    }
+    v1::PlaneModel& plane = *summary.mutable_primitives(0)->mutable_plane();
+    set(plane.mutable_normal(), 0, 0, 1);
+    plane.set_offset(-0.3);
+    set(plane.mutable_center(), 1, 1.5, 0.3);
+    set(plane.mutable_axis_u(), 0, 1, 0);
+    set(plane.mutable_axis_v(), 1, 0, 0);
+    plane.set_extent_u(3.0);
+    plane.set_extent_v(0.01);
+    v1::CylinderModel& cylinder = *summary.mutable_primitives(1)->mutable_cylinder();
+    set(cylinder.mutable_center(), 2, 1.5, 0.3);
+    set(cylinder.mutable_axis(), 0, 0, 1);
+    cylinder.set_radius(0.04);
+    cylinder.set_height(0.12);
+    v1::SphereModel& sphere = *summary.mutable_primitives(2)->mutable_sphere();
+    set(sphere.mutable_center(), 3, 1.5, 0.3);
+    sphere.set_radius(0.05);
+    v1::LineModel& line = *summary.mutable_primitives(3)->mutable_line();
+    set(line.mutable_center(), 4, 1.5, 0.3);
+    set(line.mutable_direction(), 0, 1, 0);
+    line.set_length(0.5);
+  }
+
   grpc::Status answer(const v1::ScanHeader& header, const std::vector<Vec3f>& points,
                       std::vector<v1::LabelResponse>& responses, v1::LabelSummary& summary) {
     if (!header.model().empty() && header.model() != "fake")
@@ -213,7 +257,15 @@ class FakeLabeler final : public v1::Labeler::Service {
         c.set_descriptors(wire::pack_f32(descriptors.data(), descriptors.size()));
       if (header.options().return_probabilities())
         c.set_probabilities(wire::pack_f32(probabilities.data(), probabilities.size()));
+      if (header.options().return_primitives()) {
+        // Label k > 0 is segment k - 1 (fake_primitives); label 0 is in none.
+        std::vector<std::uint32_t> segments(count);
+        for (std::size_t i = 0; i < count; ++i)
+          segments[i] = labels[i] == 0 ? 0xFFFFFFFFu : labels[i] - 1;
+        c.set_segments(wire::pack_u32(segments.data(), count));
+      }
     }
+    if (header.options().return_primitives()) fake_primitives(summary);
     summary.set_scan_id(header.scan_id());
     summary.set_model("fake");
     summary.set_model_version("1");

@@ -6,13 +6,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
 
 #include "common/human_format.hpp"
 #include "common/server_address.hpp"
 #include "fake_labeler.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
+#include "primlabel/primitives/primitives_json.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -28,6 +31,13 @@ void write_scan(const std::string& path, std::size_t n = 300) {
   cloud.resize_unorganized(n);
   for (std::size_t i = 0; i < n; ++i) cloud.xyz[i] = Vec3f(float(i % 5), 0.01f * i, 0.3f);
   write_cloud(path, cloud);
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 // An address nothing listens on.
@@ -85,6 +95,41 @@ TEST(ClientCli, LabelWritesLabelsDescriptorsProbabilitiesAndPng) {
   EXPECT_EQ(out.find_field("probability")->count, 3);
   EXPECT_TRUE(std::filesystem::exists(dir.file("out.png")));
   EXPECT_NE(r.output.find("300 points"), std::string::npos) << r.output;
+}
+
+// --primitives writes primlabel-eval's JSON from the summary's primitives (the fake's known
+// instances, read back with the core's parser).
+TEST(ClientCli, PrimitivesGoToTheirJsonFile) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  const auto r = test::run_command(
+      cli() + " --server " + server.address() + " label " + dir.file("scan.pcd") + " -o " +
+      dir.file("out.pcd") + " --primitives " + dir.file("prims.json") + " --chunk-points 64");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto instances = primitives::parse_primitives_json(read_text(dir.file("prims.json")));
+  ASSERT_EQ(instances.size(), 4u);
+  const auto* plane = std::get_if<primitives::PlaneModel>(&instances[0].model);
+  ASSERT_NE(plane, nullptr);
+  EXPECT_EQ(plane->normal, primitives::Vec3d(0, 0, 1));
+  EXPECT_DOUBLE_EQ(plane->offset, -0.3);
+  EXPECT_DOUBLE_EQ(plane->extent_u, 3.0);
+  EXPECT_EQ(instances[0].class_id, 1u);
+  EXPECT_EQ(instances[0].points, 60u);
+  EXPECT_EQ(instances[0].inliers, 50u);
+  EXPECT_DOUBLE_EQ(instances[0].confidence, 0.9);
+  const auto* cylinder = std::get_if<primitives::CylinderModel>(&instances[1].model);
+  ASSERT_NE(cylinder, nullptr);
+  EXPECT_DOUBLE_EQ(cylinder->radius, 0.04);
+  EXPECT_DOUBLE_EQ(cylinder->height, 0.12);
+  const auto* sphere = std::get_if<primitives::SphereModel>(&instances[2].model);
+  ASSERT_NE(sphere, nullptr);
+  EXPECT_DOUBLE_EQ(sphere->radius, 0.05);
+  const auto* line = std::get_if<primitives::LineModel>(&instances[3].model);
+  ASSERT_NE(line, nullptr);
+  EXPECT_DOUBLE_EQ(line->length, 0.5);
+  EXPECT_EQ(line->direction, primitives::Vec3d(0, 1, 0));
+  EXPECT_DOUBLE_EQ(instances[3].rms, 0.004);
 }
 
 TEST(ClientCli, LabeledFilesDescribeThemselvesInTheirHeader) {

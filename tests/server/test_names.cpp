@@ -39,7 +39,7 @@ TEST(SharedNames, EachStageNamesItsOwnField) {
     EXPECT_EQ(set, 1) << stage.name;
   }
   EXPECT_EQ(names, (std::set<std::string>{"receive", "prefilter", "normals", "features",
-                                          "inference", "send"}));
+                                          "inference", "primitives", "send"}));
   EXPECT_STREQ(kStages.front().name, "receive");  // pipeline order: logs and responses read it
   EXPECT_STREQ(kStages.back().name, "send");
 }

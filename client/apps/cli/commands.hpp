@@ -19,6 +19,7 @@ struct LabelCommand {
   bool png = false;
   bool descriptors = false;
   bool probabilities = false;
+  std::string primitives;  // --primitives: JSON file (one input) or directory (several)
   bool unary = false;
   bool quiet = false;
   LabelOptions options;

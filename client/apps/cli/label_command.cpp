@@ -8,8 +8,10 @@
 
 #include "commands.hpp"
 #include "common/labeled_output.hpp"
+#include "common/primitive_json.hpp"
 #include "exit_codes.hpp"
 #include "primlabel/cli/cli_common.hpp"
+#include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel::client::tools {
@@ -29,6 +31,14 @@ std::string output_path(const LabelCommand& command, const fs::path& input) {
   return out.string();
 }
 
+// Where the primitives of `input` go: --primitives itself, or inside it for several inputs.
+std::string primitives_path(const LabelCommand& command, const fs::path& input) {
+  const fs::path out(command.primitives);
+  if (command.inputs.size() > 1 || fs::is_directory(out))
+    return (out / (input.stem().string() + "_primitives.json")).string();
+  return out.string();
+}
+
 }  // namespace
 
 int run_label(Client& client, LabelCommand command) {
@@ -43,6 +53,16 @@ int run_label(Client& client, LabelCommand command) {
   }
   command.options.descriptors = command.descriptors;
   command.options.probabilities = command.probabilities;
+  command.options.primitives = !command.primitives.empty();
+  if (command.inputs.size() > 1 && !command.primitives.empty()) {
+    std::error_code ec;
+    fs::create_directories(command.primitives, ec);
+    if (ec) {
+      std::fprintf(stderr, "primlabel: %s: cannot create the primitives directory: %s\n",
+                   command.primitives.c_str(), ec.message().c_str());
+      return kExitFile;
+    }
+  }
   cli::ProgressPrinter progress(command.quiet);
   int exit_code = kExitOk;
   for (const std::string& input : command.inputs) {
@@ -82,6 +102,8 @@ int run_label(Client& client, LabelCommand command) {
         write_label_png(labeled, fs::path(out).replace_extension(".png").string(),
                         fs::path(input).filename().string() + " - " + result.summary.model() + " " +
                             result.summary.model_version());
+      if (!command.primitives.empty())
+        atomic_write_file(primitives_path(command, input), summary_primitives_json(result.summary));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "primlabel: %s\n", e.what());
       if (exit_code == kExitOk) exit_code = kExitFile;

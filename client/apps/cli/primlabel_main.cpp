@@ -54,6 +54,10 @@ int main(int argc, char** argv) {
   label->add_flag("--descriptors", label_args.descriptors, "Add the FPFH descriptors (fpfh)");
   label->add_flag("--probabilities", label_args.probabilities,
                   "Add the per-class probabilities (probability, columns as `info` lists)");
+  label->add_option("--primitives", label_args.primitives,
+                    "Also fit primitive instances and write them as JSON (as primlabel-eval "
+                    "--primitives): a file (one input) or directory (several, "
+                    "<input>_primitives.json)");
   label->add_option("--model", label_args.options.model, "Model (default: the server's)");
   label->add_option("--model-version", label_args.options.model_version, "Model version");
   label->add_flag("--tabletop", label_args.options.tabletop_only,

@@ -60,6 +60,7 @@ struct LabelOptions {
   std::string scan_id;        // the caller's id, echoed in the summary and the server's logs
   bool descriptors = false;   // return the FPFH descriptors
   bool probabilities = false;
+  bool primitives = false;  // fitted primitive instances (summary.primitives) and segment ids
   bool tabletop_only = false;
   float voxel_size = 0;  // > 0: downsample before features
   float normal_radius = 0;
@@ -80,10 +81,16 @@ struct LabelResult {
   std::vector<std::uint32_t> class_ids;  // columns of probabilities
   std::vector<std::string> class_names;
   std::vector<float> probabilities;  // point-major
+  // With LabelOptions::primitives: each point's index into primitives(), 0xFFFFFFFF for none.
+  std::vector<std::uint32_t> segments;
   v1::LabelSummary summary;
   int attempts = 1;  // calls made, including retries
 
   std::size_t size() const { return labels.size(); }
+  // The fitted instances (with LabelOptions::primitives), primitives()[s] for segment id s.
+  const google::protobuf::RepeatedPtrField<v1::Primitive>& primitives() const {
+    return summary.primitives();
+  }
 };
 
 // A failed call: the gRPC status of the last attempt (or DATA_LOSS when the server's answer did
