@@ -23,6 +23,7 @@ import numpy as np
 
 from .backoff import Backoff, BackoffPolicy
 from .errors import InvalidInput, PrimlabelError, ProtocolError
+from .pcd import PointCloud
 from .v1 import labeling_pb2, labeling_pb2_grpc
 from .wire import LabelAssembler, as_points, decode_health_status, encode_health_request
 
@@ -235,13 +236,18 @@ class Client:
         """Streams the points (Labeler.Label) in messages of chunk_points and returns their
         labels in input order.
 
-        xyz: (N, 3) array, float32 or float64 (sent as float32). normals: (N, 3), sent so the
-        server skips normal estimation. model: None = the server's default. voxel_size: > 0
+        xyz: (N, 3) array, float32 or float64 (sent as float32), or a pcd.PointCloud (its xyz,
+        and its VIEWPOINT unless viewpoint is given). normals: (N, 3), sent so the server skips
+        normal estimation. model: None = the server's default. voxel_size: > 0
         downsamples before features (labels still cover every input point); None = the model's.
-        viewpoint: the sensor origin (x, y, z) normals face (default the origin; a PCD's is
-        PointCloud.viewpoint[:3]). non_finite: "drop" (NaN/Inf points get label 0) or
+        viewpoint: the sensor origin (x, y, z) the normals face (default: the origin). It
+        changes the labels (convex or concave), so pass the scan's. non_finite: "drop" (NaN/Inf points get label 0) or
         "reject" (the call fails with INVALID_ARGUMENT).
         """
+        if isinstance(xyz, PointCloud):  # its points, seen from its VIEWPOINT as the CLI does
+            if viewpoint is None:
+                viewpoint = xyz.viewpoint[:3]
+            xyz = xyz.xyz
         points = as_points(xyz, "xyz")
         sent_normals = None if normals is None else as_points(normals, "normals", len(points))
         if non_finite not in _NON_FINITE:
