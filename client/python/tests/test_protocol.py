@@ -4,6 +4,7 @@ RESOURCE_EXHAUSTED, reassembly of out-of-order chunks, and answers that break th
 
 from __future__ import annotations
 
+import time
 from concurrent import futures
 
 import grpc
@@ -34,6 +35,8 @@ class FakeLabeler(labeling_pb2_grpc.LabelerServicer):
             elif request.HasField("chunk"):
                 parts.append(np.frombuffer(request.chunk.xyz, "<f4").reshape(-1, 3))
         behaviour = header.scan_id
+        while behaviour == "slow" and context.is_active():  # until the client gives up
+            time.sleep(0.01)
         if behaviour == "busy-once" and self.calls == 1:
             context.abort(grpc.StatusCode.RESOURCE_EXHAUSTED, "queue full")
         xyz = np.concatenate(parts) if parts else np.zeros((0, 3), np.float32)
@@ -138,3 +141,11 @@ def test_health_wire_round_trip():
     assert wire.decode_health_status(b"") == 0
     with pytest.raises(primlabel.errors.ProtocolError):
         wire.decode_health_status(b"\x08")
+
+
+def test_the_deadline_ends_a_call_the_server_does_not_answer(fake):
+    client, labeler = fake
+    with pytest.raises(primlabel.PrimlabelError) as error:
+        client.label(points(100), scan_id="slow", deadline=0.3)
+    assert error.value.code == grpc.StatusCode.DEADLINE_EXCEEDED
+    assert error.value.attempts == 1 and labeler.calls == 1  # not retried
