@@ -35,10 +35,12 @@ PACKAGES=(
   libgtest-dev
 )
 # Only the tests need these: the deployment checks (YAML, nginx -t, promtool, the local
-# three-replica proof), TLS certificates made on the fly, and clang with libFuzzer for the fuzz
-# targets (tests/fuzz), Open3D for the interoperability check (tests/interop).
+# three-replica proof), TLS certificates made on the fly, clang with libFuzzer for the fuzz
+# targets (tests/fuzz), the Python client's runtime and pytest (client/python; its stubs come
+# from protoc and protobuf-compiler-grpc's grpc_python_plugin, above), and Open3D for the
+# interoperability check (tests/interop).
 TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl clang-14 libclang-rt-14-dev
-  python3-open3d)
+  python3-grpcio python3-numpy python3-protobuf python3-pytest python3-open3d)
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev)
 [[ "${1:-}" == test ]] && PACKAGES+=("${TEST_PACKAGES[@]}")
 

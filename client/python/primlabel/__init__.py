@@ -1,0 +1,29 @@
+"""primlabel: the Python client of the primlabel point labeling service, and PCD files to numpy.
+
+    import primlabel
+    with primlabel.Client("127.0.0.1:50051") as client:
+        cloud = primlabel.pcd.read("scan.pcd")
+        result = client.label(cloud.xyz, viewpoint=cloud.viewpoint[:3])
+        cloud.label = result.labels
+        primlabel.pcd.write("scan_labeled.pcd", cloud)
+"""
+
+from . import pcd
+from ._version import __version__
+from .backoff import Backoff, BackoffPolicy
+from .client import ClassInfo, Client, HealthStatus, Result, Tls
+from .errors import InvalidInput, PrimlabelError
+
+__all__ = [
+    "Backoff",
+    "BackoffPolicy",
+    "ClassInfo",
+    "Client",
+    "HealthStatus",
+    "InvalidInput",
+    "PrimlabelError",
+    "Result",
+    "Tls",
+    "__version__",
+    "pcd",
+]

@@ -1,0 +1,346 @@
+"""The Python client of the primlabel labeling service (api/primlabel/v1/labeling.proto), the
+same protocol as the C++ client (client/src/client.cpp):
+
+    client = primlabel.Client("127.0.0.1:50051")
+    result = client.label(xyz)   # xyz: (N, 3) float32 or float64
+    result.labels[i]             # the taxonomy class of xyz[i]
+
+Every call has a deadline (the client's unless the call gives one) covering all its attempts.
+Calls failing with UNAVAILABLE or RESOURCE_EXHAUSTED (the server restarting, or its queue full)
+are retried with exponential backoff and jitter within that deadline; labeling is a pure function
+of the request, so a retry is safe. Failures raise PrimlabelError with the gRPC status.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import time
+from dataclasses import dataclass
+
+import grpc
+import numpy as np
+
+from .backoff import Backoff, BackoffPolicy
+from .errors import InvalidInput, PrimlabelError, ProtocolError
+from .pcd import PointCloud
+from .v1 import labeling_pb2, labeling_pb2_grpc
+from .wire import LabelAssembler, as_points, decode_health_status, encode_health_request
+
+DEFAULT_ADDRESS = "127.0.0.1:50051"
+DEFAULT_CHUNK_POINTS = 65536  # points per streamed request message, as the C++ client
+RETRIED_CODES = frozenset({grpc.StatusCode.UNAVAILABLE, grpc.StatusCode.RESOURCE_EXHAUSTED})
+_NON_FINITE = {
+    "drop": labeling_pb2.NON_FINITE_DROP,  # NaN/Inf points are labeled 0 and counted
+    "reject": labeling_pb2.NON_FINITE_REJECT,  # they fail the call with INVALID_ARGUMENT
+}
+
+
+@dataclass(frozen=True)
+class Tls:
+    """TLS to the server. Paths of PEM files; no ca_file = the system's roots. cert_file and
+    key_file together give mutual TLS."""
+
+    ca_file: str | None = None
+    cert_file: str | None = None
+    key_file: str | None = None
+    server_name_override: str | None = None  # expected name in the server certificate (tests)
+
+
+@dataclass(frozen=True)
+class ClassInfo:
+    id: int  # taxonomy id, as in Result.labels
+    name: str
+
+
+@dataclass
+class Result:
+    """The labels of one cloud, in the order of its points."""
+
+    labels: np.ndarray  # (N,) uint32 taxonomy class id, 0 = unknown (and dropped NaN points)
+    probabilities: np.ndarray | None  # (N, len(classes)) float32 when asked for
+    descriptors: np.ndarray | None  # (N, summary.descriptor_dim) float32, NaN rows: none
+    classes: list[ClassInfo]  # the model's classes: the columns of probabilities
+    summary: labeling_pb2.LabelSummary  # model, version, counts, timings, domain warning
+    attempts: int = 1  # calls made, including retries
+
+    @property
+    def class_ids(self) -> np.ndarray:
+        return np.array([c.id for c in self.classes], dtype=np.uint32)
+
+
+class HealthStatus(enum.IntEnum):
+    UNKNOWN = 0
+    SERVING = 1
+    NOT_SERVING = 2
+    SERVICE_UNKNOWN = 3
+
+
+def _read_pem(path: str | None, what: str) -> bytes | None:
+    if not path:
+        return None
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except OSError as e:
+        raise InvalidInput(f"{path}: cannot read the {what} file: {e.strerror}") from None
+    if not data:
+        raise InvalidInput(f"{path}: the {what} file is empty")
+    return data
+
+
+def _positive_or_zero(value, what: str) -> float:
+    number = 0.0 if value is None else float(value)
+    if not math.isfinite(number) or number < 0:
+        raise InvalidInput(f"{what} must be a finite number >= 0, got {value!r}")
+    return number
+
+
+@dataclass
+class _Call:
+    """What one labeling call sends: the header and the packed points."""
+
+    header: labeling_pb2.ScanHeader
+    xyz: np.ndarray
+    normals: np.ndarray | None
+    chunk_points: int
+    want_descriptors: bool
+    want_probabilities: bool
+
+    def requests(self):
+        yield labeling_pb2.LabelRequest(header=self.header)
+        for first in range(0, len(self.xyz), self.chunk_points):
+            end = first + self.chunk_points
+            chunk = labeling_pb2.PointChunk(xyz=self.xyz[first:end].tobytes())
+            if self.normals is not None:
+                chunk.normals = self.normals[first:end].tobytes()
+            yield labeling_pb2.LabelRequest(chunk=chunk)
+        yield labeling_pb2.LabelRequest(end=labeling_pb2.EndOfScan())
+
+
+class Client:
+    """A channel to one primlabel server; thread-safe, reuse it for every call.
+
+    address: HOST:PORT. token: the bearer token, sent as "authorization: Bearer <token>".
+    tls: None (plaintext: loopback or a trusted network), True (the system's roots) or Tls.
+    deadline: seconds per call, including its retries. retry_attempts: attempts in all on
+    UNAVAILABLE / RESOURCE_EXHAUSTED (1 = no retry).
+    """
+
+    def __init__(
+        self,
+        address: str = DEFAULT_ADDRESS,
+        token: str | None = None,
+        tls: Tls | bool | None = None,
+        deadline: float = 60.0,
+        retry_attempts: int = 4,
+        backoff: BackoffPolicy = BackoffPolicy(),
+        max_receive_message_bytes: int = 64 << 20,
+    ):
+        self.address = address
+        self.deadline = _positive_or_zero(deadline, "deadline")
+        if self.deadline == 0:
+            raise InvalidInput("deadline must be > 0 seconds")
+        if retry_attempts < 1:
+            raise InvalidInput(f"retry_attempts must be >= 1, got {retry_attempts}")
+        self.retry_attempts = int(retry_attempts)
+        self._backoff = backoff
+        self._metadata = (("authorization", f"Bearer {token}"),) if token else ()
+        options = [
+            # Keepalive as the server expects it, so a dead peer is noticed between scans.
+            ("grpc.keepalive_time_ms", 30_000),
+            ("grpc.keepalive_timeout_ms", 10_000),
+            ("grpc.keepalive_permit_without_calls", 1),
+            ("grpc.http2.max_pings_without_data", 0),
+            # A restarted server is found within 2 s, not gRPC's default of up to two minutes.
+            ("grpc.min_reconnect_backoff_ms", 100),
+            ("grpc.initial_reconnect_backoff_ms", 100),
+            ("grpc.max_reconnect_backoff_ms", 2_000),
+            ("grpc.max_receive_message_length", int(max_receive_message_bytes)),
+            # The client retries itself; gRPC's own retries would multiply the attempts.
+            ("grpc.enable_retries", 0),
+        ]
+        if tls:
+            settings = tls if isinstance(tls, Tls) else Tls()
+            cert = _read_pem(settings.cert_file, "client certificate")
+            key = _read_pem(settings.key_file, "client key")
+            if (cert is None) != (key is None):
+                raise InvalidInput("mutual TLS needs both a client certificate and its key")
+            credentials = grpc.ssl_channel_credentials(
+                root_certificates=_read_pem(settings.ca_file, "CA certificate"),
+                private_key=key,
+                certificate_chain=cert,
+            )
+            if settings.server_name_override:
+                options.append(("grpc.ssl_target_name_override", settings.server_name_override))
+            self._channel = grpc.secure_channel(address, credentials, options=options)
+        else:
+            self._channel = grpc.insecure_channel(address, options=options)
+        self._labeler = labeling_pb2_grpc.LabelerStub(self._channel)
+        self._health = self._channel.unary_unary("/grpc.health.v1.Health/Check")
+
+    def close(self) -> None:
+        self._channel.close()
+
+    def __enter__(self) -> Client:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # -----------------------------------------------------------------------------------------
+
+    def _with_retries(self, timeout: float, attempt):
+        """Runs attempt(remaining_seconds) until it succeeds, fails with a code not retried,
+        the attempts are used up or the deadline would pass during the backoff. Returns
+        (its value, attempts)."""
+        deadline_at = time.monotonic() + timeout
+        backoff = Backoff(self._backoff)
+        n = 0
+        while True:
+            n += 1
+            remaining = max(deadline_at - time.monotonic(), 0.001)
+            try:
+                return attempt(remaining), n
+            except grpc.RpcError as e:
+                code, message = e.code(), e.details() or ""
+            except ProtocolError as e:
+                raise PrimlabelError(grpc.StatusCode.DATA_LOSS, str(e), n) from None
+            if code in RETRIED_CODES and n < self.retry_attempts:
+                delay = backoff.next()
+                if time.monotonic() + delay < deadline_at:
+                    time.sleep(delay)
+                    continue
+            raise PrimlabelError(code, message, n)
+
+    def label(
+        self,
+        xyz,
+        normals=None,
+        model: str | None = None,
+        voxel_size: float | None = None,
+        probabilities: bool = False,
+        descriptors: bool = False,
+        tabletop_only: bool = False,
+        scan_id: str | None = None,
+        *,
+        model_version: str | None = None,
+        viewpoint=None,
+        normal_radius: float | None = None,
+        feature_radius: float | None = None,
+        non_finite: str = "drop",
+        chunk_points: int = DEFAULT_CHUNK_POINTS,
+        response_chunk_points: int = 0,
+        deadline: float | None = None,
+    ) -> Result:
+        """Streams the points (Labeler.Label) in messages of chunk_points and returns their
+        labels in input order.
+
+        xyz: (N, 3) array, float32 or float64 (sent as float32), or a pcd.PointCloud (its xyz,
+        and its VIEWPOINT unless viewpoint is given). normals: (N, 3), sent so the server skips
+        normal estimation. model: None = the server's default. voxel_size: > 0
+        downsamples before features (labels still cover every input point); None = the model's.
+        viewpoint: the sensor origin (x, y, z) the normals face (default: the origin). It
+        changes the labels (convex or concave), so pass the scan's. non_finite: "drop" (NaN/Inf points get label 0) or
+        "reject" (the call fails with INVALID_ARGUMENT).
+        """
+        if isinstance(xyz, PointCloud):  # its points, seen from its VIEWPOINT as the CLI does
+            if viewpoint is None:
+                viewpoint = xyz.viewpoint[:3]
+            xyz = xyz.xyz
+        points = as_points(xyz, "xyz")
+        sent_normals = None if normals is None else as_points(normals, "normals", len(points))
+        if non_finite not in _NON_FINITE:
+            raise InvalidInput(f"non_finite must be 'drop' or 'reject', got {non_finite!r}")
+        if int(chunk_points) < 1:
+            raise InvalidInput(f"chunk_points must be >= 1, got {chunk_points}")
+        if not 0 <= int(response_chunk_points) <= 0xFFFFFFFF:
+            raise InvalidInput(f"response_chunk_points out of range: {response_chunk_points}")
+        origin = np.zeros(3) if viewpoint is None else np.asarray(viewpoint, dtype=np.float64)
+        if origin.shape != (3,):
+            raise InvalidInput(f"viewpoint must be (x, y, z), got shape {origin.shape}")
+
+        header = labeling_pb2.ScanHeader(
+            model=model or "",
+            model_version=model_version or "",
+            scan_id=scan_id or "",
+            viewpoint=labeling_pb2.Vec3(x=origin[0], y=origin[1], z=origin[2]),
+            options=labeling_pb2.LabelOptions(
+                return_descriptors=bool(descriptors),
+                return_probabilities=bool(probabilities),
+                tabletop_only=bool(tabletop_only),
+                voxel_size=_positive_or_zero(voxel_size, "voxel_size"),
+                normal_radius=_positive_or_zero(normal_radius, "normal_radius"),
+                feature_radius=_positive_or_zero(feature_radius, "feature_radius"),
+                non_finite=_NON_FINITE[non_finite],
+                response_chunk_points=int(response_chunk_points),
+            ),
+            layout=labeling_pb2.PointLayout(normals=sent_normals is not None),
+            expected_points=len(points),
+        )
+        call = _Call(header, points, sent_normals, int(chunk_points), bool(descriptors),
+                     bool(probabilities))
+        timeout = self.deadline if deadline is None else _positive_or_zero(deadline, "deadline")
+
+        def attempt(remaining: float):
+            # A fresh assembler and request stream per attempt: a retry resends the whole scan.
+            assembler = LabelAssembler(len(points), call.want_descriptors, call.want_probabilities)
+            responses = self._labeler.Label(call.requests(), timeout=remaining,
+                                            metadata=self._metadata)
+            summary = None
+            try:
+                for response in responses:
+                    if response.HasField("chunk"):
+                        assembler.add(response.chunk)
+                    elif response.HasField("summary"):
+                        summary = response.summary
+            except ProtocolError:
+                responses.cancel()
+                raise
+            if summary is None:
+                raise ProtocolError("the server closed the stream without a summary")
+            return assembler.finish(summary), summary
+
+        (assembled, summary), attempts = self._with_retries(timeout, attempt)
+        labels, descriptor_rows, probability_rows, classes = assembled
+        return Result(
+            labels=labels,
+            probabilities=probability_rows,
+            descriptors=descriptor_rows,
+            classes=[ClassInfo(int(i), name) for i, name in classes],
+            summary=summary,
+            attempts=attempts,
+        )
+
+    def models(self) -> list:
+        """The models the server serves (labeling_pb2.ModelInfo), the default one flagged."""
+        response, _ = self._with_retries(
+            self.deadline,
+            lambda remaining: self._labeler.ListModels(
+                labeling_pb2.ListModelsRequest(), timeout=remaining, metadata=self._metadata
+            ),
+        )
+        return list(response.models)
+
+    def model_metadata(self, model: str, version: str = ""):
+        """One model's classes, feature and graph parameters and training summary."""
+        request = labeling_pb2.GetModelMetadataRequest(model=model, version=version)
+        response, _ = self._with_retries(
+            self.deadline,
+            lambda remaining: self._labeler.GetModelMetadata(
+                request, timeout=remaining, metadata=self._metadata
+            ),
+        )
+        return response
+
+    def health(self, service: str = "") -> HealthStatus:
+        """grpc.health.v1 Check of `service` ("" = the server as a whole). Raises PrimlabelError
+        (UNAVAILABLE) when the server cannot be reached."""
+        request = encode_health_request(service)
+        status, _ = self._with_retries(
+            self.deadline,
+            lambda remaining: decode_health_status(
+                self._health(request, timeout=remaining, metadata=self._metadata)
+            ),
+        )
+        return HealthStatus(status) if status <= 3 else HealthStatus.UNKNOWN

@@ -1,0 +1,164 @@
+"""The Python client against a real primlabel-server: the same labels as the C++ CLI point for
+point, streaming in chunks, probabilities and descriptors, errors with their gRPC codes."""
+
+from __future__ import annotations
+
+import socket
+
+import grpc
+import numpy as np
+import pytest
+
+import primlabel
+from conftest import TEST_DATA, TOKEN, binary, run
+
+
+@pytest.fixture(scope="session")
+def cli_labels(server, scan, work):
+    """What the C++ CLI writes for the scan: its labels and probabilities."""
+    out = work / "cli_labeled.pcd"
+    run(binary("primlabel"), "--server", server.address, "label", scan, "-o", out,
+        "--probabilities")
+    return primlabel.pcd.read(out)
+
+
+@pytest.fixture(scope="session")
+def cloud(scan):
+    return primlabel.pcd.read(scan)
+
+
+def test_health_and_models(client):
+    assert client.health() == primlabel.HealthStatus.SERVING
+    models = client.models()
+    assert [(m.name, m.version, m.is_default) for m in models] == [("tiny", "1", True)]
+    metadata = client.model_metadata("tiny")
+    assert metadata.name == "tiny" and len(metadata.classes) > 1
+
+
+def test_labels_equal_the_cli_point_for_point(client, cloud, cli_labels):
+    # More points than one request message: the default stream has two chunks.
+    assert len(cloud) > primlabel.client.DEFAULT_CHUNK_POINTS
+    assert cloud.viewpoint[:3] != (0, 0, 0)  # so the viewpoint must be sent
+    result = client.label(cloud.xyz, viewpoint=cloud.viewpoint[:3], scan_id="scan")
+    assert result.labels.dtype == np.uint32 and result.labels.shape == (len(cloud),)
+    np.testing.assert_array_equal(cli_labels.xyz, cloud.xyz)  # C++ and Python readers agree
+    np.testing.assert_array_equal(result.labels, cli_labels.label)
+    assert result.summary.points_received == len(cloud)
+    assert result.summary.scan_id == "scan" and result.summary.model == "tiny"
+    assert result.attempts == 1
+    # Not a constant answer: the scene has planes, edges and more.
+    assert len(np.unique(result.labels)) >= 3
+
+
+def test_small_chunks_each_way_give_the_same_labels(client, cloud, cli_labels):
+    result = client.label(cloud, chunk_points=7777, response_chunk_points=5000)
+    np.testing.assert_array_equal(result.labels, cli_labels.label)
+
+
+def test_float64_input_is_sent_as_float32(client, cloud, cli_labels):
+    result = client.label(cloud.xyz.astype(np.float64), viewpoint=cloud.viewpoint[:3])
+    np.testing.assert_array_equal(result.labels, cli_labels.label)
+
+
+def test_probability_rows_sum_to_one_in_the_order_of_classes(client, cloud, cli_labels):
+    result = client.label(cloud, probabilities=True, descriptors=True)
+    names = [c.name for c in client.model_metadata("tiny").classes]
+    assert [c.name for c in result.classes] == names
+    assert result.probabilities.shape == (len(cloud), len(result.classes))
+    described = result.labels != 0
+    assert described.mean() > 0.99
+    rows = result.probabilities[described]
+    np.testing.assert_allclose(rows.sum(axis=1), 1.0, atol=1e-5)
+    # A node-only model labels each point with its most probable class: the columns really are
+    # the classes in the summary's order.
+    np.testing.assert_array_equal(result.class_ids[rows.argmax(axis=1)],
+                                  result.labels[described])
+    np.testing.assert_allclose(result.probabilities, cli_labels.fields["probability"], atol=0)
+    assert result.descriptors.shape == (len(cloud), result.summary.descriptor_dim)
+    assert result.summary.descriptor_dim == 33
+    # Points without a descriptor are the ones labeled unknown.
+    np.testing.assert_array_equal(np.isnan(result.descriptors).any(axis=1), ~described)
+
+
+def test_normals_sent_are_used(client):
+    bunny = primlabel.pcd.read(TEST_DATA / "samples/bun0.pcd")
+    with_normals = client.label(bunny.xyz, normals=bunny.normals)
+    assert with_normals.labels.shape == (397,)
+    flipped = client.label(bunny.xyz, normals=-bunny.normals)
+    # Convex and concave swap with the normals' side, so the server did take them.
+    assert not np.array_equal(with_normals.labels, flipped.labels)
+
+
+def test_non_finite_points_dropped_or_rejected(client, cloud, cli_labels):
+    xyz = cloud.xyz.astype(np.float64)
+    bad = np.array([0, 17, len(xyz) - 1])
+    xyz[bad[0], 0] = np.nan
+    xyz[bad[1], 2] = np.inf
+    xyz[bad[2]] = 1e300  # float64 beyond float32: inf on the wire
+    result = client.label(xyz)
+    assert result.summary.points_dropped_non_finite == 3
+    np.testing.assert_array_equal(result.labels[bad], 0)
+    with pytest.raises(primlabel.PrimlabelError) as error:
+        client.label(xyz, non_finite="reject")
+    assert error.value.code == grpc.StatusCode.INVALID_ARGUMENT
+    assert error.value.attempts == 1
+
+
+def test_unknown_model_is_not_found(client, cloud):
+    with pytest.raises(primlabel.PrimlabelError) as error:
+        client.label(cloud.xyz[:1000], model="no-such-model")
+    assert error.value.code == grpc.StatusCode.NOT_FOUND
+    assert "no-such-model" in error.value.message
+    assert str(error.value).startswith("NOT_FOUND: ")
+
+
+def test_token_is_required_and_checked(token_server, cloud):
+    xyz = cloud.xyz[:2000]
+    for token in (None, "wrong-token"):
+        with primlabel.Client(token_server.address, token=token) as c:
+            with pytest.raises(primlabel.PrimlabelError) as error:
+                c.label(xyz)
+            assert error.value.code == grpc.StatusCode.UNAUTHENTICATED
+            assert error.value.attempts == 1  # not retried
+    with primlabel.Client(token_server.address, token=TOKEN) as c:
+        assert c.label(xyz).labels.shape == (2000,)
+        assert [m.name for m in c.models()] == ["tiny"]
+
+
+def test_bad_arrays_are_refused_before_any_call(client):
+    for xyz in (np.zeros((5, 2)), np.zeros(3), np.array([["a", "b", "c"]]), np.zeros((2, 3), complex)):
+        with pytest.raises(ValueError):
+            client.label(xyz)
+    with pytest.raises(primlabel.InvalidInput):
+        client.label(np.zeros((4, 3)), normals=np.zeros((3, 3)))
+    with pytest.raises(primlabel.InvalidInput):
+        client.label(np.zeros((4, 3)), voxel_size=float("nan"))
+    with pytest.raises(primlabel.InvalidInput):
+        client.label(np.zeros((4, 3)), chunk_points=0)
+
+
+def test_empty_cloud_is_answered_cleanly(client):
+    try:
+        result = client.label(np.zeros((0, 3), np.float32), probabilities=True)
+    except primlabel.PrimlabelError as error:  # the server may refuse an empty scan
+        assert error.code == grpc.StatusCode.INVALID_ARGUMENT
+    else:
+        assert result.labels.shape == (0,)
+        assert result.probabilities.shape == (0, len(result.classes))
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_unreachable_server_is_retried_then_unavailable():
+    policy = primlabel.BackoffPolicy(initial=0.01, maximum=0.05)
+    with primlabel.Client(f"127.0.0.1:{free_port()}", retry_attempts=3, backoff=policy,
+                          deadline=10) as c:
+        with pytest.raises(primlabel.PrimlabelError) as error:
+            c.health()
+        assert error.value.code == grpc.StatusCode.UNAVAILABLE
+        assert error.value.attempts == 3
+        assert "(after 3 attempts)" in str(error.value)
