@@ -4,6 +4,9 @@
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 
+#include <chrono>
+#include <thread>
+
 #include "server_test_util.hpp"
 #include "small_svm_model.hpp"
 
@@ -290,8 +293,15 @@ TEST(LabelService, MetricsCountRequestsPointsAndStages) {
   ASSERT_TRUE(label_stream(*server.stub, scan_requests(cloud, header_for())).status.ok());
   EXPECT_EQ(label_cloud(*server.stub, cloud, header_for("nope")).status.error_code(),
             grpc::StatusCode::NOT_FOUND);
-  const auto samples = scrape_metrics(server.server->metrics_port());
   using scrape::sum_samples;
+  // A call's status can reach the client before the server's reactor is done with it (OnDone,
+  // where the in-flight gauge drops): scrape until it has, within a bound.
+  auto samples = scrape_metrics(server.server->metrics_port());
+  for (int attempt = 0; attempt < 100 && sum_samples(samples, "primlabel_inflight_requests") != 0;
+       ++attempt) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    samples = scrape_metrics(server.server->metrics_port());
+  }
   EXPECT_EQ(sum_samples(samples, "primlabel_requests_total",
                         {{"method", "Label"}, {"model", "m"}, {"status", "OK"}}),
             1.0);
