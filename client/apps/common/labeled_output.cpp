@@ -24,10 +24,10 @@ CloudTags labeled_cloud_tags(const LabelResult& result) {
   if (result.descriptor_dim > 0) tags["descriptor"] = descriptor_field(result);
   if (!result.probabilities.empty()) {
     std::string columns;
-    for (std::size_t k = 0; k < result.class_ids.size(); ++k) {
-      const auto cls = class_from_id(result.class_ids[k]);
-      columns += (k ? " " : "") + std::to_string(result.class_ids[k]) + ":" +
-                 (cls ? std::string(name(*cls)) : "class");
+    // The names the server gave the columns (one word each, as the taxonomy's).
+    for (std::size_t k = 0; k < result.class_ids.size() && k < result.class_names.size(); ++k) {
+      if (k > 0) columns += ' ';
+      columns += std::to_string(result.class_ids[k]) + ":" + result.class_names[k];
     }
     tags["probability_columns"] = columns;
   }
