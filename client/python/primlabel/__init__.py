@@ -13,6 +13,7 @@ from ._version import __version__
 from .backoff import Backoff, BackoffPolicy
 from .client import ClassInfo, Client, HealthStatus, Result, Tls
 from .errors import InvalidInput, PrimlabelError
+from .wire import NO_SEGMENT
 
 __all__ = [
     "Backoff",
@@ -21,6 +22,7 @@ __all__ = [
     "Client",
     "HealthStatus",
     "InvalidInput",
+    "NO_SEGMENT",
     "PrimlabelError",
     "Result",
     "Tls",

@@ -25,7 +25,13 @@ from .backoff import Backoff, BackoffPolicy
 from .errors import InvalidInput, PrimlabelError, ProtocolError
 from .pcd import PointCloud
 from .v1 import labeling_pb2, labeling_pb2_grpc
-from .wire import LabelAssembler, as_points, decode_health_status, encode_health_request
+from .wire import (
+    NO_SEGMENT,
+    LabelAssembler,
+    as_points,
+    decode_health_status,
+    encode_health_request,
+)
 
 DEFAULT_ADDRESS = "127.0.0.1:50051"
 DEFAULT_CHUNK_POINTS = 65536  # points per streamed request message, as the C++ client
@@ -62,7 +68,14 @@ class Result:
     descriptors: np.ndarray | None  # (N, summary.descriptor_dim) float32, NaN rows: none
     classes: list[ClassInfo]  # the model's classes: the columns of probabilities
     summary: labeling_pb2.LabelSummary  # model, version, counts, timings, domain warning
+    # With primitives=True: (N,) uint32, the point's index into primitives, NO_SEGMENT if none.
+    segments: np.ndarray | None = None
     attempts: int = 1  # calls made, including retries
+
+    @property
+    def primitives(self) -> list:
+        """The fitted instances (labeling_pb2.Primitive), primitives[s] for segment id s."""
+        return list(self.summary.primitives)
 
     @property
     def class_ids(self) -> np.ndarray:
@@ -106,16 +119,37 @@ class _Call:
     chunk_points: int
     want_descriptors: bool
     want_probabilities: bool
+    want_segments: bool
+
+    def chunk(self, first: int, end: int | None) -> labeling_pb2.PointChunk:
+        chunk = labeling_pb2.PointChunk(xyz=self.xyz[first:end].tobytes())
+        if self.normals is not None:
+            chunk.normals = self.normals[first:end].tobytes()
+        return chunk
 
     def requests(self):
         yield labeling_pb2.LabelRequest(header=self.header)
         for first in range(0, len(self.xyz), self.chunk_points):
-            end = first + self.chunk_points
-            chunk = labeling_pb2.PointChunk(xyz=self.xyz[first:end].tobytes())
-            if self.normals is not None:
-                chunk.normals = self.normals[first:end].tobytes()
-            yield labeling_pb2.LabelRequest(chunk=chunk)
+            yield labeling_pb2.LabelRequest(chunk=self.chunk(first, first + self.chunk_points))
         yield labeling_pb2.LabelRequest(end=labeling_pb2.EndOfScan())
+
+    def assembler(self) -> LabelAssembler:
+        return LabelAssembler(len(self.xyz), self.want_descriptors, self.want_probabilities,
+                              self.want_segments)
+
+
+def _result(assembled_and_summary, attempts: int) -> Result:
+    assembled, summary = assembled_and_summary
+    labels, descriptor_rows, probability_rows, classes, segments = assembled
+    return Result(
+        labels=labels,
+        probabilities=probability_rows,
+        descriptors=descriptor_rows,
+        classes=[ClassInfo(int(i), name) for i, name in classes],
+        summary=summary,
+        segments=segments,
+        attempts=attempts,
+    )
 
 
 class Client:
@@ -223,15 +257,7 @@ class Client:
         descriptors: bool = False,
         tabletop_only: bool = False,
         scan_id: str | None = None,
-        *,
-        model_version: str | None = None,
-        viewpoint=None,
-        normal_radius: float | None = None,
-        feature_radius: float | None = None,
-        non_finite: str = "drop",
-        chunk_points: int = DEFAULT_CHUNK_POINTS,
-        response_chunk_points: int = 0,
-        deadline: float | None = None,
+        **options,
     ) -> Result:
         """Streams the points (Labeler.Label) in messages of chunk_points and returns their
         labels in input order.
@@ -240,10 +266,94 @@ class Client:
         and its VIEWPOINT unless viewpoint is given). normals: (N, 3), sent so the server skips
         normal estimation. model: None = the server's default. voxel_size: > 0
         downsamples before features (labels still cover every input point); None = the model's.
-        viewpoint: the sensor origin (x, y, z) the normals face (default: the origin). It
-        changes the labels (convex or concave), so pass the scan's. non_finite: "drop" (NaN/Inf points get label 0) or
-        "reject" (the call fails with INVALID_ARGUMENT).
+
+        Keyword-only options: model_version; viewpoint, the sensor origin (x, y, z) the normals
+        face (default: the origin; it changes the labels, convex or concave, so pass the
+        scan's); normal_radius, feature_radius (> 0: override, where the model allows);
+        non_finite, "drop" (NaN/Inf points get label 0) or "reject" (the call fails with
+        INVALID_ARGUMENT); primitives, True to group the labels into same-class segments fitted
+        with their class's model (Result.segments, Result.primitives); chunk_points,
+        response_chunk_points; deadline (seconds).
         """
+        call, timeout = self._prepare(xyz, normals, model, voxel_size, probabilities, descriptors,
+                                      tabletop_only, scan_id, **options)
+
+        def attempt(remaining: float):
+            # A fresh assembler and request stream per attempt: a retry resends the whole scan.
+            assembler = call.assembler()
+            responses = self._labeler.Label(call.requests(), timeout=remaining,
+                                            metadata=self._metadata)
+            summary = None
+            try:
+                for response in responses:
+                    if response.HasField("chunk"):
+                        assembler.add(response.chunk)
+                    elif response.HasField("summary"):
+                        summary = response.summary
+            except ProtocolError:
+                responses.cancel()
+                raise
+            if summary is None:
+                raise ProtocolError("the server closed the stream without a summary")
+            return assembler.finish(summary), summary
+
+        return _result(*self._with_retries(timeout, attempt))
+
+    def label_unary(
+        self,
+        xyz,
+        normals=None,
+        model: str | None = None,
+        voxel_size: float | None = None,
+        probabilities: bool = False,
+        descriptors: bool = False,
+        tabletop_only: bool = False,
+        scan_id: str | None = None,
+        **options,
+    ) -> Result:
+        """label() in one request and one answer (Labeler.LabelCloud): fewer round trips for a
+        small cloud, but the whole cloud and answer must fit the server's message limit (about
+        4M points; bigger ones fail with RESOURCE_EXHAUSTED: use label()). The same arguments;
+        chunk_points and response_chunk_points do not apply."""
+        for streamed_only in ("chunk_points", "response_chunk_points"):
+            if streamed_only in options:
+                raise InvalidInput(f"{streamed_only} applies to label() only")
+        call, timeout = self._prepare(xyz, normals, model, voxel_size, probabilities, descriptors,
+                                      tabletop_only, scan_id, **options)
+        request = labeling_pb2.LabelCloudRequest(header=call.header, points=call.chunk(0, None))
+
+        def attempt(remaining: float):
+            response = self._labeler.LabelCloud(request, timeout=remaining,
+                                                metadata=self._metadata)
+            assembler = call.assembler()
+            if response.HasField("result"):
+                assembler.add(response.result)
+            return assembler.finish(response.summary), response.summary
+
+        return _result(*self._with_retries(timeout, attempt))
+
+    def _prepare(
+        self,
+        xyz,
+        normals,
+        model,
+        voxel_size,
+        probabilities,
+        descriptors,
+        tabletop_only,
+        scan_id,
+        *,
+        model_version: str | None = None,
+        viewpoint=None,
+        normal_radius: float | None = None,
+        feature_radius: float | None = None,
+        non_finite: str = "drop",
+        primitives: bool = False,
+        chunk_points: int = DEFAULT_CHUNK_POINTS,
+        response_chunk_points: int = 0,
+        deadline: float | None = None,
+    ) -> tuple[_Call, float]:
+        """The checked request of one labeling call, and its deadline in seconds."""
         if isinstance(xyz, PointCloud):  # its points, seen from its VIEWPOINT as the CLI does
             if viewpoint is None:
                 viewpoint = xyz.viewpoint[:3]
@@ -274,43 +384,15 @@ class Client:
                 feature_radius=_positive_or_zero(feature_radius, "feature_radius"),
                 non_finite=_NON_FINITE[non_finite],
                 response_chunk_points=int(response_chunk_points),
+                return_primitives=bool(primitives),
             ),
             layout=labeling_pb2.PointLayout(normals=sent_normals is not None),
             expected_points=len(points),
         )
         call = _Call(header, points, sent_normals, int(chunk_points), bool(descriptors),
-                     bool(probabilities))
+                     bool(probabilities), bool(primitives))
         timeout = self.deadline if deadline is None else _positive_or_zero(deadline, "deadline")
-
-        def attempt(remaining: float):
-            # A fresh assembler and request stream per attempt: a retry resends the whole scan.
-            assembler = LabelAssembler(len(points), call.want_descriptors, call.want_probabilities)
-            responses = self._labeler.Label(call.requests(), timeout=remaining,
-                                            metadata=self._metadata)
-            summary = None
-            try:
-                for response in responses:
-                    if response.HasField("chunk"):
-                        assembler.add(response.chunk)
-                    elif response.HasField("summary"):
-                        summary = response.summary
-            except ProtocolError:
-                responses.cancel()
-                raise
-            if summary is None:
-                raise ProtocolError("the server closed the stream without a summary")
-            return assembler.finish(summary), summary
-
-        (assembled, summary), attempts = self._with_retries(timeout, attempt)
-        labels, descriptor_rows, probability_rows, classes = assembled
-        return Result(
-            labels=labels,
-            probabilities=probability_rows,
-            descriptors=descriptor_rows,
-            classes=[ClassInfo(int(i), name) for i, name in classes],
-            summary=summary,
-            attempts=attempts,
-        )
+        return call, timeout
 
     def models(self) -> list:
         """The models the server serves (labeling_pb2.ModelInfo), the default one flagged."""

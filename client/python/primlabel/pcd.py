@@ -1,5 +1,5 @@
 """PCD v0.7 files to and from numpy, read as core/geometry's reader does (pcd_io.cpp): DATA ascii,
-binary and binary_compressed; written as ascii or binary.
+binary and binary_compressed; written as ascii, binary or binary_compressed (LZF through liblzf).
 
     cloud = primlabel.pcd.read("scan.pcd")
     cloud.xyz          # (N, 3); organised clouds keep their NaN pixels, width and height
@@ -436,11 +436,13 @@ def _format_column(values: np.ndarray) -> np.ndarray:
 
 
 def write(path: str, cloud: PointCloud, encoding: str = "binary") -> None:
-    """Writes `cloud` as PCD v0.7, DATA ascii or binary (little-endian), atomically (a temporary
-    file beside `path` renamed over it). Floats keep their width (F 4 / F 8)."""
+    """Writes `cloud` as PCD v0.7, DATA ascii, binary or binary_compressed (little-endian; LZF
+    through liblzf), atomically (a temporary file beside `path` renamed over it). Floats keep
+    their width (F 4 / F 8)."""
     path = os.fspath(path)
-    if encoding not in ("ascii", "binary"):
-        raise PcdError(f"{path}: encoding must be 'ascii' or 'binary', got {encoding!r}")
+    if encoding not in ("ascii", "binary", "binary_compressed"):
+        raise PcdError(f"{path}: encoding must be 'ascii', 'binary' or 'binary_compressed', "
+                       f"got {encoding!r}")
     n = len(cloud.xyz)
     width = n if cloud.width is None else int(cloud.width)
     if width * int(cloud.height) != n:
@@ -468,6 +470,8 @@ def write(path: str, cloud: PointCloud, encoding: str = "binary") -> None:
         if n:
             text = np.concatenate([_format_column(values) for _, values in columns], axis=1)
             body += ("\n".join(" ".join(row) for row in text.tolist()) + "\n").encode()
+    elif encoding == "binary_compressed":
+        body += _compressed_body(path, columns)
     else:
         layout = np.dtype({
             "names": [f"f{i}" for i in range(len(columns))],
@@ -479,6 +483,19 @@ def write(path: str, cloud: PointCloud, encoding: str = "binary") -> None:
             records[f"f{i}"] = values
         body += records.tobytes()
     _write_atomically(path, body)
+
+
+def _compressed_body(path: str, columns: list) -> bytes:
+    """PCD's binary_compressed data: the uint32 compressed and uncompressed sizes, then one LZF
+    block of the fields one after another (each field's values for all points together), the
+    layout PCL writes and core/geometry and _compressed_columns read."""
+    planes = b"".join(np.ascontiguousarray(values, dtype=values.dtype.newbyteorder("<")).tobytes()
+                      for _, values in columns)
+    try:
+        compressed = lzf.compress(planes)
+    except lzf.LzfError as e:
+        raise PcdError(f"{path}: cannot write binary_compressed: {e}") from None
+    return struct.pack("<II", len(compressed), len(planes)) + compressed
 
 
 def _write_atomically(path: str, data: bytes) -> None:

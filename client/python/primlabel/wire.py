@@ -10,6 +10,7 @@ from .errors import InvalidInput, ProtocolError
 
 FLOAT32_LE = np.dtype("<f4")
 UINT32_LE = np.dtype("<u4")
+NO_SEGMENT = 0xFFFFFFFF  # LabelChunk.segments: the point is in no fitted segment
 
 
 def as_points(values, what: str, points: int | None = None) -> np.ndarray:
@@ -41,15 +42,18 @@ class LabelAssembler:
     """Puts the chunks of one answer back together and checks they cover every point exactly
     once with consistent column counts; any violation is a ProtocolError, never patched over."""
 
-    def __init__(self, points: int, want_descriptors: bool, want_probabilities: bool):
+    def __init__(self, points: int, want_descriptors: bool, want_probabilities: bool,
+                 want_segments: bool = False):
         self._points = points
         self._want_descriptors = want_descriptors
         self._want_probabilities = want_probabilities
+        self._want_segments = want_segments
         self._covered = np.zeros(points, dtype=bool)
         self._covered_count = 0
         self.labels = np.zeros(points, dtype=np.uint32)
         self.descriptors: np.ndarray | None = None
         self.probabilities: np.ndarray | None = None
+        self.segments: np.ndarray | None = None
 
     def add(self, chunk) -> None:
         first, count = chunk.first_point, chunk.point_count
@@ -77,6 +81,16 @@ class LabelAssembler:
             self.probabilities = self._place(self.probabilities, chunk.probabilities, classes,
                                              first, end, 0.0, "probabilities", at)
 
+        segment_columns = _columns(len(chunk.segments), count, "segments", first)
+        if self._want_segments and count > 0 and segment_columns < 0:
+            raise ProtocolError(f"{at}: primitives were asked for but the segment ids are missing")
+        if segment_columns > 1:
+            raise ProtocolError(f"{at}: {segment_columns} segment ids a point, not 1")
+        if segment_columns == 1:
+            if self.segments is None:
+                self.segments = np.full(self._points, NO_SEGMENT, dtype=np.uint32)
+            self.segments[first:end] = np.frombuffer(chunk.segments, dtype=UINT32_LE)
+
         self.labels[first:end] = np.frombuffer(chunk.labels, dtype=UINT32_LE)
         self._covered[first:end] = True
         self._covered_count += count
@@ -92,8 +106,8 @@ class LabelAssembler:
         return target
 
     def finish(self, summary):
-        """Checks coverage and column counts against the summary; returns
-        (labels, descriptors, probabilities, classes as (id, name) pairs)."""
+        """Checks coverage, column counts and segment ids against the summary; returns
+        (labels, descriptors, probabilities, classes as (id, name) pairs, segments)."""
         if self._covered_count != self._points:
             missing = int(np.argmin(self._covered))
             raise ProtocolError(
@@ -122,7 +136,19 @@ class LabelAssembler:
                 )
         elif self._want_probabilities:
             probabilities = np.zeros((0, len(classes)), dtype=np.float32)
-        return self.labels, descriptors, probabilities, classes
+        segments = self.segments
+        if segments is not None:
+            named = segments[segments != NO_SEGMENT]
+            if named.size and int(named.max()) >= len(summary.primitives):
+                point = int(np.argmax((segments != NO_SEGMENT)
+                                      & (segments >= len(summary.primitives))))
+                raise ProtocolError(
+                    f"point {point} is in segment {int(segments[point])}, the summary has "
+                    f"{len(summary.primitives)} primitives"
+                )
+        elif self._want_segments:
+            segments = np.zeros(0, dtype=np.uint32)
+        return self.labels, descriptors, probabilities, classes, segments
 
 
 # grpc.health.v1 by hand (as client/src/health_wire.cpp): two one-field messages do not justify a

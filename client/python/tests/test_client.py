@@ -80,6 +80,41 @@ def test_probability_rows_sum_to_one_in_the_order_of_classes(client, cloud, cli_
     np.testing.assert_array_equal(np.isnan(result.descriptors).any(axis=1), ~described)
 
 
+def test_unary_call_gives_the_streamed_answer(client, cloud, cli_labels):
+    result = client.label_unary(cloud, probabilities=True, scan_id="one-message")
+    np.testing.assert_array_equal(result.labels, cli_labels.label)
+    np.testing.assert_allclose(result.probabilities, cli_labels.fields["probability"], atol=0)
+    assert result.summary.scan_id == "one-message" and result.summary.points_received == len(cloud)
+    with pytest.raises(primlabel.InvalidInput):
+        client.label_unary(cloud, chunk_points=100)
+    with pytest.raises(primlabel.PrimlabelError) as error:
+        client.label_unary(cloud.xyz[:100], model="no-such-model")
+    assert error.value.code == grpc.StatusCode.NOT_FOUND
+
+
+@pytest.mark.parametrize("call", ["label", "label_unary"])
+def test_primitives_come_with_their_segments(client, cloud, call):
+    result = getattr(client, call)(cloud, primitives=True)
+    segments, primitives = result.segments, result.primitives
+    assert segments.shape == (len(cloud),) and segments.dtype == np.uint32
+    assert len(primitives) > 1
+    in_segment = segments != primlabel.NO_SEGMENT
+    assert in_segment.mean() > 0.5
+    assert int(segments[in_segment].max()) < len(primitives)
+    sizes = np.bincount(segments[in_segment], minlength=len(primitives))
+    for s, primitive in enumerate(primitives):
+        assert primitive.segment_id == s and primitive.point_count == sizes[s]
+        members = np.flatnonzero(segments == s)
+        assert primitive.first_point == members[0]
+        # A segment is points of one class, the primitive's.
+        np.testing.assert_array_equal(result.labels[members], primitive.class_id)
+    # The scene's table is the largest plane, fitted as z = 0 within millimetres.
+    planes = [p for p in primitives if p.WhichOneof("model") == "plane"]
+    table = max(planes, key=lambda p: p.point_count)
+    assert abs(abs(table.plane.normal.z) - 1) < 1e-3 and abs(table.plane.offset) < 5e-3
+    assert client.label(cloud).segments is None  # not asked for: none
+
+
 def test_normals_sent_are_used(client):
     bunny = primlabel.pcd.read(TEST_DATA / "samples/bun0.pcd")
     with_normals = client.label(bunny.xyz, normals=bunny.normals)

@@ -47,7 +47,7 @@ def assert_same(a: pcd.PointCloud, b: pcd.PointCloud) -> None:
     assert (a.width, a.height, tuple(a.viewpoint)) == (b.width, b.height, tuple(b.viewpoint))
 
 
-@pytest.mark.parametrize("encoding", ["ascii", "binary"])
+@pytest.mark.parametrize("encoding", ["ascii", "binary", "binary_compressed"])
 def test_round_trip_keeps_every_field_exactly(tmp_path, encoding):
     cloud = full_cloud()
     path = tmp_path / f"cloud_{encoding}.pcd"
@@ -91,7 +91,7 @@ def test_the_cli_reads_what_python_writes_and_python_reads_what_it_writes(server
     subset = pcd.PointCloud(xyz=cloud.xyz[:20000], viewpoint=cloud.viewpoint)
     with primlabel.Client(server.address) as client:
         expected = client.label(subset).labels
-    for encoding in ("ascii", "binary"):
+    for encoding in ("ascii", "binary", "binary_compressed"):
         written = tmp_path / f"subset_{encoding}.pcd"
         pcd.write(written, subset, encoding=encoding)
         out = tmp_path / f"subset_{encoding}_labeled.pcd"
@@ -102,15 +102,50 @@ def test_the_cli_reads_what_python_writes_and_python_reads_what_it_writes(server
         np.testing.assert_array_equal(labeled.label, expected)
 
 
-def test_lzf_literals_and_back_references():
-    assert lzf.decompress(b"\x02abc", 3) == b"abc"
-    assert lzf.decompress(b"\x02abc\x80\x02", 9) == b"abcabcabc"  # overlapping copy
-    assert lzf.decompress(b"\x00a\xe0\x0b\x00", 21) == b"a" * 21  # long back-reference
-    assert lzf.decompress(b"\x01ab\x20\x01", 5) == b"ababa"
+@pytest.mark.parametrize("decompress", [lzf.decompress, lzf.decompress_python])
+def test_lzf_literals_and_back_references(decompress):
+    assert decompress(b"\x02abc", 3) == b"abc"
+    assert decompress(b"\x02abc\x80\x02", 9) == b"abcabcabc"  # overlapping copy
+    assert decompress(b"\x00a\xe0\x0b\x00", 21) == b"a" * 21  # long back-reference
+    assert decompress(b"\x01ab\x20\x01", 5) == b"ababa"
     for corrupt, size in [(b"\x05ab", 6), (b"\x80\x05", 3), (b"\x02abc", 4), (b"\x02abc", 2),
                           (b"\xe0", 9), (b"\x00a\x20", 4)]:
         with pytest.raises(lzf.LzfError):
-            lzf.decompress(corrupt, size)
+            decompress(corrupt, size)
+
+
+def test_lzf_compress_round_trips_and_compresses():
+    rng = np.random.default_rng(3)
+    repetitive = np.repeat(rng.integers(0, 4, 5000, dtype=np.uint8), 7).tobytes()
+    noise = rng.integers(0, 256, 100000, dtype=np.uint8).tobytes()  # incompressible: it grows
+    assert lzf.can_compress()  # Debian's liblzf1 comes with the build's liblzf-dev
+    for data in (b"", b"a", b"abcabcabcabc" * 100, repetitive, noise):
+        packed = lzf.compress(data)
+        assert lzf.decompress(packed, len(data)) == data
+        assert lzf.decompress_python(packed, len(data)) == data
+        assert len(packed) <= len(data) + len(data) // 32 + 16
+    assert len(lzf.compress(repetitive)) < len(repetitive) // 3
+
+
+def test_binary_compressed_mosd_frame_rewritten_is_smaller_and_equal(tmp_path):
+    path = SHARED_DATA / "mosd" / "learn0.pcd"
+    if not path.exists():
+        pytest.skip(f"{path} is absent")
+    cloud = pcd.read(path)
+    out = tmp_path / "learn0_again.pcd"
+    pcd.write(out, cloud, encoding="binary_compressed")
+    assert out.stat().st_size < 0.8 * len(cloud) * 20  # x y z rgba label: 20 bytes a point
+    back = pcd.read(out)
+    np.testing.assert_array_equal(back.xyz, cloud.xyz)  # NaN pixels in the same places
+    np.testing.assert_array_equal(back.label, cloud.label)
+    np.testing.assert_array_equal(back.rgb, cloud.rgb)
+    assert (back.width, back.height) == (640, 480)
+
+
+def test_empty_cloud_binary_compressed(tmp_path):
+    out = tmp_path / "empty.pcd"
+    pcd.write(out, pcd.PointCloud(xyz=np.zeros((0, 3), np.float32)), encoding="binary_compressed")
+    assert len(pcd.read(out)) == 0
 
 
 HEADER = ("VERSION 0.7\nFIELDS x y z label\nSIZE 4 4 4 4\nTYPE F F F {label_type}\nCOUNT 1 1 1 1\n"
