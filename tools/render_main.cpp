@@ -3,19 +3,24 @@
 //   primlabel-render scene.pcd -o scene.png                       # by label, with a legend
 //   primlabel-render learn0.pcd -o learn0.png --field label --palette segments --view sensor
 //   primlabel-render features.pcd -o curvature.png --field curvature --view top
+//   primlabel-render labeled.pcd -o fits.png --primitives primitives.json   # fitted outlines
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/primitives/primitives_json.hpp"
 #include "primlabel/render/colorize.hpp"
+#include "primlabel/render/primitive_outlines.hpp"
 #include "primlabel/render/render.hpp"
 
 namespace {
@@ -24,6 +29,8 @@ using namespace primlabel;
 
 struct Arguments {
   std::string input, output, field, palette = "classes", classes, view = "oblique", title;
+  std::string primitives;  // JSON of primlabel label / primlabel-eval --primitives
+  double min_confidence = 0;
   int width = 1024, height = 768, point_size = 1;
   bool no_legend = false, no_title = false;
 };
@@ -79,6 +86,21 @@ Coloring coloring_for(const Arguments& args, const PointCloud& cloud, std::strin
   return color_by_value(values, field);
 }
 
+// The outlines of the primitives in `path`; a file that cannot be read or parsed is an input
+// error naming it, not a usage error.
+std::vector<Overlay> outlines_from(const std::string& path, double min_confidence) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw RunError("cannot read primitives file '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  try {
+    const std::vector<primitives::Primitive> fitted = primitives::parse_primitives_json(text.str());
+    return primitive_outlines(fitted, {.min_confidence = min_confidence});
+  } catch (const std::invalid_argument& e) {
+    throw RunError(path + ": " + e.what());
+  }
+}
+
 int run(const Arguments& args) {
   const PointCloud cloud = read_cloud(args.input);
   if (count_finite(cloud) == 0) throw RunError(args.input + ": no point has finite coordinates");
@@ -98,6 +120,8 @@ int run(const Arguments& args) {
                         : std::filesystem::path(args.input).filename().string() + " - " + field +
                               " (" + std::to_string(count_finite(cloud)) + " points)";
   if (!args.no_legend) options.legend = std::move(coloring.legend);
+  if (!args.primitives.empty())
+    options.overlays = outlines_from(args.primitives, args.min_confidence);
   render_png(cloud, coloring.rgb, options, args.output);
   return cli::kExitOk;
 }
@@ -142,6 +166,13 @@ int main(int argc, char** argv) {
   app.add_option("--title", args.title, "title (default: file name, field and point count)");
   app.add_flag("--no-title", args.no_title, "no title");
   app.add_flag("--no-legend", args.no_legend, "no legend");
+  app.add_option("--primitives", args.primitives,
+                 "draw the fitted primitives of this JSON file (primlabel label / primlabel-eval "
+                 "--primitives): plane rectangles, cylinder and torus outlines with axes, sphere "
+                 "circles, edge segments");
+  app.add_option("--min-confidence", args.min_confidence,
+                 "with --primitives: leave out fits below this confidence")
+      ->check(CLI::Range(0.0, 1.0));
 
   try {
     app.parse(argc, argv);

@@ -6,6 +6,7 @@
 
 #include "png_decode.hpp"
 #include "primlabel/render/colorize.hpp"
+#include "primlabel/render/primitive_outlines.hpp"
 #include "primlabel/render/raster.hpp"
 #include "primlabel/render/render.hpp"
 #include "test_util.hpp"
@@ -107,6 +108,99 @@ TEST(Render, ClearErrors) {
   RenderOptions tiny;
   tiny.width = 10;
   EXPECT_THROW(render_png(cloud, colors, tiny, "x.png"), std::invalid_argument);
+}
+
+TEST(Render, OverlaysAreDrawnOverThePointsInTheirProjection) {
+  test::TempDir dir;
+  const PointCloud cloud = test::plane_grid(0.0f, 0.0f, 0.5f, 0.005f);  // x, y in [-0.5, 0.5]
+  const std::vector<std::uint32_t> colors(cloud.size(), 0x00FF00);
+  RenderOptions options;
+  options.width = options.height = 256;
+  options.view = RenderView::kTop;
+  render_png(cloud, colors, options, dir.file("plain.png"));
+  EXPECT_EQ(decode_png(dir.file("plain.png")).count(0xFF00FF, 0, 0, 256, 256), 0u);
+
+  // A square of half the cloud's size, centred, hovering above it: drawn although the points'
+  // z-buffer is in front of nothing (overlays ignore depth), and inside the cloud's footprint.
+  options.overlays = {
+      {{{-0.25f, -0.25f, 0.1f}, {0.25f, -0.25f, 0.1f}, {0.25f, 0.25f, 0.1f}, {-0.25f, 0.25f, 0.1f}},
+       0xFF00FF,
+       true}};
+  render_png(cloud, colors, options, dir.file("square.png"));
+  const Decoded png = decode_png(dir.file("square.png"));
+  const std::size_t drawn = png.count(0xFF00FF, 0, 0, 256, 256);
+  EXPECT_GT(drawn, 4u * 100u);  // four sides of about 125 pixels, 2 pixels thick
+  EXPECT_LT(drawn, 4u * 130u * 3u);
+  // Nothing of it near the image's border or at its centre: the square is where it belongs.
+  EXPECT_EQ(png.count(0xFF00FF, 0, 0, 256, 40), 0u);
+  EXPECT_EQ(png.count(0xFF00FF, 100, 100, 156, 156), 0u);
+  // Closed: the left side is drawn too.
+  EXPECT_GT(png.count(0xFF00FF, 40, 60, 90, 196), 100u);
+
+  // Non-finite vertices and segments behind a pinhole camera are skipped, not drawn wrapped.
+  options.view = RenderView::kSensor;
+  options.overlays = {{{{0, 0, NAN}, {1, 1, 1}}, 0xFF00FF, false},
+                      {{{0, 0, 1}, {0, 0, -1}}, 0xFF00FF, false}};
+  PointCloud seen = cloud;
+  seen.viewpoint.origin = Vec3f(0, 0, 1);
+  EXPECT_NO_THROW(render_png(seen, colors, options, dir.file("sensor.png")));
+}
+
+namespace {
+double distance_to_axis(const Vec3f& p, const primitives::Vec3d& center,
+                        const primitives::Vec3d& axis) {
+  const primitives::Vec3d d = p.cast<double>() - center;
+  return (d - d.dot(axis) * axis).norm();
+}
+}  // namespace
+
+TEST(PrimitiveOutlines, FollowEachModelsParameters) {
+  using namespace primitives;
+  std::vector<Primitive> fitted(6);
+  fitted[0].class_id = 2;  // cylinder-convex
+  fitted[0].model = CylinderModel{Vec3d(0.1, 0, 0.2), Vec3d::UnitZ(), 0.04, 0.12};
+  fitted[1].class_id = 1;
+  fitted[1].model =
+      PlaneModel{Vec3d::UnitZ(), 0, Vec3d::Zero(), Vec3d::UnitX(), Vec3d::UnitY(), 0.8, 0.4};
+  fitted[2].class_id = 9;
+  fitted[2].model = SphereModel{Vec3d(0, 0, 0.3), 0.05};
+  fitted[3].class_id = 4;
+  fitted[3].model = LineModel{Vec3d(0, 0, 0.1), Vec3d::UnitY(), 0.3};
+  fitted[4].class_id = 6;  // a corner: no model, nothing drawn
+  fitted[5].class_id = 7;
+  fitted[5].model = TorusModel{Vec3d::Zero(), Vec3d::UnitZ(), 0.1, 0.02};
+  for (Primitive& p : fitted) p.confidence = 0.9;
+
+  const std::vector<Overlay> all = primitive_outlines(fitted);
+  // Cylinder: two end circles, four sides, the axis; plane: rectangle + normal; sphere: three
+  // circles; line: one segment; torus: four circles and its axis.
+  ASSERT_EQ(all.size(), 7u + 2u + 3u + 1u + 5u);
+  for (int i = 0; i < 6; ++i)
+    for (const Vec3f& p : all[i].points) {
+      EXPECT_NEAR(distance_to_axis(p, Vec3d(0.1, 0, 0.2), Vec3d::UnitZ()), 0.04, 1e-6);
+      EXPECT_LE(std::abs(p.z() - 0.2), 0.06 + 1e-6);
+    }
+  EXPECT_TRUE(all[0].closed && all[1].closed && !all[2].closed);
+  EXPECT_NEAR(all[6].points[0].z(), 0.14, 1e-6);  // the axis from end to end
+  EXPECT_NEAR(all[6].points[1].z(), 0.26, 1e-6);
+  ASSERT_EQ(all[7].points.size(), 4u);  // the plane's rectangle: 0.8 x 0.4 around the centre
+  EXPECT_NEAR(std::abs(all[7].points[0].x()), 0.4, 1e-6);
+  EXPECT_NEAR(std::abs(all[7].points[0].y()), 0.2, 1e-6);
+  for (int i = 9; i < 12; ++i)
+    for (const Vec3f& p : all[i].points)
+      EXPECT_NEAR((p.cast<double>() - Vec3d(0, 0, 0.3)).norm(), 0.05, 1e-6);
+  EXPECT_NEAR((all[12].points[1] - all[12].points[0]).norm(), 0.3, 1e-6);
+  for (const Vec3f& p : all[13].points) EXPECT_NEAR(p.head<2>().norm(), 0.12, 1e-6);
+  for (const Vec3f& p : all[14].points) EXPECT_NEAR(p.head<2>().norm(), 0.08, 1e-6);
+  // Each in its class's colour, darkened: distinct classes, distinct colours.
+  EXPECT_NE(all[0].rgb, all[7].rgb);
+  EXPECT_NE(all[0].rgb, color(PrimitiveClass::kCylinderConvex));
+
+  // Below the confidence asked for, or degenerate (NaN radius, zero extent): not drawn.
+  fitted[0].confidence = 0.2;
+  std::get<SphereModel>(fitted[2].model).radius = NAN;
+  std::get<PlaneModel>(fitted[1].model).extent_v = 0;
+  EXPECT_EQ(primitive_outlines(fitted, {.min_confidence = 0.5}).size(), 1u + 5u);
 }
 
 TEST(Colorize, ClassesSegmentsAndValues) {

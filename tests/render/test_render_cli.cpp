@@ -7,7 +7,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
+#include "png_decode.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/primitives/primitives_json.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -115,6 +120,44 @@ TEST_F(RenderCli, RuntimeErrorsExitWith1AndNameTheFile) {
   EXPECT_NE(r.output.find("has no field 'fpfh' (fields: x y z label rgb object)"),
             std::string::npos)
       << r.output;
+}
+
+TEST_F(RenderCli, DrawsTheFittedPrimitivesOfAJsonFile) {
+  // A cylinder standing in the scene's middle, as primlabel label --primitives writes it.
+  const PointCloud cloud = read_cloud(scene());
+  Vec3f lo = Vec3f::Constant(INFINITY), hi = -lo;
+  for (const Vec3f& p : cloud.xyz)
+    if (is_finite(p)) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  primitives::Primitive can;
+  can.class_id = class_id(PrimitiveClass::kCylinderConvex);
+  can.model = primitives::CylinderModel{((lo + hi) / 2).cast<double>(), primitives::Vec3d::UnitZ(),
+                                        0.15, 0.3};
+  can.confidence = 0.8;
+  can.points = 100;
+  const std::string json = dir_->file("prims.json");
+  { std::ofstream(json) << primitives::primitives_json(std::vector{can}); }
+  const std::string base =
+      render_tool() + " " + scene() + " --no-legend --width 320 --height 240 -o ";
+  ASSERT_EQ(run(base + dir_->file("plain.png")).exit_code, 0);
+  Result r = run(base + dir_->file("fits.png") + " --primitives " + json);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test::Decoded plain = test::decode_png(dir_->file("plain.png"));
+  const test::Decoded fits = test::decode_png(dir_->file("fits.png"));
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < plain.rgb.size(); ++i) changed += plain.rgb[i] != fits.rgb[i];
+  EXPECT_GT(changed, 400u) << changed;  // two circles, four sides and an axis
+  // Below --min-confidence it is left out: the same picture as without.
+  r = run(base + dir_->file("none.png") + " --primitives " + json + " --min-confidence 0.9");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(test::decode_png(dir_->file("none.png")).rgb, plain.rgb);
+
+  // A missing or malformed file is an input error naming it, in one line.
+  for (const std::string& bad : {dir_->file("absent.json"), scene()}) {
+    r = run(base + dir_->file("bad.png") + " --primitives " + bad);
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find(bad), std::string::npos) << r.output;
+  }
 }
 
 TEST(RenderCliShared, MosdSegmentsFromTheSensor) {

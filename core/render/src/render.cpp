@@ -90,6 +90,35 @@ std::uint32_t scale_color(std::uint32_t c, float f) {
   return ch(16) | ch(8) | ch(0);
 }
 
+// Each overlay segment between two points the camera can see (a pinhole view drops segments
+// reaching behind it rather than wrapping them around).
+template <class ToPixel>
+void draw_overlays(Raster& image, const Camera& camera, const std::vector<Overlay>& overlays,
+                   const ToPixel& to_pixel) {
+  const int thickness = image.width() >= 600 ? 3 : 2;
+  for (const Overlay& overlay : overlays) {
+    const std::size_t n = overlay.points.size();
+    const std::size_t segments = overlay.closed && n > 2 ? n : (n ? n - 1 : 0);
+    for (std::size_t s = 0; s < segments; ++s) {
+      const Vec3f& a = overlay.points[s];
+      const Vec3f& b = overlay.points[(s + 1) % n];
+      float ax, ay, ad, bx, by, bd;
+      if (!is_finite(a) || !is_finite(b) || !camera.project(a, ax, ay, ad) ||
+          !camera.project(b, bx, by, bd))
+        continue;
+      float x0, y0, x1, y1;
+      to_pixel(ax, ay, x0, y0);
+      to_pixel(bx, by, x1, y1);
+      // Far off-screen ends (a huge fitted plane) would make Raster::line walk a long way.
+      const float limit = 4.0f * float(std::max(image.width(), image.height()));
+      if (std::abs(x0) > limit || std::abs(y0) > limit || std::abs(x1) > limit ||
+          std::abs(y1) > limit)
+        continue;
+      image.line(x0, y0, x1, y1, overlay.rgb & 0xFFFFFF, thickness);
+    }
+  }
+}
+
 }  // namespace
 
 void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point_rgb,
@@ -140,14 +169,20 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
     const float scale = 0.98f * std::min(plot_w / span_x, plot_h / span_y);
     const float offset_x = plot_x + 0.5f * (plot_w - scale * span_x);
     const float offset_y = plot_y + 0.5f * (plot_h - scale * span_y);
+    // Screen position of a projected point, in pixels.
+    const auto to_pixel = [&](float x, float y, float& px, float& py) {
+      px = offset_x + scale * (x - min_x);
+      py = offset_y + scale * (max_y - y);
+    };
     // Depth in pixel units, so outline strength does not depend on the cloud's size.
     const float depth_scale = camera.perspective ? 1.0f : scale;
     std::vector<float> zbuffer(pixels.size(), INFINITY);
     std::vector<std::uint32_t> color(pixels.size(), 0);
     const int r = std::max(options.point_radius_px, 0);
     for (const Projected& p : projected) {
-      const int cx = int(std::lround(offset_x + scale * (p.x - min_x)));
-      const int cy = int(std::lround(offset_y + scale * (max_y - p.y)));
+      float px, py;
+      to_pixel(p.x, p.y, px, py);
+      const int cx = int(std::lround(px)), cy = int(std::lround(py));
       const float depth = camera.perspective ? std::log(p.depth) * scale : p.depth * depth_scale;
       for (int dy = -r; dy <= r; ++dy)
         for (int dx = -r; dx <= r; ++dx) {
@@ -187,6 +222,7 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
         if (n) shade *= std::max(0.35f, std::exp(-0.25f * std::max(0.0f, zbuffer[at] - sum / n)));
         pixels[at] = scale_color(color[at], shade);
       }
+    draw_overlays(image, camera, options.overlays, to_pixel);
   }
 
   if (!options.title.empty()) image.text(margin, margin, options.title, 0x202020, text_scale);

@@ -21,6 +21,14 @@ struct LegendEntry {
   std::uint32_t rgb;  // 0xRRGGBB
 };
 
+// A 3D polyline drawn over the points (no depth test: outlines of fitted primitives must show
+// through the surface they were fitted to), e.g. from primitive_outlines().
+struct Overlay {
+  std::vector<Vec3f> points;
+  std::uint32_t rgb = 0x000000;  // 0xRRGGBB
+  bool closed = false;           // also join the last point to the first
+};
+
 struct RenderOptions {
   int width = 1024;
   int height = 768;
@@ -30,6 +38,9 @@ struct RenderOptions {
   std::uint32_t background = 0xFFFFFF;
   std::string title;                // drawn top-left when not empty
   std::vector<LegendEntry> legend;  // drawn bottom-left when not empty
+  // Drawn over the points in the same projection; the picture is framed by the points only, so
+  // an overlay beyond them is clipped at the image's edge.
+  std::vector<Overlay> overlays;
 };
 
 // Renders the finite points of `cloud` with colours `point_rgb` (0xRRGGBB, one per point) to a
