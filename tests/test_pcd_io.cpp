@@ -163,6 +163,30 @@ TEST(PcdWrite, HeaderListsFieldsLikePcl) {
   EXPECT_EQ(lines[10], "DATA binary_compressed");
 }
 
+TEST_P(PcdRoundTrip, HeaderCommentsFollowTheFirstLineAndAreSkippedByTheReader) {
+  test::TempDir dir;
+  const std::string path = dir.file("cloud.pcd");
+  const PointCloud original = awkward_cloud();
+  write_pcd(path, original, GetParam(), {"primlabel model tabletop", "a second line"});
+  std::ifstream in(path, std::ios::binary);
+  std::vector<std::string> lines;
+  for (std::string line; lines.size() < 4 && std::getline(in, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 4u);
+  EXPECT_EQ(lines[1], "# primlabel model tabletop");
+  EXPECT_EQ(lines[2], "# a second line");
+  EXPECT_EQ(lines[3], "VERSION 0.7");
+  expect_same_cloud(original, read_pcd(path));
+}
+
+TEST(PcdWrite, AMultiLineHeaderCommentIsRefusedAndNothingIsWritten) {
+  test::TempDir dir;
+  const std::string path = dir.file("cloud.pcd");
+  EXPECT_THROW(write_pcd(path, awkward_cloud(), PcdEncoding::kBinary, {"one\nPOINTS 5"}),
+               std::invalid_argument);
+  EXPECT_THROW(write_cloud(path, awkward_cloud(), {"cr\r"}), std::invalid_argument);
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
 TEST(PcdWrite, AsciiWritesNanAsNan) {
   test::TempDir dir;
   const std::string path = dir.file("nan.pcd");

@@ -91,6 +91,25 @@ INSTANTIATE_TEST_SUITE_P(BothEncodings, PlyRoundTrip,
                                                                                 : "Binary");
                          });
 
+TEST(PlyWrite, HeaderCommentsFollowTheFormatLineAndAreSkippedByTheReader) {
+  test::TempDir dir;
+  const std::string path = dir.file("cloud.ply");
+  const PointCloud original = awkward_cloud();
+  write_cloud(path, original, {"primlabel classes 1 plane", "second"});
+  std::ifstream in(path, std::ios::binary);
+  std::vector<std::string> lines;
+  for (std::string line; lines.size() < 5 && std::getline(in, line);) lines.push_back(line);
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_EQ(lines[1], "format binary_little_endian 1.0");
+  EXPECT_EQ(lines[2], "comment primlabel classes 1 plane");
+  EXPECT_EQ(lines[3], "comment second");
+  EXPECT_EQ(lines[4], "comment written by primlabel");
+  EXPECT_EQ(read_ply(path).size(), original.size());
+  EXPECT_THROW(write_ply(path, original, PlyEncoding::kAscii, {"two\nlines"}),
+               std::invalid_argument);
+  EXPECT_EQ(read_ply(path).size(), original.size());  // the earlier file is still there
+}
+
 TEST(PlyWrite, HeaderDeclaresStandardProperties) {
   test::TempDir dir;
   const std::string path = dir.file("cloud.ply");

@@ -32,11 +32,11 @@ PointCloud read_cloud(const std::string& path) {
   return format_of(path) == CloudFormat::kPcd ? read_pcd(path) : read_ply(path);
 }
 
-void write_cloud(const std::string& path, const PointCloud& cloud) {
+void write_cloud(const std::string& path, const PointCloud& cloud, const HeaderComments& comments) {
   if (format_of(path) == CloudFormat::kPcd)
-    write_pcd(path, cloud);
+    write_pcd(path, cloud, PcdEncoding::kBinaryCompressed, comments);
   else
-    write_ply(path, cloud);
+    write_ply(path, cloud, PlyEncoding::kBinaryLittleEndian, comments);
 }
 
 }  // namespace primlabel

@@ -17,6 +17,7 @@
 #include <limits>
 #include <new>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -108,6 +109,17 @@ inline void write_file_atomically(const std::string& path, std::string_view byte
     atomic_write_file(path, bytes);
   } catch (const AtomicWriteError& e) {
     throw IoError(e.what());
+  }
+}
+
+// Header comments (cloud_io.hpp: HeaderComments) as "<marker><line>\n" each; a line break in one
+// would end the comment and corrupt the header, so it is refused before anything is written.
+inline void append_comment_lines(std::string& out, std::string_view marker,
+                                 const std::vector<std::string>& comments) {
+  for (const std::string& line : comments) {
+    if (line.find_first_of("\r\n") != std::string::npos)
+      throw std::invalid_argument("header comment '" + line.substr(0, 40) + "' must be one line");
+    out.append(marker).append(line) += '\n';
   }
 }
 

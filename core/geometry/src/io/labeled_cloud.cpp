@@ -3,10 +3,8 @@
 #include <algorithm>
 #include <cctype>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 
-#include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel {
@@ -19,14 +17,15 @@ bool is_ply(const std::string& path) {
   return ext == ".ply";
 }
 
-std::string tag_lines(const CloudTags& tags, const char* prefix) {
-  std::string out;
+// The tags as header comment lines "primlabel <key> <value>" (read_cloud_tags reads them back).
+HeaderComments tag_comments(const CloudTags& tags) {
+  HeaderComments out;
   for (const auto& [key, value] : tags) {
     if (key.empty() || key.find_first_of(" \t\r\n") != std::string::npos)
       throw std::invalid_argument("tag key '" + key + "' must be one word");
     if (value.find_first_of("\r\n") != std::string::npos)
       throw std::invalid_argument("tag '" + key + "' must be one line");
-    out += std::string(prefix) + key + " " + value + "\n";
+    out.push_back("primlabel " + key + " " + value);
   }
   return out;
 }
@@ -34,28 +33,7 @@ std::string tag_lines(const CloudTags& tags, const char* prefix) {
 }  // namespace
 
 void write_tagged_cloud(const std::string& path, const PointCloud& cloud, const CloudTags& tags) {
-  const bool ply = is_ply(path);
-  const std::string lines = tag_lines(tags, ply ? "comment primlabel " : "# primlabel ");
-  write_cloud(path, cloud);
-  if (lines.empty()) return;
-  // The writers own the format; the tags go in as comment lines right after the first line
-  // (PCD's "# .PCD v0.7" comment) or after PLY's "format" line.
-  std::string bytes;
-  {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    bytes = buffer.str();
-  }
-  std::size_t at = bytes.find('\n');
-  if (ply && at != std::string::npos) at = bytes.find('\n', at + 1);
-  if (at == std::string::npos) throw IoError(path + ": unexpected header written, cannot add tags");
-  bytes.insert(at + 1, lines);
-  try {
-    atomic_write_file(path, bytes);
-  } catch (const AtomicWriteError& e) {
-    throw IoError(e.what());
-  }
+  write_cloud(path, cloud, tag_comments(tags));
 }
 
 CloudTags read_cloud_tags(const std::string& path) {

@@ -600,7 +600,7 @@ std::vector<OutputField> output_fields(const PointCloud& cloud) {
 }
 
 std::string pcd_header(const PointCloud& cloud, Shape shape, const std::vector<OutputField>& fields,
-                       PcdEncoding encoding) {
+                       PcdEncoding encoding, const HeaderComments& comments) {
   std::string names, sizes, types, counts;
   for (const OutputField& field : fields) {
     names += ' ' + field.name;
@@ -610,7 +610,9 @@ std::string pcd_header(const PointCloud& cloud, Shape shape, const std::vector<O
     counts += ' ';
     append_integer(counts, field.count);
   }
-  std::string header = "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n";
+  std::string header = "# .PCD v0.7 - Point Cloud Data file format\n";
+  append_comment_lines(header, "# ", comments);
+  header += "VERSION 0.7\n";
   header += "FIELDS" + names + "\nSIZE" + sizes + "\nTYPE" + types + "\nCOUNT" + counts;
   header += cat("\nWIDTH ", shape.width, "\nHEIGHT ", shape.height, "\nVIEWPOINT");
   const Viewpoint& view = cloud.viewpoint;
@@ -695,14 +697,15 @@ void append_compressed_body(const std::string& path, std::string& out, std::size
   out.append(reinterpret_cast<const char*>(compressed.data()), compressed_size);
 }
 
-void write_pcd_file(const std::string& path, const PointCloud& cloud, PcdEncoding encoding) {
+void write_pcd_file(const std::string& path, const PointCloud& cloud, PcdEncoding encoding,
+                    const HeaderComments& comments) {
   const Shape shape = validate_cloud_for_writing(path, cloud);
   const std::vector<OutputField> fields = output_fields(cloud);
   std::vector<std::string> names;
   for (const OutputField& field : fields) names.push_back(field.name);
   check_unique_names(path, names);
 
-  std::string out = pcd_header(cloud, shape, fields, encoding);
+  std::string out = pcd_header(cloud, shape, fields, encoding, comments);
   switch (encoding) {
     case PcdEncoding::kAscii:
       append_ascii_body(out, cloud.size(), fields);
@@ -724,8 +727,9 @@ namespace primlabel {
 
 PointCloud read_pcd(const std::string& path) { return io_detail::read_pcd_file(path); }
 
-void write_pcd(const std::string& path, const PointCloud& cloud, PcdEncoding encoding) {
-  io_detail::write_pcd_file(path, cloud, encoding);
+void write_pcd(const std::string& path, const PointCloud& cloud, PcdEncoding encoding,
+               const HeaderComments& comments) {
+  io_detail::write_pcd_file(path, cloud, encoding, comments);
 }
 
 }  // namespace primlabel

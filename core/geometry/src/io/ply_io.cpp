@@ -659,7 +659,8 @@ std::vector<OutputProperty> output_properties(const PointCloud& cloud) {
   return out;
 }
 
-void write_ply_file(const std::string& path, const PointCloud& cloud, PlyEncoding encoding) {
+void write_ply_file(const std::string& path, const PointCloud& cloud, PlyEncoding encoding,
+                    const HeaderComments& comments) {
   validate_cloud_for_writing(path, cloud);
   const std::vector<OutputProperty> properties = output_properties(cloud);
   std::vector<std::string> names;
@@ -669,7 +670,9 @@ void write_ply_file(const std::string& path, const PointCloud& cloud, PlyEncodin
   const std::size_t n = cloud.size();
   std::string out = "ply\nformat ";
   out += encoding == PlyEncoding::kAscii ? "ascii" : "binary_little_endian";
-  out += cat(" 1.0\ncomment written by primlabel\nelement vertex ", n, "\n");
+  out += " 1.0\n";
+  append_comment_lines(out, "comment ", comments);
+  out += cat("comment written by primlabel\nelement vertex ", n, "\n");
   std::size_t record_bytes = 0;
   for (const OutputProperty& property : properties) {
     out += cat("property ", property.type, " ", property.name, "\n");
@@ -712,8 +715,9 @@ namespace primlabel {
 
 PointCloud read_ply(const std::string& path) { return io_detail::read_ply_file(path); }
 
-void write_ply(const std::string& path, const PointCloud& cloud, PlyEncoding encoding) {
-  io_detail::write_ply_file(path, cloud, encoding);
+void write_ply(const std::string& path, const PointCloud& cloud, PlyEncoding encoding,
+               const HeaderComments& comments) {
+  io_detail::write_ply_file(path, cloud, encoding, comments);
 }
 
 }  // namespace primlabel

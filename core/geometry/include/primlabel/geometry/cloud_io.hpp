@@ -14,6 +14,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "primlabel/geometry/point_cloud.hpp"
 
@@ -27,16 +28,24 @@ class IoError : public std::runtime_error {
 enum class PcdEncoding { kAscii, kBinary, kBinaryCompressed };
 enum class PlyEncoding { kAscii, kBinaryLittleEndian };
 
+// Header comment lines a writer puts right after the format's first line (PCD: after
+// "# .PCD v0.7 ...", as "# <line>"; PLY: after "format ...", as "comment <line>"). Readers
+// (ours, PCL's, Open3D's) skip them. A line holding '\r' or '\n' is an std::invalid_argument.
+using HeaderComments = std::vector<std::string>;
+
 PointCloud read_pcd(const std::string& path);
 void write_pcd(const std::string& path, const PointCloud& cloud,
-               PcdEncoding encoding = PcdEncoding::kBinaryCompressed);
+               PcdEncoding encoding = PcdEncoding::kBinaryCompressed,
+               const HeaderComments& comments = {});
 
 PointCloud read_ply(const std::string& path);
 void write_ply(const std::string& path, const PointCloud& cloud,
-               PlyEncoding encoding = PlyEncoding::kBinaryLittleEndian);
+               PlyEncoding encoding = PlyEncoding::kBinaryLittleEndian,
+               const HeaderComments& comments = {});
 
 // Dispatch on the extension (.pcd / .ply, case-insensitive); anything else is an IoError.
 PointCloud read_cloud(const std::string& path);
-void write_cloud(const std::string& path, const PointCloud& cloud);
+void write_cloud(const std::string& path, const PointCloud& cloud,
+                 const HeaderComments& comments = {});
 
 }  // namespace primlabel
