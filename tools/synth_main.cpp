@@ -1,6 +1,7 @@
 // primlabel-synth: labeled synthetic table scenes, scanned by a simulated LMS400 or Kinect.
 //
 //   primlabel-synth --scene table --sensor lms400 --seed 7 -o scene.pcd
+//   primlabel-synth --seed 7 -o scene.pcd --primitives scene_primitives.json   # the true shapes
 //   primlabel-synth --set train --count 50 --out-dir data/ --sensor lms400
 //   primlabel-synth --list-classes
 
@@ -17,7 +18,9 @@
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/primitives/primitives_json.hpp"
 #include "primlabel/synth/generate.hpp"
+#include "primlabel/synth/true_primitives.hpp"
 
 namespace {
 
@@ -25,7 +28,7 @@ using namespace primlabel;
 using namespace primlabel::synth;
 
 struct Arguments {
-  std::string scene = "table", sensor = "lms400", output, set, out_dir;
+  std::string scene = "table", sensor = "lms400", output, set, out_dir, primitives;
   std::uint64_t seed = 1;
   int count = 0;
   double radius = kDefaultLabelRadius, noise_scale = 1.0, dropout = -1, angular_step = 0;
@@ -79,11 +82,31 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The scene's true primitives as primlabel-eval --primitives writes fitted ones, plus each one's
+// object; `points` counts the scan's points of its class within a few noise levels of it (0:
+// not seen).
+void write_true_primitives(const std::string& path, const Generated& scan, double noise_scale) {
+  std::vector<TruePrimitive> truth = true_primitives(scan.scene);
+  const double tolerance = 0.003 * std::max(1.0, noise_scale);
+  count_points_on(truth, scan.cloud, tolerance);
+  json::Json list = json::Json::array();
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    json::Json entry = primitives::to_json(truth[i].primitive, i);
+    entry["object"] = truth[i].object;
+    list.push_back(std::move(entry));
+  }
+  const json::Json out = {{"source", "primlabel-synth ground truth"},
+                          {"points_tolerance", json::rounded(tolerance, "%.4g")},
+                          {"primitives", std::move(list)}};
+  atomic_write_file(path, json::dump(out, 1) + "\n");
+}
+
 int write_one(const Arguments& args) {
   const auto start = std::chrono::steady_clock::now();
   const Generated scan = generate(options_from(args, args.seed));
   const double generate_seconds = seconds_since(start);
   write_tagged_cloud(args.output, scan.cloud, scan.tags);
+  if (!args.primitives.empty()) write_true_primitives(args.primitives, scan, args.noise_scale);
   if (!args.quiet) {
     std::size_t valid, on_objects;
     const std::string summary = class_summary(scan.cloud, valid, on_objects);
@@ -110,9 +133,14 @@ int write_set(const Arguments& args) {
     std::snprintf(file, sizeof file, "%s_%04d.pcd", args.set.c_str(), i);
     const Generated scan = generate(options_from(args, seed));
     write_tagged_cloud((dir / file).string(), scan.cloud, scan.tags);
+    const std::string truth_file = std::filesystem::path(file).stem().string() + "_primitives.json";
+    write_true_primitives((dir / truth_file).string(), scan, args.noise_scale);
     const std::size_t valid = count_finite(scan.cloud);
-    scenes.push_back(
-        {{"file", file}, {"seed", seed}, {"points", valid}, {"objects", scan.tags.at("objects")}});
+    scenes.push_back({{"file", file},
+                      {"primitives", truth_file},
+                      {"seed", seed},
+                      {"points", valid},
+                      {"objects", scan.tags.at("objects")}});
     if (!args.quiet)
       std::fprintf(stderr, "%s: %zu points (seed %llu)\n", file, valid,
                    static_cast<unsigned long long>(seed));
@@ -158,6 +186,9 @@ int main(int argc, char** argv) {
   app.add_option("--radius", args.radius, "label radius r (m): the scale labels are defined at")
       ->check(CLI::PositiveNumber);
   app.add_option("-o,--output", args.output, "output cloud (.pcd or .ply)");
+  app.add_option("--primitives", args.primitives,
+                 "also write the scene's true primitives (planes, cylinders, spheres, tori, world "
+                 "frame) as JSON; --set writes <scene>_primitives.json beside each scene");
   app.add_option("--set", args.set,
                  "write a scene set from its own seed range: train (1000..), "
                  "val (2000..), test (3000..)")

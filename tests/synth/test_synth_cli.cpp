@@ -7,11 +7,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/primitives/primitives_json.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -67,8 +69,8 @@ TEST(SynthCli, WritesASceneSetWithManifest) {
   const std::string set_dir = dir.file("val");
   const Result r = run("--set val --count 2 --out-dir " + set_dir + " -q");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  for (const std::string file :
-       {"val_0000.pcd", "val_0001.pcd", "val_manifest.json", "classes.txt"})
+  for (const std::string file : {"val_0000.pcd", "val_0001.pcd", "val_0000_primitives.json",
+                                 "val_0001_primitives.json", "val_manifest.json", "classes.txt"})
     EXPECT_TRUE(std::filesystem::exists(set_dir + "/" + file)) << file;
   EXPECT_EQ(read_cloud_tags(set_dir + "/val_0001.pcd").at("seed"), "2001");
   std::ifstream in(set_dir + "/val_manifest.json");
@@ -77,6 +79,28 @@ TEST(SynthCli, WritesASceneSetWithManifest) {
   EXPECT_NE(manifest.str().find("\"seed\": 2000"), std::string::npos) << manifest.str();
   EXPECT_NE(manifest.str().find("\"label_radius\": 0.025"), std::string::npos);
   EXPECT_EQ(read_class_map(set_dir + "/classes.txt").to_text(), ClassMap::taxonomy().to_text());
+}
+
+TEST(SynthCli, WritesTheTruePrimitivesBesideTheScene) {
+  test::TempDir dir;
+  const std::string json = dir.file("truth.json");
+  const Result r =
+      run("--scene primitives --seed 3 -q -o " + dir.file("p.pcd") + " --primitives " + json);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(json);
+  std::stringstream text;
+  text << in.rdbuf();
+  // The format of primlabel-eval --primitives, read back by its own parser.
+  const std::vector<primitives::Primitive> truth = primitives::parse_primitives_json(text.str());
+  std::map<primitives::PrimitiveKind, int> seen;
+  for (const primitives::Primitive& p : truth)
+    if (p.points >= 50) ++seen[p.kind()];
+  // The primitives scene has boxes and lids, cans and mugs, a ball and a bowl, and a ring.
+  EXPECT_GE(seen[primitives::PrimitiveKind::kPlane], 4);
+  EXPECT_GE(seen[primitives::PrimitiveKind::kCylinder], 3);
+  EXPECT_GE(seen[primitives::PrimitiveKind::kSphere], 2);
+  EXPECT_EQ(seen[primitives::PrimitiveKind::kTorus], 1);
+  EXPECT_NE(text.str().find("\"object\": 6"), std::string::npos);
 }
 
 TEST(SynthCli, UsageErrorsExitWith2AndOneLine) {

@@ -173,6 +173,8 @@ class MugShape : public Shape {
   double footprint_radius() const override;
   double outer_radius() const { return radius_; }
   double inner_radius() const { return inner_radius_; }
+  double height() const { return height_; }
+  double floor_height() const { return floor_; }  // of the inner floor above the bottom
 
  private:
   bool intersect_handle(const Ray& ray, double t_min, double t_max, SurfaceHit& hit) const;
