@@ -25,6 +25,7 @@
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/primitives/fit_primitives.hpp"
 #include "primlabel/synth/generate.hpp"
+#include "primlabel/synth/true_primitives.hpp"
 
 namespace {
 
@@ -48,35 +49,18 @@ struct TrueSurface {
   std::optional<Vec3d> center;  // spheres
 };
 
+// The scene's curved true primitives (synth::true_primitives; its planes are not scored here).
 std::vector<TrueSurface> true_surfaces(const synth::Scene& scene) {
-  using C = PrimitiveClass;
   std::vector<TrueSurface> out;
-  for (std::size_t o = 1; o < scene.objects.size(); ++o) {
-    const synth::SceneObject& object = scene.objects[o];
-    const synth::Shape* shape = object.shape.get();
-    const Eigen::Matrix3d rotation = object.world_from_local.linear();
-    const Vec3d up = rotation * Vec3d::UnitZ();
-    auto add = [&](PrimitiveKind kind, C cls, double radius, const Vec3d& axis,
-                   std::optional<Vec3d> center = std::nullopt) {
-      out.push_back({int(o), kind, class_id(cls), radius, axis, center});
-    };
-    if (const auto* can = dynamic_cast<const synth::CanShape*>(shape)) {
-      add(PrimitiveKind::kCylinder, C::kCylinderConvex, can->radius(), up);
-    } else if (const auto* lying = dynamic_cast<const synth::LyingCanShape*>(shape)) {
-      add(PrimitiveKind::kCylinder, C::kCylinderConvex, lying->radius(), rotation * Vec3d::UnitX());
-    } else if (const auto* mug = dynamic_cast<const synth::MugShape*>(shape)) {
-      add(PrimitiveKind::kCylinder, C::kCylinderConvex, mug->outer_radius(), up);
-      add(PrimitiveKind::kCylinder, C::kCylinderConcave, mug->inner_radius(), up);
-    } else if (const auto* bowl = dynamic_cast<const synth::BowlShape*>(shape)) {
-      const Vec3d center = object.world_from_local * Vec3d(0, 0, bowl->center_height());
-      add(PrimitiveKind::kSphere, C::kSphereConvex, bowl->outer_radius(), up, center);
-      add(PrimitiveKind::kSphere, C::kSphereConcave, bowl->inner_radius(), up, center);
-    } else if (const auto* ball = dynamic_cast<const synth::BallShape*>(shape)) {
-      add(PrimitiveKind::kSphere, C::kSphereConvex, ball->radius(), up,
-          object.world_from_local * Vec3d(0, 0, ball->radius()));
-    } else if (const auto* ring = dynamic_cast<const synth::TorusShape*>(shape)) {
-      add(PrimitiveKind::kTorus, C::kTorusConvex, ring->major_radius(), up);
-    }
+  for (const synth::TruePrimitive& t : synth::true_primitives(scene)) {
+    const primitives::Primitive& p = t.primitive;
+    if (const auto* c = std::get_if<primitives::CylinderModel>(&p.model))
+      out.push_back({t.object, PrimitiveKind::kCylinder, p.class_id, c->radius, c->axis});
+    else if (const auto* sp = std::get_if<primitives::SphereModel>(&p.model))
+      out.push_back(
+          {t.object, PrimitiveKind::kSphere, p.class_id, sp->radius, Vec3d::UnitZ(), sp->center});
+    else if (const auto* tr = std::get_if<primitives::TorusModel>(&p.model))
+      out.push_back({t.object, PrimitiveKind::kTorus, p.class_id, tr->major_radius, tr->axis});
   }
   return out;
 }
