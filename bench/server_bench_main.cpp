@@ -232,7 +232,13 @@ FrameFigures frame_figures(const std::string& label, const std::string& name,
       label.c_str(), out.points, out.described, out.voxel, out.server_p50, out.server_p90,
       1e3 / out.server_p50, out.local_p50, out.local_p90, reps);
   std::printf("%-24s   server stages ms:", "");
-  for (const auto& [stage, ms] : out.server_stages) std::printf(" %s %.1f", stage.c_str(), ms);
+  double staged = 0;
+  for (const auto& [stage, ms] : out.server_stages) {
+    std::printf(" %s %.1f", stage.c_str(), ms);
+    staged += ms;
+  }
+  // What no stage covers: the client's packing, the transport and the client reading the answer.
+  std::printf(" | in no stage %.1f", server_ms[nearest_to(server_ms, out.server_p50)] - staged);
   std::printf("\n%-24s   in-process stages ms:", "");
   for (const auto& [stage, ms] : out.local_stages) std::printf(" %s %.1f", stage.c_str(), ms);
   std::printf("\n");

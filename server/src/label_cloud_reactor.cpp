@@ -98,7 +98,6 @@ class LabelCloudReactor final : public grpc::ServerUnaryReactor,
     if (finished_) return session_.free_result();
     try {
       if (auto failed = session_.outcome()) return fail(*failed);
-      const Clock::time_point send_start = Clock::now();
       const LabelResponder responder(session_.result(), 0, std::uint64_t(-1));
       v1::LabelCloudResponse response;
       responder.fill_range(0, session_.result().labels.size(), *response.mutable_result());
@@ -106,7 +105,8 @@ class LabelCloudReactor final : public grpc::ServerUnaryReactor,
       fill_summary(record_, *session_.plan().entry, session_.result(), *response.mutable_summary());
       session_.free_result();
       *response_ = serialize_message(response);
-      record_.stages.send = std::chrono::duration<double>(Clock::now() - send_start).count();
+      record_.stages.send =
+          std::chrono::duration<double>(Clock::now() - session_.job_ended()).count();
       finish(grpc::Status::OK);
     } catch (...) {
       fail(internal_error("answering", std::current_exception()));

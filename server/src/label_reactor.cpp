@@ -181,7 +181,6 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
     guarded("answering", [&] {
       if (auto failed = session_.outcome()) return fail(*failed);
       phase_ = Phase::kSending;
-      send_start_ = Clock::now();
       responder_.emplace(session_.result(), session_.header().options().response_chunk_points(),
                          env_.config->response_chunk_bytes);
       write_next();
@@ -193,7 +192,8 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
     if (next_chunk_ < responder_->chunk_count()) {
       responder_->fill_chunk(next_chunk_++, *response.mutable_chunk());
     } else {
-      record_.stages.send = seconds_between(send_start_, Clock::now());
+      // From the job's end: the hand-over to this thread, packing and writing the chunks.
+      record_.stages.send = seconds_between(session_.job_ended(), Clock::now());
       fill_summary(record_, *session_.plan().entry, session_.result(), *response.mutable_summary());
       summary_sent_ = true;
     }
@@ -323,7 +323,7 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
   bool summary_sent_ = false;
   grpc::ByteBuffer write_buffer_;
   bool write_pending_ = false;
-  Clock::time_point send_start_, write_started_, stopped_at_;
+  Clock::time_point write_started_, stopped_at_;
 
   TimerService::Id timer_ = 0;
   Clock::time_point timer_at_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <vector>
 
 #include "primitive_messages.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
@@ -82,11 +83,21 @@ void fill_summary(const RequestRecord& record, const ModelEntry& entry,
 
   std::map<std::uint32_t, std::uint64_t> counts;
   for (std::uint32_t id : result.class_ids) counts[id] = 0;
-  std::uint64_t labeled = 0;
+  // Class ids are small: count in a flat table (a map lookup per point cost ms on a frame).
+  constexpr std::uint32_t kDenseIds = 256;
+  std::vector<std::uint64_t> dense(kDenseIds, 0);
   for (std::uint32_t label : result.labels) {
-    ++counts[label];
-    if (label != class_id(PrimitiveClass::kUnknown)) ++labeled;
+    if (label < kDenseIds)
+      ++dense[label];
+    else
+      ++counts[label];
   }
+  for (std::uint32_t id = 0; id < kDenseIds; ++id)
+    if (dense[id] > 0) counts[id] += dense[id];
+  const std::uint32_t unknown = class_id(PrimitiveClass::kUnknown);
+  const auto unlabeled = counts.find(unknown);
+  const std::uint64_t labeled =
+      result.labels.size() - (unlabeled == counts.end() ? 0 : unlabeled->second);
   summary.set_points_labeled(labeled);
   for (const auto& [id, points] : counts) {
     v1::ClassCount* count = summary.add_class_counts();

@@ -46,6 +46,7 @@ LabelServer::LabelServer(ServerConfig config)
   env_.receiving = receiving_.get();
   env_.requests = &requests_;
   env_.timers = &timers_;
+  env_.trimmer = &trimmer_;
   env_.metrics = &metrics_;
   env_.auth = &auth_;
   env_.draining = &draining_;

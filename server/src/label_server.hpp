@@ -56,6 +56,7 @@ class LabelServer {
   std::atomic<bool> draining_{false};
   // Before admission_: jobs still stopping when the workers are joined may touch them.
   TimerService timers_;
+  IdleMemoryTrimmer trimmer_{timers_};
   std::unique_ptr<SlotBudget> receiving_;
   RequestGauge requests_{metrics_};
   std::unique_ptr<Admission> admission_;

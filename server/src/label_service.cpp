@@ -1,6 +1,6 @@
 #include "label_service.hpp"
 
-#include "free_memory.hpp"
+#include <algorithm>
 
 namespace primlabel::server {
 
@@ -10,8 +10,9 @@ ScanLimits limits_of(const ServerConfig& config) {
   return ScanLimits{config.max_points, config.max_request_bytes};
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+double seconds_between(std::chrono::steady_clock::time_point from,
+                       std::chrono::steady_clock::time_point to) {
+  return std::chrono::duration<double>(to - from).count();
 }
 
 }  // namespace
@@ -25,16 +26,18 @@ ServiceError receiving_busy(const SlotBudget& budget) {
 }
 
 LabelSession::LabelSession(const ServiceEnvironment& env, RequestRecord& record)
-    : env_(env), requests_(env.requests), record_(record) {}
+    : env_(env), requests_(env.requests), trimmer_(env.trimmer), record_(record) {}
 
 void LabelSession::free_result() {
   const std::uint64_t points = result_.labels.size();
   result_ = pipeline::LabelingResult{};
-  return_free_memory(points);
+  if (trimmer_) trimmer_->released(points);
 }
 
 LabelSession::~LabelSession() {
   if (counted_) requests_->add_in_flight(-1);
+  // A scan refused while it arrived still held its points until now.
+  if (trimmer_ && assembler_) trimmer_->released(assembler_->points());
 }
 
 std::optional<ServiceError> LabelSession::start(const v1::ScanHeader& header, bool streamed) {
@@ -69,19 +72,20 @@ std::optional<ServiceError> LabelSession::run(std::function<void()> done) {
   record_.points = assembler_->points();
   record_.dropped_non_finite = assembler_->non_finite();
   if (auto incomplete = assembler_->finish()) return incomplete;
-  record_.stages.receive = seconds_since(receive_start_);
+  scan_complete_ = std::chrono::steady_clock::now();
+  record_.stages.receive = seconds_between(receive_start_, scan_complete_);
   receiving_.reset();
   ticket_ = env_.admission->try_admit();
   if (!ticket_) return server_busy(*env_.admission);
   const int threads = env_.threads_per_job;
   job_ = env_.admission->submit(*ticket_, [this, threads, done = std::move(done)] {
+    job_start_ = std::chrono::steady_clock::now();
     job_error_ =
         run_label_job(plan_, assembler_->cloud(), RunContext{threads, stop_.get_token()}, result_);
+    job_end_ = std::chrono::steady_clock::now();
     // The compute slot and the points go as soon as the result exists, not when it is sent.
-    const std::uint64_t points = assembler_->points();
     assembler_->cloud() = PointCloud{};
     ticket_.reset();
-    return_free_memory(points);
     done();
   });
   return std::nullopt;
@@ -97,11 +101,20 @@ bool LabelSession::stop() {
 
 std::optional<ServiceError> LabelSession::outcome() {
   if (job_error_) return job_error_;
-  record_.stages.prefilter = result_.prefilter_seconds;
-  record_.stages.normals = result_.normal_seconds;
-  record_.stages.features = result_.descriptor_seconds;
-  record_.stages.inference = result_.inference_seconds;
-  if (result_.primitives) record_.stages.primitives = result_.primitive_seconds;
+  StageTimes& stages = record_.stages;
+  stages.prefilter = seconds_between(scan_complete_, job_start_) + result_.prefilter_seconds;
+  // The neighbour index and shared search go to the first stage that searches: the normals, or
+  // the features when the client sent its own normals (normals then stay 0).
+  const double search = result_.index_seconds + result_.lists_seconds;
+  const bool own_normals = plan_.options.use_cloud_normals;
+  stages.normals = result_.normal_seconds + (own_normals ? 0.0 : search);
+  stages.features = result_.descriptor_seconds + (own_normals ? search : 0.0);
+  const double primitives = result_.primitives ? result_.primitive_seconds : 0.0;
+  if (result_.primitives) stages.primitives = primitives;
+  // The rest of the job: graph, BP, duplicates and the fan-out (never below 0 by rounding).
+  stages.inference =
+      std::max(0.0, seconds_between(job_start_, job_end_) - result_.prefilter_seconds -
+                        stages.normals - stages.features - primitives);
   return std::nullopt;
 }
 

@@ -38,8 +38,14 @@ class LabelSession {
   std::optional<ServiceError> run(std::function<void()> done);
   // Requests the job's stop at once; true when no worker had started it (`done` never runs).
   bool stop();
-  // After `done`: the job's error, or nothing and the stage times are in the record.
+  // After `done`: the job's error, or nothing and the stage times are in the record, each
+  // stage up to `send` (which the caller times from job_ended()) covering the call without gaps:
+  // prefilter from the complete scan (the wait for a worker included) to the description,
+  // normals with the neighbour index and shared search (features when
+  // the client sent normals), inference with the graph, BP and the
+  // fan-out to every point.
   std::optional<ServiceError> outcome();
+  std::chrono::steady_clock::time_point job_ended() const { return job_end_; }
 
   const v1::ScanHeader& header() const { return header_; }
   const LabelPlan& plan() const { return plan_; }
@@ -54,6 +60,7 @@ class LabelSession {
  private:
   const ServiceEnvironment& env_;
   RequestGauge* const requests_;  // copied: the session may outlive the environment's owner
+  IdleMemoryTrimmer* const trimmer_;
   RequestRecord& record_;
   v1::ScanHeader header_;
   LabelPlan plan_;
@@ -61,7 +68,7 @@ class LabelSession {
   std::optional<SlotBudget::Slot> receiving_;
   std::optional<Admission::Ticket> ticket_;  // given back by the worker when the job ends
   bool counted_ = false;
-  std::chrono::steady_clock::time_point receive_start_;
+  std::chrono::steady_clock::time_point receive_start_, scan_complete_, job_start_, job_end_;
   std::stop_source stop_;
   std::shared_ptr<Admission::Job> job_;
   std::optional<ServiceError> job_error_;  // written by the worker before `done`

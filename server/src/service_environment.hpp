@@ -1,12 +1,14 @@
 #pragma once
 // What the RPC handlers share: configuration, the model registry, admission (compute slots),
-// the receiving-stream budget, the request gauge, the timer thread, metrics, auth and whether
+// the receiving-stream budget, the request gauge, the timer thread and the idle memory trim,
+// metrics, auth and whether
 // the server is draining. Owned by LabelServer, which outlives every handler.
 
 #include <atomic>
 
 #include "admission.hpp"
 #include "auth.hpp"
+#include "free_memory.hpp"
 #include "model_registry.hpp"
 #include "request_gauge.hpp"
 #include "server_config.hpp"
@@ -23,6 +25,7 @@ struct ServiceEnvironment {
   SlotBudget* receiving = nullptr;
   RequestGauge* requests = nullptr;
   TimerService* timers = nullptr;
+  IdleMemoryTrimmer* trimmer = nullptr;
   ServerMetrics* metrics = nullptr;
   const TokenAuth* auth = nullptr;
   const std::atomic<bool>* draining = nullptr;
