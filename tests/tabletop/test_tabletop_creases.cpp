@@ -178,7 +178,7 @@ TEST(TabletopCreaseSplit, SameResultForAnyThreadCount) {
 TEST(TabletopCreaseSplit, BadOptionsAreRejected) {
   ConvexitySplitOptions options;
   options.patch_size = 0.0f;
-  EXPECT_THROW(split_at_concave_creases({}, Vec3f::Zero(), {}, options), std::invalid_argument);
+  EXPECT_THROW(split_at_concave_creases(PointCloud{}, {}, options), std::invalid_argument);
   options = {};
   options.concavity_tolerance_deg = 90.0f;
   EXPECT_THROW(options.validate(), std::invalid_argument);

@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -32,6 +35,8 @@ struct Patch {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // zero when undefined
   bool has_normal = false;
+  Eigen::Vector2d chroma_sum = Eigen::Vector2d::Zero();  // (r, g) / (r + g + b) of lit points
+  std::size_t chroma_count = 0;
 };
 
 // Sums of points and their outer products, relative to an origin, for a least-squares plane.
@@ -60,9 +65,11 @@ double singular_angle_limit(double beta_deg) {
 
 class CreaseSplitter {
  public:
-  CreaseSplitter(const std::vector<Vec3f>& points, const Vec3f& viewpoint,
-                 const ConvexitySplitOptions& options)
-      : points_(points), viewpoint_(viewpoint.cast<double>()), options_(options) {}
+  CreaseSplitter(const PointCloud& cloud, const ConvexitySplitOptions& options)
+      : points_(cloud.xyz),
+        rgba_(cloud.rgba),
+        viewpoint_(cloud.viewpoint.origin.cast<double>()),
+        options_(options) {}
 
   std::vector<std::vector<std::uint32_t>> split(const std::vector<std::uint32_t>& cluster) {
     if (cluster.size() < 2 * options_.min_segment_points) return {cluster};
@@ -89,6 +96,8 @@ class CreaseSplitter {
       if (a != b) ++contact[{std::min(a, b), std::max(a, b)}];
     }
     join_small_segments(segments, size, contact);
+    join_isolated_segments(segments, size);
+    keep_only_creases(segments, neighbours);
 
     std::map<std::uint32_t, std::vector<std::uint32_t>> pieces;
     for (std::uint32_t i = 0; i < n; ++i) {
@@ -131,6 +140,14 @@ class CreaseSplitter {
       }
       const std::uint32_t i = cluster[local];
       patches_.back().members.push_back(i);
+      if (!rgba_.empty()) {
+        const std::uint32_t c = rgba_[i];
+        const double r = (c >> 16) & 0xFF, g = (c >> 8) & 0xFF, b = c & 0xFF;
+        if (r + g + b >= 60.0) {  // darker pixels do not tell a material
+          patches_.back().chroma_sum += Eigen::Vector2d(r, g) / (r + g + b);
+          ++patches_.back().chroma_count;
+        }
+      }
       const Eigen::Vector3d p = points_[i].cast<double>() - origin_;
       Moments& m = moments.back();
       ++m.count;
@@ -167,6 +184,18 @@ class CreaseSplitter {
           const auto it = index_.find(key_of(p.x + dx, p.y + dy, p.z + dz));
           if (it != index_.end()) f(it->second);
         }
+  }
+
+  // A concave fold between a and b: both have normals, they bend toward each other and their
+  // normals are at least the tolerance apart. Returns the angle between the normals (deg), or a
+  // negative value when the connection is not such a fold.
+  double fold_angle(const Patch& a, const Patch& b) const {
+    if (!a.has_normal || !b.has_normal) return -1.0;
+    const double beta_deg = std::acos(std::clamp(a.normal.dot(b.normal), -1.0, 1.0)) / kDegree;
+    const Eigen::Vector3d d = (a.centroid - b.centroid).normalized();
+    if (beta_deg < options_.concavity_tolerance_deg || a.normal.dot(d) - b.normal.dot(d) > 0.0)
+      return -1.0;
+    return beta_deg;
   }
 
   bool convex(const Patch& a, const Patch& b) const {
@@ -232,7 +261,102 @@ class CreaseSplitter {
     }
   }
 
+  // A small segment touching no other patch (within the clustering tolerance, but not in a
+  // neighbouring voxel) joins the segment of the nearest patch centroid.
+  void join_isolated_segments(DisjointSets& segments, std::vector<std::size_t>& size) {
+    const std::uint32_t n = static_cast<std::uint32_t>(patches_.size());
+    for (;;) {
+      std::uint32_t small = UINT32_MAX;
+      std::size_t segment_count = 0;
+      for (std::uint32_t i = 0; i < n; ++i) {
+        if (segments.find(i) != i) continue;
+        ++segment_count;
+        if (size[i] < options_.min_segment_points &&
+            (small == UINT32_MAX || size[i] < size[small]))
+          small = i;
+      }
+      if (small == UINT32_MAX || segment_count < 2) return;
+      std::uint32_t nearest = UINT32_MAX;
+      double best = std::numeric_limits<double>::infinity();
+      for (std::uint32_t i = 0; i < n; ++i) {
+        if (segments.find(i) != small) continue;
+        for (std::uint32_t j = 0; j < n; ++j) {
+          if (segments.find(j) == small) continue;
+          const double d = (patches_[i].centroid - patches_[j].centroid).squaredNorm();
+          if (d < best) {
+            best = d;
+            nearest = j;
+          }
+        }
+      }
+      const std::uint32_t other = segments.find(nearest);
+      const std::size_t joined = size[small] + size[other];
+      segments.join(small, other);
+      size[segments.find(small)] = joined;
+    }
+  }
+
+  // A cut between two segments stands only where they meet at a crease: most of their patch
+  // connections are concave folds, and the fold is sharp (the faces of two objects) or the
+  // segments differ in colour. A container's inside against its floor or its outer wall folds
+  // gently or not at all, in one material. Rejected cuts are joined, the longest first.
+  void keep_only_creases(DisjointSets& segments,
+                         const std::vector<std::pair<std::uint32_t, std::uint32_t>>& neighbours) {
+    for (;;) {
+      struct Boundary {
+        std::size_t connections = 0, folds = 0;
+        double fold_sum = 0.0;
+      };
+      std::map<std::pair<std::uint32_t, std::uint32_t>, Boundary> boundaries;
+      for (const auto& [i, j] : neighbours) {
+        const std::uint32_t a = segments.find(i), b = segments.find(j);
+        if (a == b) continue;
+        Boundary& boundary = boundaries[{std::min(a, b), std::max(a, b)}];
+        ++boundary.connections;
+        const double fold = fold_angle(patches_[i], patches_[j]);
+        if (fold >= 0.0) {
+          ++boundary.folds;
+          boundary.fold_sum += fold;
+        }
+      }
+      if (boundaries.empty()) return;
+      std::map<std::uint32_t, std::pair<Eigen::Vector2d, std::size_t>> colour;
+      for (std::uint32_t i = 0; i < patches_.size(); ++i) {
+        auto& c = colour.try_emplace(segments.find(i), Eigen::Vector2d::Zero(), 0).first->second;
+        c.first += patches_[i].chroma_sum;
+        c.second += patches_[i].chroma_count;
+      }
+      const auto colour_difference = [&](std::uint32_t a, std::uint32_t b) {
+        const auto& ca = colour[a];
+        const auto& cb = colour[b];
+        if (ca.second == 0 || cb.second == 0) return 0.0;
+        return (ca.first / double(ca.second) - cb.first / double(cb.second)).norm();
+      };
+      std::pair<std::uint32_t, std::uint32_t> rejected{UINT32_MAX, UINT32_MAX};
+      std::size_t rejected_length = 0;
+      for (const auto& [pair, boundary] : boundaries) {
+        const double fold_share = double(boundary.folds) / double(boundary.connections);
+        const double mean_fold = boundary.folds ? boundary.fold_sum / double(boundary.folds) : 0.0;
+        const double colour_gap = colour_difference(pair.first, pair.second);
+        if (std::getenv("PRIMLABEL_CREASE_DEBUG"))
+          std::fprintf(stderr, "boundary %u-%u conn %zu share %.2f fold %.1f colour %.3f\n",
+                       pair.first, pair.second, boundary.connections, fold_share, mean_fold,
+                       colour_gap);
+        const bool crease = fold_share >= options_.min_fold_share &&
+                            (mean_fold >= options_.sharp_fold_deg ||
+                             colour_gap > options_.min_chromaticity_difference);
+        if (!crease && boundary.connections > rejected_length) {
+          rejected = pair;
+          rejected_length = boundary.connections;
+        }
+      }
+      if (rejected_length == 0) return;
+      segments.join(rejected.first, rejected.second);
+    }
+  }
+
   const std::vector<Vec3f>& points_;
+  const std::vector<std::uint32_t>& rgba_;
   Eigen::Vector3d viewpoint_;
   const ConvexitySplitOptions& options_;
   Eigen::Vector3d origin_;
@@ -243,14 +367,14 @@ class CreaseSplitter {
 }  // namespace
 
 std::vector<std::vector<std::uint32_t>> split_at_concave_creases(
-    const std::vector<Vec3f>& points, const Vec3f& viewpoint,
-    std::vector<std::vector<std::uint32_t>> clusters, const ConvexitySplitOptions& options) {
+    const PointCloud& cloud, std::vector<std::vector<std::uint32_t>> clusters,
+    const ConvexitySplitOptions& options) {
   options.validate();
   std::vector<std::vector<std::uint32_t>> out;
   if (!options.enabled) {
     out = std::move(clusters);
   } else {
-    CreaseSplitter splitter(points, viewpoint, options);
+    CreaseSplitter splitter(cloud, options);
     for (const auto& cluster : clusters) {
       if (cluster.empty()) continue;
       for (auto& piece : splitter.split(cluster)) out.push_back(std::move(piece));

@@ -28,15 +28,20 @@ struct ConvexitySplitOptions {
   float concavity_tolerance_deg = 10.0f;  // concave folds flatter than this are smooth
   bool sanity_check = true;               // reject step-like "convex" connections
   std::size_t min_segment_points = 400;   // both sides of a cut hold at least this many points
+  // A cut stands where most of the boundary's connections are concave folds (min_fold_share)
+  // and the fold is sharp (mean angle between the normals across it) or the colours differ.
+  float min_fold_share = 0.5f;
+  float sharp_fold_deg = 45.0f;
+  float min_chromaticity_difference = 0.05f;
 
   void validate() const;  // throws std::invalid_argument naming the bad option
 };
 
 // Returns the clusters with each cut at its concave creases: input indices ascending within each
 // piece, pieces ordered by size (largest first, ties by first index). `viewpoint` orients the
-// normals.
+// normals (the cloud's VIEWPOINT origin is the sensor); its colour, when it has one, tells materials.
 std::vector<std::vector<std::uint32_t>> split_at_concave_creases(
-    const std::vector<Vec3f>& points, const Vec3f& viewpoint,
-    std::vector<std::vector<std::uint32_t>> clusters, const ConvexitySplitOptions& options);
+    const PointCloud& cloud, std::vector<std::vector<std::uint32_t>> clusters,
+    const ConvexitySplitOptions& options);
 
 }  // namespace primlabel::tabletop
