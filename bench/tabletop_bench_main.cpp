@@ -99,8 +99,7 @@ MethodRun run_ours(const PointCloud& cloud, const TabletopOptions& options,
     result = segment_tabletop(cloud, options, context);
     run.ms = std::min(run.ms, result.timings.total_ms);
   }
-  if (!result.ok())
-    throw std::runtime_error(path + ": " + result.message);
+  if (!result.ok()) throw std::runtime_error(path + ": " + result.message);
   run.found = true;
   if (cloud.has_labels()) run.scores = evaluate_segmentation(cloud, result);
   return run;

@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -56,8 +54,8 @@ std::uint64_t key_of(std::int32_t x, std::int32_t y, std::int32_t z) {
   return bits(z) << 42 | bits(y) << 21 | bits(x);
 }
 
-// LCCP's sanity criterion (extended convexity): the largest angle between d and n_i x n_j at which a
-// connection with normals beta apart is still taken for a step, not a fold.
+// LCCP's sanity criterion (extended convexity): the largest angle between d and n_i x n_j at which
+// a connection with normals beta apart is still taken for a step, not a fold.
 double singular_angle_limit(double beta_deg) {
   constexpr double kMax = 60.0, kOffset = 25.0, kSlope = 0.25;
   return kMax / (1.0 + std::exp(-kSlope * (beta_deg - kOffset)));
@@ -77,7 +75,7 @@ class CreaseSplitter {
     const std::size_t n = patches_.size();
     std::vector<std::pair<std::uint32_t, std::uint32_t>> neighbours;  // (i, j), i < j
     for (std::uint32_t i = 0; i < n; ++i)
-      for_each_neighbour(i, [&](std::uint32_t j) {
+      for_each_neighbour(i, edge_reach_, [&](std::uint32_t j) {
         if (i < j) neighbours.emplace_back(i, j);
       });
 
@@ -159,7 +157,7 @@ class CreaseSplitter {
       std::sort(patch.members.begin(), patch.members.end());
       patch.centroid = moments[i].sum / double(moments[i].count);
       Moments around = moments[i];
-      for_each_neighbour(i, [&](std::uint32_t j) { around.add(moments[j]); });
+      for_each_neighbour(i, normal_reach_, [&](std::uint32_t j) { around.add(moments[j]); });
       if (around.count < 6) continue;
       const Eigen::Vector3d mean = around.sum / double(around.count);
       const Eigen::Matrix3d covariance =
@@ -175,12 +173,13 @@ class CreaseSplitter {
   }
 
   template <typename F>
-  void for_each_neighbour(std::uint32_t i, F&& f) const {
+  void for_each_neighbour(std::uint32_t i, int reach, F&& f) const {
     const Patch& p = patches_[i];
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
-          if (dx == 0 && dy == 0 && dz == 0) continue;
+          const int steps = std::abs(dx) + std::abs(dy) + std::abs(dz);
+          if (steps == 0 || steps > reach) continue;
           const auto it = index_.find(key_of(p.x + dx, p.y + dy, p.z + dz));
           if (it != index_.end()) f(it->second);
         }
@@ -222,8 +221,9 @@ class CreaseSplitter {
 
   // Joins every segment smaller than min_segment_points to the neighbour it touches most
   // (ties: the larger, then the lower root), smallest first; isolated small segments stay.
-  void join_small_segments(DisjointSets& segments, std::vector<std::size_t>& size,
-                           std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t>& contact) {
+  void join_small_segments(
+      DisjointSets& segments, std::vector<std::size_t>& size,
+      std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t>& contact) {
     for (;;) {
       // The smallest segment that has a neighbour and is too small.
       std::uint32_t small = UINT32_MAX;
@@ -271,8 +271,7 @@ class CreaseSplitter {
       for (std::uint32_t i = 0; i < n; ++i) {
         if (segments.find(i) != i) continue;
         ++segment_count;
-        if (size[i] < options_.min_segment_points &&
-            (small == UINT32_MAX || size[i] < size[small]))
+        if (size[i] < options_.min_segment_points && (small == UINT32_MAX || size[i] < size[small]))
           small = i;
       }
       if (small == UINT32_MAX || segment_count < 2) return;
@@ -338,10 +337,6 @@ class CreaseSplitter {
         const double fold_share = double(boundary.folds) / double(boundary.connections);
         const double mean_fold = boundary.folds ? boundary.fold_sum / double(boundary.folds) : 0.0;
         const double colour_gap = colour_difference(pair.first, pair.second);
-        if (std::getenv("PRIMLABEL_CREASE_DEBUG"))
-          std::fprintf(stderr, "boundary %u-%u conn %zu share %.2f fold %.1f colour %.3f\n",
-                       pair.first, pair.second, boundary.connections, fold_share, mean_fold,
-                       colour_gap);
         const bool crease = fold_share >= options_.min_fold_share &&
                             (mean_fold >= options_.sharp_fold_deg ||
                              colour_gap > options_.min_chromaticity_difference);
@@ -355,6 +350,10 @@ class CreaseSplitter {
     }
   }
 
+  // Connections and normals both reach only the 6 face neighbours: across a crease, diagonal
+  // links and normals averaged over 27 patches blend the two faces into a chain of gentle,
+  // seemingly smooth steps that joins the objects again.
+  static constexpr int edge_reach_ = 1, normal_reach_ = 1;
   const std::vector<Vec3f>& points_;
   const std::vector<std::uint32_t>& rgba_;
   Eigen::Vector3d viewpoint_;
