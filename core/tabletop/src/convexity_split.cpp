@@ -370,7 +370,9 @@ std::vector<std::vector<std::uint32_t>> split_at_concave_creases(
     const ConvexitySplitOptions& options) {
   options.validate();
   std::vector<std::vector<std::uint32_t>> out;
-  if (!options.enabled) {
+  // Normals face the sensor only in a single view (an organised scan); a merged or synthetic
+  // cloud may hold surfaces the VIEWPOINT never saw, whose flipped normals would fake creases.
+  if (!options.enabled || !cloud.organized()) {
     out = std::move(clusters);
   } else {
     CreaseSplitter splitter(cloud, options);

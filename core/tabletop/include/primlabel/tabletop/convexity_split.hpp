@@ -40,6 +40,7 @@ struct ConvexitySplitOptions {
   void validate() const;  // throws std::invalid_argument naming the bad option
 };
 
+// Organised clouds only (one view, so normals can face the sensor); others are returned whole.
 // Returns the clusters with each cut at its concave creases: input indices ascending within each
 // piece, pieces ordered by size (largest first, ties by first index). `viewpoint` orients the
 // normals (the cloud's VIEWPOINT origin is the sensor); its colour, when it has one, tells
