@@ -16,10 +16,16 @@
 #include <pcl/segmentation/extract_polygonal_prism_data.h>
 #include <pcl/segmentation/sac_segmentation.h>
 #include <pcl/surface/convex_hull.h>
+#if __has_include(<pcl/segmentation/lccp_segmentation.h>)
+#include <pcl/segmentation/lccp_segmentation.h>
+#include <pcl/segmentation/supervoxel_clustering.h>
+#define PRIMLABEL_PCL_HAS_LCCP 1
+#endif
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 
 namespace primlabel::bench {
 
@@ -27,7 +33,75 @@ using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 std::string pcl_tabletop_version() { return PCL_VERSION_PRETTY; }
 
-PclTabletopResult pcl_tabletop(const PointCloud& input, const PclTabletopOptions& options) {
+bool pcl_has_lccp() {
+#ifdef PRIMLABEL_PCL_HAS_LCCP
+  return true;
+#else
+  return false;
+#endif
+}
+
+namespace {
+
+#ifdef PRIMLABEL_PCL_HAS_LCCP
+// LCCP (Stein et al. 2014) on supervoxels (Papon et al. 2013) of the object points, with the
+// parameters of PCL's LCCP example, except the voxel resolution at the Kinect's spacing at 1 m.
+std::vector<pcl::PointIndices> lccp_clusters(const PointCloud& input, const Cloud& finite,
+                                             const pcl::Indices& to_input,
+                                             const pcl::Indices& objects, int min_size) {
+  using PointT = pcl::PointXYZRGBA;
+  pcl::PointCloud<PointT>::Ptr points(new pcl::PointCloud<PointT>);
+  points->reserve(objects.size());
+  for (pcl::index_t i : objects) {
+    PointT p;
+    p.x = finite[i].x;
+    p.y = finite[i].y;
+    p.z = finite[i].z;
+    const std::uint32_t rgb = input.has_rgba() ? input.rgba[to_input[i]] : 0x808080u;
+    p.r = (rgb >> 16) & 0xFF;
+    p.g = (rgb >> 8) & 0xFF;
+    p.b = rgb & 0xFF;
+    p.a = 255;
+    points->push_back(p);
+  }
+  pcl::SupervoxelClustering<PointT> supervoxels(0.0075f, 0.03f);
+  supervoxels.setUseSingleCameraTransform(true);  // camera-frame Kinect clouds
+  supervoxels.setInputCloud(points);
+  supervoxels.setColorImportance(0.0f);
+  supervoxels.setSpatialImportance(1.0f);
+  supervoxels.setNormalImportance(4.0f);
+  std::map<std::uint32_t, pcl::Supervoxel<PointT>::Ptr> clusters;
+  supervoxels.extract(clusters);
+  std::multimap<std::uint32_t, std::uint32_t> adjacency;
+  supervoxels.getSupervoxelAdjacency(adjacency);
+
+  pcl::LCCPSegmentation<PointT> lccp;
+  lccp.setConcavityToleranceThreshold(10.0f);
+  lccp.setSanityCheck(true);
+  lccp.setSmoothnessCheck(true, 0.0075f, 0.03f, 0.1f);
+  lccp.setKFactor(0);
+  lccp.setInputSupervoxels(clusters, adjacency);
+  lccp.setMinSegmentSize(0);
+  lccp.segment();
+  pcl::PointCloud<pcl::PointXYZL>::Ptr supervoxel_labels = supervoxels.getLabeledCloud();
+  pcl::PointCloud<pcl::PointXYZL>::Ptr labeled = supervoxel_labels->makeShared();
+  lccp.relabelCloud(*labeled);
+
+  // The labeled cloud lists the input points in order; label 0 is "unassigned".
+  std::map<std::uint32_t, pcl::PointIndices> by_label;
+  for (std::size_t k = 0; k < labeled->size() && k < objects.size(); ++k)
+    if ((*labeled)[k].label != 0) by_label[(*labeled)[k].label].indices.push_back(objects[k]);
+  std::vector<pcl::PointIndices> result;
+  for (auto& [label, members] : by_label)
+    if (static_cast<int>(members.indices.size()) >= min_size) result.push_back(std::move(members));
+  return result;
+}
+#endif
+
+enum class Clustering { kEuclidean, kLccp };
+
+PclTabletopResult run_pipeline(const PointCloud& input, const PclTabletopOptions& options,
+                               Clustering clustering) {
   PclTabletopResult result;
   Cloud::Ptr cloud(new Cloud);
   cloud->resize(input.size());
@@ -87,7 +161,11 @@ PclTabletopResult pcl_tabletop(const PointCloud& input, const PclTabletopOptions
   prism.segment(*objects);
 
   std::vector<pcl::PointIndices> clusters;
-  if (!objects->indices.empty()) {
+#ifdef PRIMLABEL_PCL_HAS_LCCP
+  if (clustering == Clustering::kLccp && !objects->indices.empty())
+    clusters = lccp_clusters(input, *finite, to_input, objects->indices, options.min_cluster_size);
+#endif
+  if (clustering == Clustering::kEuclidean && !objects->indices.empty()) {
     pcl::search::KdTree<pcl::PointXYZ>::Ptr tree(new pcl::search::KdTree<pcl::PointXYZ>);
     tree->setInputCloud(finite, std::make_shared<pcl::Indices>(objects->indices));
     pcl::EuclideanClusterExtraction<pcl::PointXYZ> extract;
@@ -111,6 +189,16 @@ PclTabletopResult pcl_tabletop(const PointCloud& input, const PclTabletopOptions
     result.clusters.push_back(std::move(members));
   }
   return result;
+}
+
+}  // namespace
+
+PclTabletopResult pcl_tabletop(const PointCloud& input, const PclTabletopOptions& options) {
+  return run_pipeline(input, options, Clustering::kEuclidean);
+}
+
+PclTabletopResult pcl_lccp(const PointCloud& input, const PclTabletopOptions& options) {
+  return run_pipeline(input, options, Clustering::kLccp);
 }
 
 }  // namespace primlabel::bench

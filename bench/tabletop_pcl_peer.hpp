@@ -1,7 +1,7 @@
 #pragma once
 // PCL's classic table-top pipeline as a peer for primlabel-bench-tabletop: SACSegmentation (MSAC,
 // plane perpendicular to the up axis), ConvexHull of the projected inliers,
-// ExtractPolygonalPrismData and EuclideanClusterExtraction, with the same thresholds as
+// ExtractPolygonalPrismData and EuclideanClusterExtraction (or LCCP), with the same thresholds as
 // primlabel's filter. PCL-free interface; tabletop_pcl_peer.cpp is the only file including PCL.
 
 #include <Eigen/Core>
@@ -36,6 +36,11 @@ struct PclTabletopResult {
 
 // Runs the pipeline on `cloud` (NaN points allowed; they are removed as part of the timing).
 PclTabletopResult pcl_tabletop(const PointCloud& cloud, const PclTabletopOptions& options);
+
+// The same table and prism, but the objects are LCCP segments of supervoxels (Stein et al. 2014,
+// PCL's LCCPSegmentation) instead of Euclidean clusters. Only when pcl_has_lccp().
+PclTabletopResult pcl_lccp(const PointCloud& input, const PclTabletopOptions& options);
+bool pcl_has_lccp();
 
 std::string pcl_tabletop_version();
 

@@ -47,6 +47,7 @@ void TabletopOptions::validate() const {
   if (!std::isfinite(hull_margin)) fail("hull margin must be finite");
   plane.validate();
   clusters.validate();
+  creases.validate();
   split.validate();
   merge.validate();
 }
@@ -259,9 +260,10 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
     result.clusters = euclidean_clusters(xyz, candidates, options.clusters);
   }
   context.throw_if_stopped(kWhat);
-  // 5. Objects as wholes: split stacked objects first, so that the lower object's occluded
-  // parts can still be joined to what remains of it.
+  // 5. Objects as wholes: cut touching objects at their creases and split stacked objects first, so
+  // that the lower object's occluded parts can still be joined to what remains of it.
   const auto refine_start = Clock::now();
+  result.clusters = split_at_concave_creases(cloud, std::move(result.clusters), options.creases);
   result.clusters = split_stacked(xyz, height, plane, std::move(result.clusters), options.split);
   result.clusters =
       merge_occluded(cloud, height, band_grid, std::move(result.clusters), options.merge);

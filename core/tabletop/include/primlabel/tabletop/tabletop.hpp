@@ -3,9 +3,11 @@
 // convex hull bounds the table; the points above the table inside the hull, grouped by Euclidean
 // clustering, are the objects. Only the table and the objects are then labeled.
 //
-// Euclidean clusters are then refined (stacked_split.hpp, occlusion_merge.hpp): objects standing
-// on objects are split at the supporting surface, and parts of one object cut apart by occlusion
-// (a nearer object in front of it, or a container's own wall hiding its missing rim) are joined.
+// Euclidean clusters are then refined (convexity_split.hpp, stacked_split.hpp,
+// occlusion_merge.hpp): touching objects are cut apart at the concave creases where they meet,
+// objects standing on objects are split at the supporting surface, and parts of one object cut
+// apart by occlusion (a nearer object in front of it, or a container's own wall hiding its missing
+// rim) are joined.
 //
 // Data conditions (no valid point, no plane, plane not horizontal) give a TabletopResult with a
 // status and a message; only invalid options throw (std::invalid_argument).
@@ -18,6 +20,7 @@
 
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/run_context.hpp"
+#include "primlabel/tabletop/convexity_split.hpp"
 #include "primlabel/tabletop/euclidean_clusters.hpp"
 #include "primlabel/tabletop/occlusion_merge.hpp"
 #include "primlabel/tabletop/plane_fit.hpp"
@@ -61,8 +64,9 @@ struct TabletopOptions {
   float max_object_height = 0.5f;
   float hull_margin = 0.0f;  // grow (> 0) or shrink (< 0) the table hull (m)
   ClusterOptions clusters{0.02f, 100, 200000};
-  StackSplitOptions split;      // objects standing on objects
-  OcclusionMergeOptions merge;  // parts of one object cut apart by occlusion (organised clouds)
+  ConvexitySplitOptions creases;  // touching objects, cut at concave creases
+  StackSplitOptions split;        // objects standing on objects
+  OcclusionMergeOptions merge;    // parts of one object cut apart by occlusion (organised clouds)
 
   std::uint64_t seed = 1;  // RANSAC seed (copied into plane.seed)
 
