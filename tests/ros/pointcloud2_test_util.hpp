@@ -6,11 +6,11 @@
 #include <sensor_msgs/PointCloud2.h>
 
 #include <algorithm>
-#include <bit>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 
+#include "byte_order.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 
 namespace primlabel::rostest {
@@ -24,9 +24,14 @@ struct MessageLayout {
   std::uint32_t row_padding = 0;  // bytes after each row (row_step > width * point_step)
 };
 
-inline bool swapped(const PointCloud2& m) {
-  return (m.is_bigendian != 0) != (std::endian::native == std::endian::big);
+// (C++17 here, as the ROS headers need: no designated initializers.)
+inline MessageLayout layout_of(bool float64, bool big_endian, std::uint32_t row_padding) {
+  MessageLayout layout;
+  layout.float64 = float64, layout.big_endian = big_endian, layout.row_padding = row_padding;
+  return layout;
 }
+
+inline bool swapped(const PointCloud2& m) { return rosnode::needs_swap(m.is_bigendian); }
 
 template <class T>
 void put(std::uint8_t* at, T value, bool swap) {

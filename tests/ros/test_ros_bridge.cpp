@@ -49,17 +49,17 @@ void expect_same_points(const PointCloud& read, const PointCloud& sent) {
 
 TEST(PointCloud2Xyz, ReadsFloat32WithPointAndRowPadding) {
   const PointCloud cloud = organised_cloud();
-  const PointCloud2 m = to_pointcloud2(cloud, {.row_padding = 12});
+  const PointCloud2 m = to_pointcloud2(cloud, layout_of(false, false, 12));
   ASSERT_GT(m.row_step, m.width * m.point_step);
   expect_same_points(xyz_from_pointcloud2(m), cloud);
 }
 
 TEST(PointCloud2Xyz, ReadsFloat64AndBigEndian) {
   const PointCloud cloud = organised_cloud();
-  expect_same_points(xyz_from_pointcloud2(to_pointcloud2(cloud, {.float64 = true})), cloud);
-  expect_same_points(xyz_from_pointcloud2(to_pointcloud2(cloud, {.big_endian = true})), cloud);
+  expect_same_points(xyz_from_pointcloud2(to_pointcloud2(cloud, layout_of(true, false, 0))), cloud);
+  expect_same_points(xyz_from_pointcloud2(to_pointcloud2(cloud, layout_of(false, true, 0))), cloud);
   expect_same_points(xyz_from_pointcloud2(to_pointcloud2(
-                         cloud, {.float64 = true, .big_endian = true, .row_padding = 3})),
+                         cloud, layout_of(true, true, 3))),
                      cloud);
 }
 
@@ -143,11 +143,11 @@ void expect_layout_kept(const PointCloud2& in, const PointCloud2& out) {
 }
 
 TEST(LabeledPointCloud2, KeepsTheInputLayoutAndAppendsLabelConfidenceAndProbabilities) {
-  for (const MessageLayout layout : {MessageLayout{}, MessageLayout{.big_endian = true},
-                                     MessageLayout{.float64 = true, .row_padding = 7}}) {
+  for (const MessageLayout& layout :
+       {MessageLayout{}, layout_of(false, true, 0), layout_of(true, false, 7)}) {
     const PointCloud2 in = to_pointcloud2(organised_cloud(), layout);
     const client::LabelResult r = result_for(6);
-    const PointCloud2 out = labeled_pointcloud2(in, r, {.confidence = true, .probabilities = true});
+    const PointCloud2 out = labeled_pointcloud2(in, r, rosnode::LabeledFields{true, true});
     expect_layout_kept(in, out);
     const PointField& label = field_named(out, "label");
     EXPECT_EQ(label.datatype, PointField::UINT32);
@@ -189,7 +189,7 @@ TEST(LabeledPointCloud2, RefusesAResultOfAnotherSize) {
   EXPECT_THROW(labeled_pointcloud2(in, result_for(5), {}), std::invalid_argument);
   client::LabelResult no_probabilities = result_for(6);
   no_probabilities.probabilities.clear();
-  EXPECT_THROW(labeled_pointcloud2(in, no_probabilities, {.confidence = true}),
+  EXPECT_THROW(labeled_pointcloud2(in, no_probabilities, rosnode::LabeledFields{true, false}),
                std::invalid_argument);
 }
 

@@ -19,9 +19,8 @@
 
 #include "pointcloud2_test_util.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
-#include "primlabel/model/label_model.hpp"
 #include "process.hpp"
-#include "random_label_model.hpp"
+#include "random_model_file.hpp"
 #include "test_util.hpp"
 
 namespace primlabel::rostest {
@@ -97,7 +96,7 @@ class RosNode : public ::testing::Test {
     if (!fs::exists(test::binary("primlabel-server")) || !fs::exists(PRIMLABEL_ROSMASTER)) return;
     dir_ = new test::TempDir();
     fs::create_directories(dir_->file("models/random/1"));
-    save_model(dir_->file("models/random/1/model.plm"), testing::random_label_model("random"));
+    write_random_label_model(dir_->file("models/random/1/model.plm"), "random");
     fs::create_directories(dir_->file("ros"));
     setenv("ROS_HOME", dir_->file("ros").c_str(), 1);
     setenv("ROS_LOG_DIR", dir_->file("ros/log").c_str(), 1);
@@ -258,12 +257,12 @@ TEST_F(RosNode, LabelsPointCloud2LikeTheCli) {
   if (fs::exists(test::shared_data("mosd/learn0.pcd")))
     cases.push_back({file("mosd_crop.pcd"),
                      mosd_crop(file("mosd_crop.pcd")),
-                     {.row_padding = 16},
+                     layout_of(false, false, 16),
                      "camera_depth_optical_frame"});
   ASSERT_TRUE(fs::exists(test::shared_data("pcl/bun0.pcd")));
   cases.push_back({test::shared_data("pcl/bun0.pcd"),
                    read_cloud(test::shared_data("pcl/bun0.pcd")),
-                   {.float64 = true},
+                   layout_of(true, false, 0),
                    "bunny"});
   std::uint32_t seconds = 1'700'000'000;
   for (const Case& c : cases) {

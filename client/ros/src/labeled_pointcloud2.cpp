@@ -1,12 +1,12 @@
 #include "labeled_pointcloud2.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cctype>
 #include <cstring>
 #include <stdexcept>
 #include <vector>
 
+#include "byte_order.hpp"
 #include "pointcloud2_xyz.hpp"
 
 namespace primlabel::rosnode {
@@ -97,7 +97,7 @@ PointCloud2 labeled_pointcloud2(const PointCloud2& input, const client::LabelRes
   out.data.assign(std::size_t(out.row_step) * out.height, 0);
 
   // Labels are written in the cloud's own byte order, as its copied fields are.
-  const bool swap = (input.is_bigendian != 0) != (std::endian::native == std::endian::big);
+  const bool swap = needs_swap(input.is_bigendian);
   std::size_t i = 0;
   for (std::uint32_t row = 0; row < input.height; ++row) {
     const std::uint8_t* from = input.data.data() + std::size_t(row) * input.row_step;

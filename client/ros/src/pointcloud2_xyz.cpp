@@ -1,10 +1,11 @@
 #include "pointcloud2_xyz.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cstring>
 #include <stdexcept>
 #include <string>
+
+#include "byte_order.hpp"
 
 namespace primlabel::rosnode {
 
@@ -57,7 +58,7 @@ XyzLayout xyz_layout(const PointCloud2& cloud) {
   layout.x = coordinate_field(cloud, "x");
   layout.y = coordinate_field(cloud, "y");
   layout.z = coordinate_field(cloud, "z");
-  layout.swap_bytes = (cloud.is_bigendian != 0) != (std::endian::native == std::endian::big);
+  layout.swap_bytes = needs_swap(cloud.is_bigendian);
   // 64-bit arithmetic: width * point_step fits; (height - 1) * row_step is checked by division.
   const std::uint64_t row_bytes = std::uint64_t(cloud.width) * cloud.point_step;
   if (cloud.row_step < row_bytes)
