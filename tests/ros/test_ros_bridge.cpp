@@ -58,9 +58,7 @@ TEST(PointCloud2Xyz, ReadsFloat64AndBigEndian) {
   const PointCloud cloud = organised_cloud();
   expect_same_points(xyz_from_pointcloud2(to_pointcloud2(cloud, layout_of(true, false, 0))), cloud);
   expect_same_points(xyz_from_pointcloud2(to_pointcloud2(cloud, layout_of(false, true, 0))), cloud);
-  expect_same_points(xyz_from_pointcloud2(to_pointcloud2(
-                         cloud, layout_of(true, true, 3))),
-                     cloud);
+  expect_same_points(xyz_from_pointcloud2(to_pointcloud2(cloud, layout_of(true, true, 3))), cloud);
 }
 
 TEST(PointCloud2Xyz, ReadsFieldsInAnyOrderAndOffset) {
@@ -115,7 +113,7 @@ client::LabelResult result_for(std::size_t points) {
   r.class_names = {"plane", "edge/corner"};
   for (std::size_t i = 0; i < points; ++i) {
     r.labels.push_back(i % 3 == 2 ? 0 : (i % 2 ? 4 : 1));
-    const float p = 0.1f * float(i);
+    const float p = i == 2 ? kNaN : 0.1f * float(i);  // point 2 has no descriptor
     r.probabilities.insert(r.probabilities.end(), {p, 1.0f - p});
   }
   r.summary.set_frame_id("camera_depth_optical_frame");
@@ -158,6 +156,11 @@ TEST(LabeledPointCloud2, KeepsTheInputLayoutAndAppendsLabelConfidenceAndProbabil
     ASSERT_TRUE(has_field(out, "prob_edge_corner"));
     for (std::size_t i = 0; i < 6; ++i) {
       EXPECT_EQ(value_of<std::uint32_t>(out, i, "label"), r.labels[i]);
+      if (i == 2) {  // no probabilities: NaN, and NaN confidence
+        EXPECT_TRUE(std::isnan(value_of<float>(out, i, "prob_plane")));
+        EXPECT_TRUE(std::isnan(value_of<float>(out, i, "confidence")));
+        continue;
+      }
       EXPECT_EQ(value_of<float>(out, i, "prob_plane"), r.probabilities[2 * i]);
       EXPECT_EQ(value_of<float>(out, i, "prob_edge_corner"), r.probabilities[2 * i + 1]);
       EXPECT_EQ(value_of<float>(out, i, "confidence"),

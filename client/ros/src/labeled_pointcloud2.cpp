@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -37,6 +39,14 @@ void write_word(std::uint8_t* at, T value, bool swap) {
   std::memcpy(bytes, &value, 4);
   if (swap) std::reverse(bytes, bytes + 4);
   std::memcpy(at, bytes, 4);
+}
+
+// The highest of a point's probabilities; NaN for a point without any (no descriptor).
+float highest(const float* probabilities, std::size_t classes) {
+  float best = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t k = 0; k < classes; ++k)
+    if (!std::isnan(probabilities[k]) && !(probabilities[k] <= best)) best = probabilities[k];
+  return best;
 }
 
 }  // namespace
@@ -111,7 +121,7 @@ PointCloud2 labeled_pointcloud2(const PointCloud2& input, const client::LabelRes
       if (!with_probabilities) continue;
       const float* p = result.probabilities.data() + i * classes;
       if (fields.confidence) {
-        write_word(extra, classes ? *std::max_element(p, p + classes) : 0.0f, swap);
+        write_word(extra, highest(p, classes), swap);
         extra += 4;
       }
       if (fields.probabilities)

@@ -13,7 +13,7 @@
 namespace primlabel::rosnode {
 
 struct LabeledFields {
-  bool confidence = false;     // float32 `confidence`: the point's highest class probability
+  bool confidence = false;     // float32 `confidence`: the highest class probability (or NaN)
   bool probabilities = false;  // float32 `prob_<class>` per class, in the summary's class order
 };
 
