@@ -37,10 +37,12 @@ PACKAGES=(
 # Only the tests need these: the deployment checks (YAML, nginx -t, promtool, the local
 # three-replica proof), TLS certificates made on the fly, clang with libFuzzer for the fuzz
 # targets (tests/fuzz), the Python client's runtime and pytest (client/python; its stubs come
-# from protoc and protobuf-compiler-grpc's grpc_python_plugin, above), and Open3D for the
-# interoperability check (tests/interop).
+# from protoc and protobuf-compiler-grpc's grpc_python_plugin, above), Open3D for the
+# interoperability check (tests/interop), and ROS 1 (roscpp, sensor_msgs, std_msgs and rosmaster)
+# for the ROS node client/ros and its test ros.LabelsPointCloud2.
 TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl clang-14 libclang-rt-14-dev
-  python3-grpcio python3-numpy python3-protobuf python3-pytest python3-open3d)
+  python3-grpcio python3-numpy python3-protobuf python3-pytest python3-open3d
+  libroscpp-dev libsensor-msgs-dev libstd-msgs-dev python3-rosmaster)
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev)
 [[ "${1:-}" == test ]] && PACKAGES+=("${TEST_PACKAGES[@]}")
 

@@ -28,6 +28,8 @@ v1::LabelRequest header_request(const PointCloud& cloud, const LabelOptions& o) 
   header.set_model(o.model);
   header.set_model_version(o.model_version);
   header.set_scan_id(o.scan_id);
+  header.set_frame_id(o.frame_id);
+  header.set_stamp_ns(o.stamp_ns);
   const Vec3f viewpoint = o.viewpoint.value_or(cloud.viewpoint.origin);
   header.mutable_viewpoint()->set_x(viewpoint.x());
   header.mutable_viewpoint()->set_y(viewpoint.y());

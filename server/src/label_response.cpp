@@ -76,6 +76,8 @@ void fill_summary(const RequestRecord& record, const ModelEntry& entry,
                   const pipeline::LabelingResult& result, v1::LabelSummary& summary) {
   summary.set_request_id(record.id());
   summary.set_scan_id(record.scan_id);
+  summary.set_frame_id(record.frame_id);
+  summary.set_stamp_ns(record.stamp_ns);
   summary.set_model(entry.name);
   summary.set_model_version(entry.version);
   summary.set_points_received(record.points);

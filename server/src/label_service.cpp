@@ -44,6 +44,8 @@ std::optional<ServiceError> LabelSession::start(const v1::ScanHeader& header, bo
   receive_start_ = std::chrono::steady_clock::now();
   header_ = header;
   record_.scan_id = header.scan_id();
+  record_.frame_id = header.frame_id();
+  record_.stamp_ns = header.stamp_ns();
   record_.model = header.model();
   const ScanLimits limits = limits_of(*env_.config);
   if (auto invalid = check_header(header, limits)) return invalid;

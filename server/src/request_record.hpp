@@ -25,6 +25,9 @@ class RequestRecord {
   // As the client sent them until the model is resolved; capped (user_text) where they are
   // logged or counted.
   std::string scan_id, model, version;
+  // The scan's frame and stamp, echoed in the summary.
+  std::string frame_id;
+  std::uint64_t stamp_ns = 0;
   // Set once `model` names a loaded model: only then is it a metric label, so clients that send
   // made-up names cannot grow the metrics without bound (they count as model="").
   bool model_resolved = false;

@@ -136,8 +136,13 @@ TEST_F(ClientE2e, StreamedInSmallChunksAndUnaryGiveTheSameLabels) {
   small.chunk_points = 777;
   small.response_chunk_points = 500;
   small.probabilities = true;
+  small.frame_id = "map";
+  small.stamp_ns = 123'456'789'012ull;
   const auto streamed = client.label(cloud, small);
   const auto unary = client.label_unary(cloud);
+  EXPECT_EQ(streamed.frame_id(), "map");  // echoed by the server
+  EXPECT_EQ(streamed.stamp_ns(), 123'456'789'012ull);
+  EXPECT_EQ(unary.frame_id(), "");
   ASSERT_EQ(streamed.size(), cloud.size());
   EXPECT_EQ(streamed.labels, unary.labels);
   EXPECT_EQ(streamed.summary.points_received(), cloud.size());

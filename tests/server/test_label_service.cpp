@@ -39,6 +39,32 @@ TEST(LabelService, StreamedLabelsMatchLabelCloudInProcess) {
                                               "inference", "send"}));
 }
 
+// ScanHeader.frame_id and stamp_ns come back in the summary, streamed and unary, and stay empty
+// when not sent (a ROS node puts its header's frame and stamp on the labeled cloud from them).
+TEST(LabelService, TheSummaryEchoesFrameIdAndStamp) {
+  const LabelModel model = random_label_model("tabletop", "1");
+  TestServer server({model});
+  const PointCloud cloud = table_with_box_cloud(0.02f);
+  v1::ScanHeader header = header_for("tabletop");
+  header.set_frame_id("camera_depth_optical_frame");
+  header.set_stamp_ns(1'700'000'000'123'456'789ull);
+  const LabelAnswer streamed = label_stream(*server.stub, scan_requests(cloud, header, 1000));
+  ASSERT_TRUE(streamed.status.ok()) << streamed.status.error_message();
+  EXPECT_EQ(streamed.summary->frame_id(), "camera_depth_optical_frame");
+  EXPECT_EQ(streamed.summary->stamp_ns(), 1'700'000'000'123'456'789ull);
+  header.set_frame_id("base_laser");
+  header.set_stamp_ns(42);
+  const LabelAnswer unary = label_cloud(*server.stub, cloud, header);
+  ASSERT_TRUE(unary.status.ok()) << unary.status.error_message();
+  EXPECT_EQ(unary.summary->frame_id(), "base_laser");
+  EXPECT_EQ(unary.summary->stamp_ns(), 42u);
+  const LabelAnswer plain =
+      label_stream(*server.stub, scan_requests(cloud, header_for("tabletop"), 1000));
+  ASSERT_TRUE(plain.status.ok()) << plain.status.error_message();
+  EXPECT_EQ(plain.summary->frame_id(), "");
+  EXPECT_EQ(plain.summary->stamp_ns(), 0u);
+}
+
 // The summary carries the cloud's point spacing, and a warning when the model was trained for a
 // spacing far from it (here: recorded as 10x finer than the 1 cm table grid).
 TEST(LabelService, TheSummaryWarnsOfACloudOutsideTheModelsSpacing) {

@@ -71,6 +71,11 @@ struct LabelOptions {
   std::size_t chunk_points = 65'536;  // points per streamed request message
   std::uint32_t response_chunk_points = 0;            // 0 = the server's default
   std::optional<std::chrono::milliseconds> deadline;  // default: ClientOptions::deadline
+
+  // Where and when the scan was taken (e.g. a ROS header's frame_id and stamp), echoed in the
+  // summary (LabelResult::frame_id(), stamp_ns()).
+  std::string frame_id;
+  std::uint64_t stamp_ns = 0;  // nanoseconds since the epoch; 0 = none
 };
 
 // The labels of one cloud, in the order of its points.
@@ -87,6 +92,9 @@ struct LabelResult {
   int attempts = 1;  // calls made, including retries
 
   std::size_t size() const { return labels.size(); }
+  // LabelOptions::frame_id and stamp_ns as the server echoed them.
+  const std::string& frame_id() const { return summary.frame_id(); }
+  std::uint64_t stamp_ns() const { return summary.stamp_ns(); }
   // The fitted instances (with LabelOptions::primitives), primitives()[s] for segment id s.
   const google::protobuf::RepeatedPtrField<v1::Primitive>& primitives() const {
     return summary.primitives();

@@ -1,0 +1,109 @@
+#include "node_parameters.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <type_traits>
+
+#include "common/server_address.hpp"
+
+namespace primlabel::rosnode {
+
+namespace {
+
+template <class T>
+constexpr const char* type_name() {
+  if constexpr (std::is_same_v<T, std::string>) return "a string";
+  if constexpr (std::is_same_v<T, bool>) return "a boolean";
+  if constexpr (std::is_same_v<T, int>) return "an integer";
+  return "a number";
+}
+
+// `value` from ~key when that is set; a value of another type is an error, not the default.
+template <class T>
+void read(const ros::NodeHandle& node, const std::string& key, T& value) {
+  if (!node.hasParam(key)) return;
+  if (!node.getParam(key, value))
+    throw std::invalid_argument("~" + key + " must be " + type_name<T>());
+}
+
+std::string trimmed(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) return {};
+  return text.substr(first, text.find_last_not_of(" \t\r\n") - first + 1);
+}
+
+}  // namespace
+
+NodeParameters read_parameters(const ros::NodeHandle& node) {
+  NodeParameters p;
+  read(node, "server", p.server);
+  read(node, "token", p.token);
+  read(node, "token_file", p.token_file);
+  read(node, "tls", p.tls);
+  read(node, "tls_ca", p.tls_ca);
+  read(node, "tls_cert", p.tls_cert);
+  read(node, "tls_key", p.tls_key);
+  read(node, "tls_server_name", p.tls_server_name);
+  read(node, "deadline", p.deadline);
+  read(node, "retries", p.retries);
+  read(node, "model", p.model);
+  read(node, "model_version", p.model_version);
+  read(node, "voxel_size", p.voxel_size);
+  read(node, "tabletop_only", p.tabletop_only);
+  read(node, "confidence", p.confidence);
+  read(node, "probabilities", p.probabilities);
+  read(node, "input_topic", p.input_topic);
+  read(node, "output_topic", p.output_topic);
+  read(node, "summary_topic", p.summary_topic);
+
+  try {
+    p.server = client::tools::server_address_with_port(p.server);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument("~server: " + std::string(e.what()));
+  }
+  if (!std::isfinite(p.voxel_size) || p.voxel_size < 0)
+    throw std::invalid_argument("~voxel_size must be a finite number >= 0 (metres)");
+  if (!std::isfinite(p.deadline) || p.deadline <= 0)
+    throw std::invalid_argument("~deadline must be a finite number of seconds > 0");
+  if (p.retries < 1) throw std::invalid_argument("~retries must be >= 1 (attempts in all)");
+  if (p.input_topic.empty() || p.output_topic.empty() || p.summary_topic.empty())
+    throw std::invalid_argument("~input_topic, ~output_topic and ~summary_topic must not be empty");
+  return p;
+}
+
+client::ClientOptions client_options(const NodeParameters& p) {
+  client::ClientOptions options;
+  options.address = p.server;
+  options.deadline = std::chrono::milliseconds(static_cast<long long>(p.deadline * 1000));
+  options.retry_attempts = p.retries;
+  if (p.tls || !p.tls_ca.empty() || !p.tls_cert.empty() || !p.tls_key.empty())
+    options.tls = client::TlsOptions{p.tls_ca, p.tls_cert, p.tls_key, p.tls_server_name};
+  if (!p.token.empty()) {
+    options.bearer_token = trimmed(p.token);
+  } else if (!p.token_file.empty()) {
+    std::ifstream in(p.token_file);
+    std::stringstream text;
+    text << in.rdbuf();
+    if (!in) throw std::runtime_error("~token_file " + p.token_file + ": cannot read it");
+    options.bearer_token = trimmed(text.str());
+  } else if (const char* env = std::getenv("PRIMLABEL_TOKEN")) {
+    options.bearer_token = trimmed(env);
+  }
+  return options;
+}
+
+client::LabelOptions label_options(const NodeParameters& p) {
+  client::LabelOptions options;
+  options.model = p.model;
+  options.model_version = p.model_version;
+  options.voxel_size = static_cast<float>(p.voxel_size);
+  options.tabletop_only = p.tabletop_only;
+  options.probabilities = p.confidence || p.probabilities;
+  return options;
+}
+
+}  // namespace primlabel::rosnode

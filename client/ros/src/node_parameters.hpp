@@ -1,0 +1,47 @@
+#pragma once
+// The node's private parameters (~server, ~model, ...; README: client/ros/README.md) and the
+// client options they make.
+
+#include <ros/node_handle.h>
+
+#include <string>
+
+#include "primlabel/client/client.hpp"
+
+namespace primlabel::rosnode {
+
+struct NodeParameters {
+  // The service.
+  std::string server = "127.0.0.1:50051";  // HOST[:PORT]; HOST alone means port 50051
+  std::string token;                       // bearer token; else ~token_file, else $PRIMLABEL_TOKEN
+  std::string token_file;                  // a file holding the token
+  bool tls = false;  // TLS with the system's roots (implied by ~tls_ca, ~tls_cert, ~tls_key)
+  std::string tls_ca, tls_cert, tls_key, tls_server_name;
+  double deadline = 10.0;  // seconds a call may take, its retries included
+  int retries = 4;         // attempts in all when the server is unavailable
+  // The labeling.
+  std::string model;          // empty = the server's default model
+  std::string model_version;  // empty = the latest loaded
+  double voxel_size = 0.0;    // > 0: downsample first (m); 0 = the model's setting
+  bool tabletop_only = false;
+  bool confidence = false;     // publish a float32 `confidence` field (the highest probability)
+  bool probabilities = false;  // publish float32 `prob_<class>` fields
+  // Topics, resolved in the node's namespace.
+  std::string input_topic = "points";
+  std::string output_topic = "points_labeled";
+  std::string summary_topic = "points_labeled_summary";
+};
+
+// Reads the parameters under `private_node` (a NodeHandle on "~"), defaults where unset. Throws
+// std::invalid_argument naming the parameter: a wrong type, a negative or non-finite voxel size,
+// a deadline <= 0, retries < 1, an empty topic, a malformed server address.
+NodeParameters read_parameters(const ros::NodeHandle& private_node);
+
+// The connection: address, deadline, retries, TLS and the bearer token (read from ~token_file or
+// $PRIMLABEL_TOKEN when ~token is empty; throws std::runtime_error when the file is unreadable).
+client::ClientOptions client_options(const NodeParameters& parameters);
+
+// What every cloud is labeled with; probabilities are asked for when either output needs them.
+client::LabelOptions label_options(const NodeParameters& parameters);
+
+}  // namespace primlabel::rosnode
