@@ -1,6 +1,7 @@
-// The vectorised pair kernel must give exactly the bins of the scalar, PCL-identical path, for
-// every input: random pairs, and pairs built to hit its fallbacks (axis-aligned normals with
-// signed zeros, exact and near ties of the source choice, angles on bin boundaries).
+// The vectorised pair kernels (AVX2 and SSE2) must give exactly the bins of the scalar,
+// PCL-identical path, for every input: random pairs, and pairs built to hit its fallbacks
+// (axis-aligned normals with signed zeros, exact and near ties of the source choice, angles on bin
+// boundaries).
 
 #include <gtest/gtest.h>
 
@@ -21,16 +22,18 @@ std::size_t count_mismatches(const std::vector<Pair>& pairs, int bins) {
   std::uint8_t alpha[1], phi[1], theta[1];
   for (const Pair& pair : pairs) {
     PairTargets targets;
-    // Pad the batch so the pair is evaluated in a SIMD lane, not in the scalar tail.
-    for (int lane = 0; lane < 4; ++lane) targets.push(pair.p2, pair.n2);
-    std::uint8_t a[4], f[4], t[4];
-    pair_bins_batch(pair.p1, pair.n1, targets, 4, bins, a, f, t);
+    // Twelve copies: the first eight go through the AVX2 lanes where the CPU has them, the last
+    // four through the SSE2 lanes (all twelve through SSE2 elsewhere), none through the tail.
+    constexpr int kLanes = 12;
+    for (int lane = 0; lane < kLanes; ++lane) targets.push(pair.p2, pair.n2);
+    std::uint8_t a[kLanes], f[kLanes], t[kLanes];
+    pair_bins_batch(pair.p1, pair.n1, targets, kLanes, bins, a, f, t);
     PairFeatures exact;
     pair_features(pair.p1, pair.n1, pair.p2, pair.n2, exact);
     alpha[0] = static_cast<std::uint8_t>(angle_bin(exact.alpha, bins));
     phi[0] = static_cast<std::uint8_t>(cosine_bin(exact.phi, bins));
     theta[0] = static_cast<std::uint8_t>(cosine_bin(exact.theta, bins));
-    for (int lane = 0; lane < 4; ++lane)
+    for (int lane = 0; lane < kLanes; ++lane)
       mismatches += (a[lane] != alpha[0]) + (f[lane] != phi[0]) + (t[lane] != theta[0]);
   }
   return mismatches;
@@ -90,12 +93,13 @@ TEST(PairBinsBatch, AdversarialPairsMatchTheExactPath) {
 TEST(PairBinsBatch, ScalarTailAndPrefixCounts) {
   std::mt19937 rng(3);
   PairTargets targets;
-  for (int i = 0; i < 7; ++i) targets.push(Vec3f(0.01f * i, 0.02f, -0.01f * i), random_unit(rng));
+  // 15 of 16: eight wide, four wide and a scalar tail of three, the 16th untouched.
+  for (int i = 0; i < 16; ++i) targets.push(Vec3f(0.01f * i, 0.02f, -0.01f * i), random_unit(rng));
   const Vec3f p1(0.001f, 0, 0), n1 = random_unit(rng);
-  std::vector<std::uint8_t> a(7, 99), f(7, 99), t(7, 99);
-  pair_bins_batch(p1, n1, targets, 6, 11, a.data(), f.data(), t.data());
-  EXPECT_EQ(a[6], 99);  // beyond the prefix: untouched
-  for (int j = 0; j < 6; ++j) {
+  std::vector<std::uint8_t> a(16, 99), f(16, 99), t(16, 99);
+  pair_bins_batch(p1, n1, targets, 15, 11, a.data(), f.data(), t.data());
+  EXPECT_EQ(a[15], 99);  // beyond the prefix: untouched
+  for (int j = 0; j < 15; ++j) {
     PairFeatures exact;
     pair_features(p1, n1, Vec3f(targets.x[j], targets.y[j], targets.z[j]),
                   Vec3f(targets.nx[j], targets.ny[j], targets.nz[j]), exact);

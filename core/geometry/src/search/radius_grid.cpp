@@ -76,6 +76,10 @@ bool RadiusGrid::cell_range(const Vec3f& q, float radius, std::int64_t lo[3],
 std::size_t RadiusGrid::candidates(const Vec3f& q, float radius) const {
   std::int64_t lo[3], hi[3];
   if (!cell_range(q, radius, lo, hi)) return 0;
+  return candidates_in(lo, hi);
+}
+
+std::size_t RadiusGrid::candidates_in(const std::int64_t lo[3], const std::int64_t hi[3]) const {
   std::size_t total = 0;
   for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
     for (std::int64_t y = lo[1]; y <= hi[1]; ++y)

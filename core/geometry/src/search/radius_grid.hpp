@@ -6,6 +6,7 @@
 // Distances are computed in nanoflann's order, so a grid query returns exactly the set the k-d tree
 // would.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -37,33 +38,52 @@ class RadiusGrid {
             NeighborList& out) const {
     std::int64_t lo[3], hi[3];
     if (!cell_range(q, radius, lo, hi)) return;
+    // Every candidate is written branch-free and kept if inside, so the writes need room for all
+    // candidates: a per-thread buffer that is never zero-filled (growing the lists for each run
+    // zero-filled every candidate, ~10% of a dense query).
+    thread_local CandidateBuffer buffer;
+    buffer.reserve(candidates_in(lo, hi));
+    std::uint32_t* indices = buffer.indices.get();
+    float* sq_dists = buffer.sq_dists.get();
+    std::size_t count = 0;
     for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
       for (std::int64_t y = lo[1]; y <= hi[1]; ++y) {
         const std::size_t first = starts_[cell_index({lo[0], y, z})];
         const std::size_t last = starts_[cell_index({hi[0], y, z}) + 1];
-        std::size_t count = out.indices.size();
-        out.indices.resize(count + (last - first));
-        out.sq_dists.resize(count + (last - first));
         for (std::size_t i = first; i < last; ++i) {
           const std::uint32_t index = index_[i];
           const Vec3f& p = points_[i];
           // nanoflann's L2_Simple_Adaptor: ((0 + dx^2) + dy^2) + dz^2.
           const float dx = q.x() - p.x(), dy = q.y() - p.y(), dz = q.z() - p.z();
           const float sq = (dx * dx + dy * dy) + dz * dz;
-          out.indices[count] = index;
-          out.sq_dists[count] = sq;
+          indices[count] = index;
+          sq_dists[count] = sq;
           count += (sq < sq_radius) & accept(index);  // branch-free: write always, keep if inside
         }
-        out.indices.resize(count);
-        out.sq_dists.resize(count);
       }
+    out.indices.insert(out.indices.end(), indices, indices + count);
+    out.sq_dists.insert(out.sq_dists.end(), sq_dists, sq_dists + count);
   }
 
  private:
   RadiusGrid() = default;
   // The cells a query of this radius reads, as [lo, hi] per axis; false when there are none.
   bool cell_range(const Vec3f& q, float radius, std::int64_t lo[3], std::int64_t hi[3]) const;
+  std::size_t candidates_in(const std::int64_t lo[3], const std::int64_t hi[3]) const;
   std::int64_t cell_coord(float v, int d) const;
+
+  // Room for one query's candidates, grown (never shrunk or initialised) as queries need it.
+  struct CandidateBuffer {
+    std::unique_ptr<std::uint32_t[]> indices;
+    std::unique_ptr<float[]> sq_dists;
+    std::size_t capacity = 0;
+    void reserve(std::size_t wanted) {
+      if (wanted <= capacity) return;
+      capacity = std::max(wanted, 2 * capacity);
+      indices.reset(new std::uint32_t[capacity]);
+      sq_dists.reset(new float[capacity]);
+    }
+  };
   std::array<std::int64_t, 3> cell_coords(const Vec3f& p) const;
   std::size_t cell_index(const std::array<std::int64_t, 3>& c) const {
     return static_cast<std::size_t>((c[2] * dims_[1] + c[1]) * dims_[0] + c[0]);
