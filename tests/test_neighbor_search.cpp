@@ -83,6 +83,41 @@ TEST(NeighborSearch, SparseAndDenseCloudsAgreeWithBruteForce) {
   }
 }
 
+// The radius grid reads only the rows and x-spans its sphere reaches, in cells half the
+// radius wide: points exactly on cell faces and at exactly the radius, near the origin and a
+// kilometre away (where float rounding of the cell coordinates is coarsest), must all be found.
+TEST(NeighborSearch, GridRowCullingMissesNoPointOnCellFacesOrAtTheRadius) {
+  const float r = 0.03f;
+  for (const float offset : {0.0f, 1000.0f}) {
+    std::vector<Vec3f> points;
+    const float step = r / 2.0f;  // the grid cell width: lattice points sit on cell faces
+    for (int x = 0; x < 40; ++x)
+      for (int y = 0; y < 40; ++y)
+        for (int z = 0; z < 6; ++z)
+          points.emplace_back(offset + step * float(x), -offset + step * float(y),
+                              0.5f * offset + step * float(z));
+    NeighborSearch search(points);
+    NeighborList found;
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<std::size_t> pick(0, points.size() - 1);
+    std::uniform_real_distribution<float> jitter(-step, step);
+    for (int trial = 0; trial < 300; ++trial) {
+      Vec3f q = points[pick(rng)];
+      if (trial % 2) q += Vec3f(jitter(rng), jitter(rng), jitter(rng));
+      search.find(q, Neighborhood::Radius(r), found, /*sorted=*/false);
+      std::vector<std::uint32_t> expected;
+      for (std::uint32_t i = 0; i < points.size(); ++i) {
+        const float dx = q.x() - points[i].x(), dy = q.y() - points[i].y(),
+                    dz = q.z() - points[i].z();
+        if ((dx * dx + dy * dy) + dz * dz < r * r) expected.push_back(i);
+      }
+      std::vector<std::uint32_t> got = found.indices;
+      std::sort(got.begin(), got.end());
+      ASSERT_EQ(got, expected) << "offset " << offset << ", trial " << trial;
+    }
+  }
+}
+
 TEST_F(NeighborSearchTest, UnsortedRadiusHasTheSameSetAndIsRepeatable) {
   NeighborSearch search(cloud_.xyz);
   NeighborList sorted, unsorted, again;

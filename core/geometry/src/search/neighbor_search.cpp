@@ -346,8 +346,7 @@ struct NeighborSearch::Impl {
     const std::size_t cap = static_cast<std::size_t>(hood.max_neighbors);
     if (!sorted) {
       if (const RadiusGrid* grid = grid_for(hood.radius)) {
-        if (grid->candidates(query, hood.radius) <= kCandidatesPerNeighbor * cap) {
-          grid->find(query, sq_radius, hood.radius, accept, out);
+        if (grid->find(query, sq_radius, hood.radius, accept, out, kCandidatesPerNeighbor * cap)) {
           if (out.size() <= cap) return;
           out.clear();
         }

@@ -26,22 +26,37 @@ std::unique_ptr<RadiusGrid> RadiusGrid::build(const FinitePoints& points, float 
   // cell count overflow int64. Such clouds are left to the k-d tree.
   if (!std::isfinite(1.0f / radius)) return nullptr;
   const double max_cells = std::min(4.0 * double(n) + 4096, double(1 << 28));
+  // Half-radius cells where their count stays within max_cells, else radius-wide ones (thirds
+  // saved no more instructions than halves on LMS400 and Kinect scans; callgrind):
+  // finer cells fit a query's sphere more closely, but every cell costs a slot even when empty.
   std::int64_t dims[3];
-  double cells = 1;
-  for (int d = 0; d < 3; ++d) {
-    const double extent = (double(hi[d]) - double(lo[d])) / double(radius);
-    if (!(extent < max_cells)) return nullptr;  // also NaN
-    // The float quotient whenever it is finite: the same cells, so the same order.
-    const float quotient = (hi[d] - lo[d]) / radius;
-    const double span = std::isfinite(quotient) ? std::floor(quotient) : std::floor(extent);
-    dims[d] = static_cast<std::int64_t>(std::min(span, max_cells)) + 1;
-    cells *= double(dims[d]);
+  double cells = 0;
+  float cell = radius;
+  for (int parts = 2; parts >= 1; --parts) {
+    cell = parts == 1 ? radius : radius / float(parts);
+    if (!(cell > 0.0f) || !std::isfinite(1.0f / cell)) return nullptr;
+    cells = 1;
+    bool fits = true;
+    for (int d = 0; d < 3 && fits; ++d) {
+      const double extent = (double(hi[d]) - double(lo[d])) / double(cell);
+      if (!(extent < max_cells)) {  // also NaN
+        fits = false;
+        break;
+      }
+      // The float quotient whenever it is finite: the same cells, so the same order.
+      const float quotient = (hi[d] - lo[d]) / cell;
+      const double span = std::isfinite(quotient) ? std::floor(quotient) : std::floor(extent);
+      dims[d] = static_cast<std::int64_t>(std::min(span, max_cells)) + 1;
+      cells *= double(dims[d]);
+    }
+    if (fits && cells <= max_cells) break;
+    if (parts == 1) return nullptr;
   }
-  if (cells > max_cells) return nullptr;
 
   auto grid = std::unique_ptr<RadiusGrid>(new RadiusGrid);
   grid->origin_ = lo;
-  grid->inv_cell_ = 1.0f / radius;
+  grid->cell_ = cell;
+  grid->inv_cell_ = 1.0f / cell;
   for (int d = 0; d < 3; ++d) grid->dims_[d] = dims[d];
   std::vector<std::uint32_t> cell_of(n);
   grid->starts_.assign(static_cast<std::size_t>(cells) + 1, 0);
@@ -63,37 +78,70 @@ std::unique_ptr<RadiusGrid> RadiusGrid::build(const FinitePoints& points, float 
   return grid;
 }
 
-bool RadiusGrid::cell_range(const Vec3f& q, float radius, std::int64_t lo[3],
-                            std::int64_t hi[3]) const {
+std::size_t RadiusGrid::query_runs(const Vec3f& q, float radius, std::vector<Run>& runs) const {
+  runs.clear();
+  std::int64_t lo[3], hi[3];
   for (int d = 0; d < 3; ++d) {
     lo[d] = std::max<std::int64_t>(0, cell_coord(q[d] - radius, d));
     hi[d] = std::min<std::int64_t>(dims_[d] - 1, cell_coord(q[d] + radius, d));
-    if (lo[d] > hi[d]) return false;
+    if (lo[d] > hi[d]) return 0;
   }
-  return true;
-}
-
-std::size_t RadiusGrid::candidates(const Vec3f& q, float radius) const {
-  std::int64_t lo[3], hi[3];
-  if (!cell_range(q, radius, lo, hi)) return 0;
-  return candidates_in(lo, hi);
-}
-
-std::size_t RadiusGrid::candidates_in(const std::int64_t lo[3], const std::int64_t hi[3]) const {
+  // Rows and x-spans are culled against a slightly larger sphere: a point is filed under the
+  // cell its rounded coordinate falls in, which may lie a rounding error outside the cell's
+  // nominal bounds. The slack only adds candidates; the distance test decides.
+  // Filing rounds (p - origin) * (1 / cell) in float: an error of a few ulps of the cell
+  // coordinate (up to the largest dimension) and of the coordinates themselves.
+  double scale = std::fabs(double(radius));
+  for (int d = 0; d < 3; ++d)
+    scale = std::max({scale, std::fabs(double(q[d])), std::fabs(double(origin_[d]))});
+  const double widest = double(std::max({dims_[0], dims_[1], dims_[2]}));
+  const double slack = double(cell_) * (1e-4 + 1e-6 * widest) + 1e-6 * scale;
+  const double reach = double(radius) + slack;
+  const double sq_reach = reach * reach;
+  // The distance from the query to the slab of cell c along axis d (0 inside it).
+  const auto square = [](double v) { return v * v; };
+  const auto slab_distance = [&](std::int64_t c, int d) {
+    const double low = double(origin_[d]) + double(c) * double(cell_);
+    const double v = double(q[d]);
+    if (v < low) return low - v;
+    if (v > low + double(cell_)) return v - (low + double(cell_));
+    return 0.0;
+  };
+  // Squared slab distances per row coordinate (a query spans at most a handful of cells).
+  constexpr std::int64_t kMaxSpan = 16;
+  double dz2[kMaxSpan], dy2[kMaxSpan];
+  const std::int64_t z_count = std::min(hi[2] - lo[2] + 1, kMaxSpan);
+  const std::int64_t y_count = std::min(hi[1] - lo[1] + 1, kMaxSpan);
+  if (z_count < hi[2] - lo[2] + 1 || y_count < hi[1] - lo[1] + 1) {
+    // Cells narrower than radius / 8 are never built; this is only a guard.
+    for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+      for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
+        runs.push_back(
+            {starts_[cell_index({lo[0], y, z})], starts_[cell_index({hi[0], y, z}) + 1]});
+  } else {
+    for (std::int64_t k = 0; k < z_count; ++k) dz2[k] = square(slab_distance(lo[2] + k, 2));
+    for (std::int64_t k = 0; k < y_count; ++k) dy2[k] = square(slab_distance(lo[1] + k, 1));
+    for (std::int64_t kz = 0; kz < z_count; ++kz) {
+      if (dz2[kz] > sq_reach) continue;
+      const std::int64_t z = lo[2] + kz;
+      for (std::int64_t ky = 0; ky < y_count; ++ky) {
+        const double rest = sq_reach - dz2[kz] - dy2[ky];
+        if (rest < 0.0) continue;
+        const std::int64_t y = lo[1] + ky;
+        const float half = static_cast<float>(std::sqrt(rest) + slack);
+        const std::int64_t x0 = std::max(lo[0], cell_coord(q.x() - half, 0));
+        const std::int64_t x1 = std::min(hi[0], cell_coord(q.x() + half, 0));
+        if (x0 > x1) continue;
+        const std::size_t row = cell_index({0, y, z});
+        const std::size_t first = starts_[row + std::size_t(x0)];
+        const std::size_t last = starts_[row + std::size_t(x1) + 1];
+        if (first != last) runs.push_back({first, last});
+      }
+    }
+  }
   std::size_t total = 0;
-  for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
-    for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-      total += starts_[cell_index({hi[0], y, z}) + 1] - starts_[cell_index({lo[0], y, z})];
+  for (const Run& run : runs) total += run.last - run.first;
   return total;
-}
-
-// Clamped to [-1, dims] before the conversion: a query far outside the grid (or one whose float
-// offset overflows) must not convert an out-of-range or NaN value to an integer.
-std::int64_t RadiusGrid::cell_coord(float v, int d) const {
-  const float c = std::floor((v - origin_[d]) * inv_cell_);
-  if (!(c >= -1.0f)) return -1;
-  if (!(c <= float(dims_[d]))) return dims_[d];
-  return static_cast<std::int64_t>(c);
 }
 
 std::array<std::int64_t, 3> RadiusGrid::cell_coords(const Vec3f& p) const {
