@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "labeled_pointcloud2.hpp"
+#include "node_parameters.hpp"
 #include "pointcloud2_test_util.hpp"
 #include "pointcloud2_xyz.hpp"
 #include "summary_json.hpp"
@@ -226,6 +227,15 @@ TEST(SummaryJson, CarriesTheProtoFieldNamesFrameAndStamp) {
   EXPECT_EQ(json.at("model"), "tabletop-kinect");
   EXPECT_EQ(json.at("class_counts").at(0).at("name"), "plane");
   EXPECT_EQ(json.at("scan_id"), "");  // every field present
+}
+
+TEST(NodeParameters, TheViewpointGoesIntoTheLabelOptionsOnlyWhenSet) {
+  rosnode::NodeParameters parameters;
+  EXPECT_FALSE(rosnode::label_options(parameters).viewpoint.has_value());  // the frame's origin
+  parameters.viewpoint = std::array<double, 3>{0.5, -1.25, 2.0};
+  const auto options = rosnode::label_options(parameters);
+  ASSERT_TRUE(options.viewpoint.has_value());
+  EXPECT_EQ(*options.viewpoint, Vec3f(0.5f, -1.25f, 2.0f));
 }
 
 }  // namespace

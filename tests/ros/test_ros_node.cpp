@@ -350,7 +350,8 @@ TEST_F(RosNode, ABurstIsLabeledUpToItsNewestCloud) {
 TEST_F(RosNode, RefusesBadParametersAtStart) {
   int run = 0;
   for (const std::string& bad :
-       {"_voxel_size:=-1", "_deadline:=0", "_server:=host:port", "_probabilities:=maybe"}) {
+       {"_voxel_size:=-1", "_deadline:=0", "_server:=host:port", "_probabilities:=maybe",
+        "_viewpoint:=[1.0,2.0]", "_viewpoint:=up"}) {
     // A name of its own each time: private parameters stay on the master after the node exits.
     auto node = start_node("bad" + std::to_string(++run), {bad});
     const auto code = node->process.wait_for(60s);

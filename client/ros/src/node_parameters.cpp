@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
+#include <vector>
 
 #include "common/server_address.hpp"
 
@@ -53,6 +54,15 @@ NodeParameters read_parameters(const ros::NodeHandle& node) {
   read(node, "model", p.model);
   read(node, "model_version", p.model_version);
   read(node, "voxel_size", p.voxel_size);
+  if (node.hasParam("viewpoint")) {
+    std::vector<double> xyz;
+    if (!node.getParam("viewpoint", xyz) || xyz.size() != 3 || !std::isfinite(xyz[0]) ||
+        !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]))
+      throw std::invalid_argument(
+          "~viewpoint must be a list of three finite numbers [x, y, z] (metres, in the cloud's "
+          "frame)");
+    p.viewpoint = std::array<double, 3>{xyz[0], xyz[1], xyz[2]};
+  }
   read(node, "tabletop_only", p.tabletop_only);
   read(node, "confidence", p.confidence);
   read(node, "probabilities", p.probabilities);
@@ -101,6 +111,10 @@ client::LabelOptions label_options(const NodeParameters& p) {
   options.model = p.model;
   options.model_version = p.model_version;
   options.voxel_size = static_cast<float>(p.voxel_size);
+  if (p.viewpoint)
+    options.viewpoint =
+        Vec3f(static_cast<float>((*p.viewpoint)[0]), static_cast<float>((*p.viewpoint)[1]),
+              static_cast<float>((*p.viewpoint)[2]));
   options.tabletop_only = p.tabletop_only;
   options.probabilities = p.confidence || p.probabilities;
   return options;

@@ -4,6 +4,8 @@
 
 #include <ros/node_handle.h>
 
+#include <array>
+#include <optional>
 #include <string>
 
 #include "primlabel/client/client.hpp"
@@ -23,6 +25,9 @@ struct NodeParameters {
   std::string model;          // empty = the server's default model
   std::string model_version;  // empty = the latest loaded
   double voxel_size = 0.0;    // > 0: downsample first (m); 0 = the model's setting
+  // The sensor's position in the cloud's frame, for orienting normals; unset = the frame's
+  // origin (right for a cloud in its camera's own frame, wrong for one in base_link or map).
+  std::optional<std::array<double, 3>> viewpoint;
   bool tabletop_only = false;
   bool confidence = false;     // publish a float32 `confidence` field (the highest probability)
   bool probabilities = false;  // publish float32 `prob_<class>` fields
@@ -34,6 +39,7 @@ struct NodeParameters {
 
 // Reads the parameters under `private_node` (a NodeHandle on "~"), defaults where unset. Throws
 // std::invalid_argument naming the parameter: a wrong type, a negative or non-finite voxel size,
+// a viewpoint that is not three finite numbers,
 // a deadline <= 0, retries < 1, an empty topic, a malformed server address.
 NodeParameters read_parameters(const ros::NodeHandle& private_node);
 
