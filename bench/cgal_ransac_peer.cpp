@@ -13,7 +13,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
+#include <tuple>
 
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/synth/true_primitives.hpp"
@@ -22,11 +24,12 @@ namespace primlabel::bench {
 namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using PointWithNormal = std::pair<Kernel::Point_3, Kernel::Vector_3>;
+// detect() reorders its input, so each point carries its index in the caller's cloud.
+using PointWithNormal = std::tuple<Kernel::Point_3, Kernel::Vector_3, std::uint32_t>;
 using Points = std::vector<PointWithNormal>;
 using Traits = CGAL::Shape_detection::Efficient_RANSAC_traits<
-    Kernel, Points, CGAL::First_of_pair_property_map<PointWithNormal>,
-    CGAL::Second_of_pair_property_map<PointWithNormal>>;
+    Kernel, Points, CGAL::Nth_of_tuple_property_map<0, PointWithNormal>,
+    CGAL::Nth_of_tuple_property_map<1, PointWithNormal>>;
 using Ransac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
 using CgalPlane = CGAL::Shape_detection::Plane<Traits>;
 using CgalCylinder = CGAL::Shape_detection::Cylinder<Traits>;
@@ -99,34 +102,62 @@ primitives::PlaneModel plane_model(const CgalPlane& shape, const Members& m) {
   return model;
 }
 
+primitives::CylinderModel cylinder_through(const Vec3d& origin, const Vec3d& axis, double radius,
+                                           const Members& m) {
+  primitives::CylinderModel model;
+  model.axis = axis.normalized();
+  model.radius = radius;
+  const auto [lo, hi] = m.extent(origin, model.axis);
+  model.center = origin + 0.5 * (lo + hi) * model.axis;
+  model.height = hi - lo;
+  return model;
+}
+
+// The cylinder a torus of huge major radius is, near the points: the tube around the centre
+// circle's tangent at the point of the circle nearest their centroid.
+primitives::CylinderModel cylinder_of_torus(const primitives::TorusModel& torus, const Members& m) {
+  Vec3d radial = m.centroid() - torus.center;
+  radial -= radial.dot(torus.axis) * torus.axis;
+  radial.normalize();
+  const Vec3d on_circle = torus.center + torus.major_radius * radial;
+  return cylinder_through(on_circle, torus.axis.cross(radial), torus.minor_radius, m);
+}
+
 primitives::Model to_model(const Ransac::Shape& shape, const Members& m,
-                           std::uint32_t& class_id_out) {
+                           const CgalRansacParameters& parameters, std::uint32_t& class_id_out,
+                           bool& torus_as_cylinder) {
+  torus_as_cylinder = false;
   if (const auto* plane = dynamic_cast<const CgalPlane*>(&shape)) {
     class_id_out = class_id(C::kPlane);
     return plane_model(*plane, m);
   }
+  std::optional<primitives::CylinderModel> cylinder_model;
+  if (const auto* torus = dynamic_cast<const CgalTorus*>(&shape)) {
+    const primitives::TorusModel model{to_eigen(torus->center()),
+                                       to_eigen(torus->axis()).normalized(), torus->major_radius(),
+                                       torus->minor_radius()};
+    const double limit = parameters.degenerate_torus_major_radius;
+    if (!(limit > 0 && model.major_radius > limit)) {
+      class_id_out = class_id(C::kTorusConvex);
+      return model;
+    }
+    cylinder_model = cylinder_of_torus(model, m);
+    torus_as_cylinder = true;
+  }
   if (const auto* cylinder = dynamic_cast<const CgalCylinder*>(&shape)) {
-    primitives::CylinderModel model;
     const Kernel::Line_3 axis = cylinder->axis();
-    const Vec3d origin = to_eigen(axis.point());
-    model.axis = to_eigen(axis.to_vector()).normalized();
-    model.radius = cylinder->radius();
-    const auto [lo, hi] = m.extent(origin, model.axis);
-    model.center = origin + 0.5 * (lo + hi) * model.axis;
-    model.height = hi - lo;
+    cylinder_model =
+        cylinder_through(to_eigen(axis.point()), to_eigen(axis.to_vector()), cylinder->radius(), m);
+  }
+  if (cylinder_model) {
     class_id_out =
-        class_id(m.convex(model.center, &model.axis) ? C::kCylinderConvex : C::kCylinderConcave);
-    return model;
+        class_id(m.convex(cylinder_model->center, &cylinder_model->axis) ? C::kCylinderConvex
+                                                                         : C::kCylinderConcave);
+    return *cylinder_model;
   }
   if (const auto* sphere = dynamic_cast<const CgalSphere*>(&shape)) {
     primitives::SphereModel model{to_eigen(sphere->center()), sphere->radius()};
     class_id_out = class_id(m.convex(model.center, nullptr) ? C::kSphereConvex : C::kSphereConcave);
-    return model;
-  }
-  if (const auto* torus = dynamic_cast<const CgalTorus*>(&shape)) {
-    primitives::TorusModel model{to_eigen(torus->center()), to_eigen(torus->axis()).normalized(),
-                                 torus->major_radius(), torus->minor_radius()};
-    class_id_out = class_id(C::kTorusConvex);
     return model;
   }
   class_id_out = class_id(C::kUnknown);
@@ -146,14 +177,12 @@ CgalDetections detect_with_cgal(const std::vector<Vec3f>& xyz, std::span<const V
   if (normals.size() != xyz.size())
     throw std::invalid_argument("detect_with_cgal: one normal per point needed");
   Points points;
-  std::vector<std::uint32_t> input_index;  // CGAL's point k is input point input_index[k]
   points.reserve(xyz.size());
   for (std::size_t i = 0; i < xyz.size(); ++i) {
     const Vec3f& n = normals[i];
     if (!is_finite(xyz[i]) || !is_finite(n) || n.squaredNorm() < 1e-12f) continue;
     points.emplace_back(Kernel::Point_3(xyz[i].x(), xyz[i].y(), xyz[i].z()),
-                        Kernel::Vector_3(n.x(), n.y(), n.z()));
-    input_index.push_back(std::uint32_t(i));
+                        Kernel::Vector_3(n.x(), n.y(), n.z()), std::uint32_t(i));
   }
 
   CgalDetections out;
@@ -180,11 +209,13 @@ CgalDetections detect_with_cgal(const std::vector<Vec3f>& xyz, std::span<const V
   for (const auto& shape : ransac.shapes()) {
     Members members{xyz, normals, {}};
     for (const std::size_t k : shape->indices_of_assigned_points())
-      members.indices.push_back(input_index[k]);
+      members.indices.push_back(std::get<2>(points[k]));
     if (members.indices.empty()) continue;
     std::sort(members.indices.begin(), members.indices.end());
     primitives::Primitive p;
-    p.model = to_model(*shape, members, p.class_id);
+    bool torus_as_cylinder = false;
+    p.model = to_model(*shape, members, parameters, p.class_id, torus_as_cylinder);
+    if (torus_as_cylinder) ++out.tori_as_cylinders;
     p.points = p.inliers = members.indices.size();
     p.first_point = members.indices.front();
     p.centroid = members.centroid();

@@ -1,7 +1,9 @@
 // The CGAL Efficient RANSAC peer (bench/cgal_ransac_peer.hpp) on a tiny cloud of known shapes:
-// a 20 x 20 cm plane and, beside it, a 40 mm cylinder, sampled at 3 mm with 0.3 mm noise and
+// a 20 x 12 cm plane and, beside it, a 40 mm cylinder, sampled at 3 mm with 0.3 mm noise and
 // their exact normals. CGAL's shapes, converted to primlabel Primitives, come back with the
-// right parameters, and the shared matcher finds both true instances. Built only with CGAL.
+// right parameters (CGAL often returns the can as a torus of kilometres' major radius: the
+// adaptor reports it as the cylinder it is), and the shared matcher finds both true instances.
+// Built only with CGAL.
 
 #include <gtest/gtest.h>
 
@@ -32,7 +34,7 @@ Cloud plane_and_cylinder() {
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0, 0.0003);
   for (double x = 0; x < 0.2; x += kSpacing)
-    for (double y = 0; y < 0.2; y += kSpacing) {
+    for (double y = 0; y < 0.12; y += kSpacing) {
       c.xyz.push_back(Vec3d(x, y, noise(rng)).cast<float>());
       c.normals.push_back(Vec3f::UnitZ());
       c.object.push_back(0);
@@ -80,7 +82,9 @@ TEST(CgalPeer, FindsThePlaneAndTheCylinderWithTheirParameters) {
     }
   for (std::size_t k = 0; k < counted.size(); ++k) {
     EXPECT_EQ(counted[k], found.set.primitives[k].points);
-    if (k) EXPECT_GE(found.set.primitives[k - 1].points, found.set.primitives[k].points);
+    if (k > 0) {
+      EXPECT_GE(found.set.primitives[k - 1].points, found.set.primitives[k].points);
+    }
   }
 
   const bench::InstanceMatch m =
@@ -98,8 +102,10 @@ TEST(CgalPeer, FindsThePlaneAndTheCylinderWithTheirParameters) {
     } else {
       const auto& plane = std::get<primitives::PlaneModel>(p.model);
       EXPECT_LT(bench::axis_angle_deg(plane.normal, Vec3d::UnitZ()), 1.0);
-      EXPECT_NEAR(plane.normal.dot(Vec3d(0.1, 0.1, 0)) + plane.offset, 0, 0.001);
+      EXPECT_NEAR(plane.normal.dot(Vec3d(0.1, 0.06, 0)) + plane.offset, 0, 0.001);
       EXPECT_NEAR(plane.extent_u, 0.2, 0.01);
+      EXPECT_NEAR(plane.extent_v, 0.12, 0.01);
+      EXPECT_LT(bench::axis_angle_deg(plane.axis_u, Vec3d::UnitX()), 2.0);
       EXPECT_EQ(p.class_id, class_id(PrimitiveClass::kPlane));
     }
   }
