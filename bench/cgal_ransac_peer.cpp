@@ -74,10 +74,11 @@ struct Members {
   }
 };
 
-primitives::PlaneModel plane_model(const CgalPlane& shape, const Members& m) {
+// The plane n.x + offset = 0 and the oriented rectangle its points cover.
+primitives::PlaneModel plane_model(const Vec3d& normal, double offset, const Members& m) {
   primitives::PlaneModel model;
-  model.normal = to_eigen(shape.plane_normal()).normalized();
-  model.offset = shape.d();  // CGAL's Plane_3 convention: n.x + d = 0
+  model.normal = normal.normalized();
+  model.offset = offset;
   // The in-plane principal axes of the points give the oriented rectangle they cover.
   const Vec3d mean = m.centroid();
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
@@ -113,6 +114,16 @@ primitives::CylinderModel cylinder_through(const Vec3d& origin, const Vec3d& axi
   return model;
 }
 
+// The plane a cylinder or sphere of huge radius is near the points: tangent where the direction
+// from the axis (or centre) through their centroid meets the surface.
+primitives::PlaneModel tangent_plane(const Vec3d& center, const Vec3d* axis, double radius,
+                                     const Members& m) {
+  Vec3d radial = m.centroid() - center;
+  if (axis) radial -= radial.dot(*axis) * *axis;
+  radial.normalize();
+  return plane_model(radial, -radial.dot(center + radius * radial), m);
+}
+
 // The cylinder a torus of huge major radius is, near the points: the tube around the centre
 // circle's tangent at the point of the circle nearest their centroid.
 primitives::CylinderModel cylinder_of_torus(const primitives::TorusModel& torus, const Members& m) {
@@ -125,24 +136,39 @@ primitives::CylinderModel cylinder_of_torus(const primitives::TorusModel& torus,
 
 primitives::Model to_model(const Ransac::Shape& shape, const Members& m,
                            const CgalRansacParameters& parameters, std::uint32_t& class_id_out,
-                           bool& torus_as_cylinder) {
-  torus_as_cylinder = false;
-  if (const auto* plane = dynamic_cast<const CgalPlane*>(&shape)) {
+                           bool& degenerate) {
+  const double limit = parameters.degenerate_radius;
+  degenerate = false;
+  std::optional<primitives::PlaneModel> plane_of;
+  if (const auto* plane = dynamic_cast<const CgalPlane*>(&shape))
+    // CGAL's Plane_3 convention: n.x + d = 0.
+    plane_of = plane_model(to_eigen(plane->plane_normal()), plane->d(), m);
+  if (const auto* cylinder = dynamic_cast<const CgalCylinder*>(&shape);
+      cylinder && limit > 0 && cylinder->radius() > limit) {
+    const Vec3d axis = to_eigen(cylinder->axis().to_vector()).normalized();
+    plane_of = tangent_plane(to_eigen(cylinder->axis().point()), &axis, cylinder->radius(), m);
+    degenerate = true;
+  }
+  if (const auto* sphere = dynamic_cast<const CgalSphere*>(&shape);
+      sphere && limit > 0 && sphere->radius() > limit) {
+    plane_of = tangent_plane(to_eigen(sphere->center()), nullptr, sphere->radius(), m);
+    degenerate = true;
+  }
+  if (plane_of) {
     class_id_out = class_id(C::kPlane);
-    return plane_model(*plane, m);
+    return *plane_of;
   }
   std::optional<primitives::CylinderModel> cylinder_model;
   if (const auto* torus = dynamic_cast<const CgalTorus*>(&shape)) {
     const primitives::TorusModel model{to_eigen(torus->center()),
                                        to_eigen(torus->axis()).normalized(), torus->major_radius(),
                                        torus->minor_radius()};
-    const double limit = parameters.degenerate_torus_major_radius;
     if (!(limit > 0 && model.major_radius > limit)) {
       class_id_out = class_id(C::kTorusConvex);
       return model;
     }
     cylinder_model = cylinder_of_torus(model, m);
-    torus_as_cylinder = true;
+    degenerate = true;
   }
   if (const auto* cylinder = dynamic_cast<const CgalCylinder*>(&shape)) {
     const Kernel::Line_3 axis = cylinder->axis();
@@ -213,9 +239,9 @@ CgalDetections detect_with_cgal(const std::vector<Vec3f>& xyz, std::span<const V
     if (members.indices.empty()) continue;
     std::sort(members.indices.begin(), members.indices.end());
     primitives::Primitive p;
-    bool torus_as_cylinder = false;
-    p.model = to_model(*shape, members, parameters, p.class_id, torus_as_cylinder);
-    if (torus_as_cylinder) ++out.tori_as_cylinders;
+    bool degenerate = false;
+    p.model = to_model(*shape, members, parameters, p.class_id, degenerate);
+    if (degenerate) ++out.degenerate;
     p.points = p.inliers = members.indices.size();
     p.first_point = members.indices.front();
     p.centroid = members.centroid();

@@ -27,11 +27,13 @@ struct CgalRansacParameters {
   std::size_t min_points = 50;
   double probability = 0.01;  // CGAL's default: chance of missing the largest shape
   std::uint64_t seed = 1;     // CGAL's default random generator, reseeded per call
-  // CGAL's torus contains the cylinder as its limit, and on a can's wall it often wins with a
-  // major radius of kilometres. A torus whose major radius exceeds this (primlabel's own bound,
-  // FitSettings::max_radius, far beyond any table-top object) is reported as that cylinder: the
-  // centre circle's tangent at the points as axis, the minor radius as radius. 0: never.
-  double degenerate_torus_major_radius = 2.0;
+  // CGAL's curved shapes contain simpler ones as their limits, and they often win there: a can's
+  // wall comes back as a torus of major radius in kilometres, the table top as a cylinder of
+  // 30 m. A shape whose (major) radius exceeds this bound (primlabel's own, FitSettings::
+  // max_radius, far beyond any table-top object) is reported as what it degenerates to near its
+  // points: such a torus as the cylinder around its centre circle's tangent (the minor radius as
+  // radius), such a cylinder or sphere as the tangent plane. 0: report CGAL's shapes as they are.
+  double degenerate_radius = 2.0;
 
   // cluster_epsilon = 4x the median point spacing (as primlabel's segments connect points within
   // 4x the spacing, README: Primitive instances); the rest as above.
@@ -43,8 +45,8 @@ struct CgalDetections {
   // tori convex or concave by their normals); inliers = points (CGAL assigns each point to at
   // most one shape), rms to the model, confidence 1; point_segment per input point.
   primitives::PrimitiveSet set;
-  double seconds = 0;                 // CGAL's detect() alone (wall time, one thread)
-  std::size_t tori_as_cylinders = 0;  // see degenerate_torus_major_radius
+  double seconds = 0;          // CGAL's detect() alone (wall time, one thread)
+  std::size_t degenerate = 0;  // shapes reported as their limit (see degenerate_radius)
 };
 
 // `normals` holds one normal per point. Points or normals that are not finite take no part.

@@ -81,6 +81,9 @@ InstanceMatch match_instances(const primitives::PrimitiveSet& detected,
     const auto most = std::max_element(on.begin(), on.end());
     if (most == on.end() || 2 * *most < members[d].size()) continue;  // on no true surface
     const std::size_t t = std::size_t(most - on.begin());
+    const MatchedPair e = errors(p.model, truth[t].primitive.model);
+    if (e.axis_error_deg > options.max_angle_deg || e.radius_error > options.max_radius_error)
+      continue;  // a wrong instance of that surface
     if (*most > best[t].second) best[t] = {d, *most};
   }
   for (std::size_t t = 0; t < truth.size(); ++t) {

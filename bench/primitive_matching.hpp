@@ -3,7 +3,9 @@
 // every detector the primitives benchmark compares (primlabel from predicted or true labels,
 // CGAL's Efficient RANSAC). A detection lies on a true primitive when at least half of its points
 // are points of that primitive's object within `tolerance` of its surface (synth::distance_to);
-// its true primitive is the one of the same model kind with most of its points. Each true
+// its true primitive is the one of the same model kind with most of its points, and it is a
+// wrong instance (not matched) when its parameters are off that primitive's by more than the
+// gates (5x the targets, so the error figures still show what is matched). Each true
 // primitive is matched by at most one detection (the one with most points on it): a second
 // detection of the same surface, a detection on no true surface and a detection of the wrong
 // kind all count against precision. Recall is over the true primitives with at least
@@ -24,6 +26,8 @@ struct MatchOptions {
   std::size_t min_true_points = 50;
   // Detections with fewer points are not scored (neither side reports them as instances).
   std::size_t min_detection_points = 50;
+  double max_angle_deg = 10;       // axis (cylinder, torus) or normal (plane) against the true one
+  double max_radius_error = 0.01;  // m: cylinder, sphere radius; torus major radius
 };
 
 // A true primitive and the detection matched to it, with the errors of its parameters.

@@ -282,6 +282,7 @@ int run(const Arguments& args) {
   const bench::MatchOptions match_options;
   InstanceFigures predicted_instances, truth_instances, cgal_instances;
   double label_seconds = 0;  // label_cloud end to end: normals, descriptors, CRF, primitives
+  [[maybe_unused]] std::size_t cgal_degenerate = 0;
   for (int s = 0; s < args.scenes; ++s) {
     synth::GenerateOptions options;
     options.seed = args.first_seed + std::uint64_t(s);
@@ -324,18 +325,22 @@ int run(const Arguments& args) {
         instances, match_options, truth_instances);
 #ifdef PRIMLABEL_HAVE_CGAL
     // The same points with primlabel's normals (label_cloud left them in the cloud).
+    const auto cgal_parameters = bench::CgalRansacParameters::for_spacing(result.point_spacing);
     const bench::CgalDetections cgal =
-        bench::detect_with_cgal(g.cloud.xyz, g.cloud.normals,
-                                bench::CgalRansacParameters::for_spacing(result.point_spacing));
+        bench::detect_with_cgal(g.cloud.xyz, g.cloud.normals, cgal_parameters);
     cgal_instances.seconds += cgal.seconds;
+    cgal_degenerate += cgal.degenerate;
     add_match(
         bench::match_instances(cgal.set, g.cloud.xyz, objects.values, instances, match_options),
         instances, match_options, cgal_instances);
     std::printf(
-        "seed %llu: CGAL Efficient RANSAC %zu shapes in %.0f ms (cluster epsilon %.1f mm)\n",
-        static_cast<unsigned long long>(options.seed), cgal.set.primitives.size(),
-        1000 * cgal.seconds,
-        1000 * bench::CgalRansacParameters::for_spacing(result.point_spacing).cluster_epsilon);
+        "seed %llu: CGAL Efficient RANSAC %zu shapes (%zu degenerate, reported as their limit) "
+        "in %.0f ms; epsilon %.1f mm, normals within %.0f deg, cluster epsilon %.1f mm, min "
+        "points %zu\n",
+        static_cast<unsigned long long>(options.seed), cgal.set.primitives.size(), cgal.degenerate,
+        1000 * cgal.seconds, 1000 * cgal_parameters.epsilon,
+        std::acos(cgal_parameters.normal_threshold) * 180 / M_PI,
+        1000 * cgal_parameters.cluster_epsilon, cgal_parameters.min_points);
 #endif
     std::printf(
         "seed %llu: %zu points, %s; %zu primitives from predicted labels in %.0f ms "
@@ -369,6 +374,7 @@ int run(const Arguments& args) {
       "with labeling end to end, normals excluded from CGAL's time)\n",
       "", args.threads, fit_speedup, end_to_end_speedup);
   line["instances_cgal"] = instance_json(cgal_instances, args.scenes);
+  line["cgal_degenerate_shapes"] = cgal_degenerate;
   line["cgal_over_primlabel_fit_time"] = json::rounded(fit_speedup, "%.2f");
   line["cgal_over_primlabel_label_cloud_time"] = json::rounded(end_to_end_speedup, "%.2f");
 #else

@@ -1,7 +1,8 @@
 // The instance matching every detector of primlabel-bench-primitives is scored with
 // (bench/primitive_matching.hpp): a detection counts once, on the true primitive of its kind and
 // object most of its points lie on; duplicates, wrong kinds and detections off every true surface
-// count against precision only.
+// and detections whose parameters are far off the surface they lie on count against precision
+// only.
 
 #include <gtest/gtest.h>
 
@@ -75,6 +76,12 @@ TEST(PrimitiveMatching, CountsEachTrueInstanceOnceAndNoWrongDetection) {
   const auto off_surface = s.detection(CylinderModel{{0.5, 0, 0.05}, Vec3d::UnitZ(), 0.05, 0.1});
   const auto other_object = s.detection(PlaneModel{});
   const auto plane = s.detection(PlaneModel{});
+  // On the plane's points but 30 degrees off: a wrong instance, however many points it has.
+  const auto tilted_plane =
+      s.detection(PlaneModel{Vec3d(0, std::sin(M_PI / 6), std::cos(M_PI / 6)), 0, Vec3d::Zero(),
+                             Vec3d::UnitX(), Vec3d::UnitY(), 1, 1});
+  // On the outer wall's points but 15 mm too wide.
+  const auto wide = s.detection(CylinderModel{{0.5, 0, 0.05}, Vec3d::UnitZ(), 0.055, 0.1});
   const auto tiny = s.detection(PlaneModel{});
   s.add(120, 2, cylinder, [](double t) { return on_circle(0.04, t); });
   s.add(60, 2, duplicate, [](double t) { return on_circle(0.0401, t); });
@@ -82,13 +89,15 @@ TEST(PrimitiveMatching, CountsEachTrueInstanceOnceAndNoWrongDetection) {
   s.add(80, 2, off_surface, [](double t) { return on_circle(0.05, t); });  // 10 mm out
   s.add(80, 3, other_object, on_plane);  // on the plane's surface but another object's points
   s.add(150, 1, plane, on_plane);
+  s.add(200, 1, tilted_plane, on_plane);
+  s.add(200, 2, wide, [](double t) { return on_circle(0.04, t); });
   s.add(20, 1, tiny, on_plane);  // under min_detection_points: not scored
   s.add(30, 1, primitives::kNoSegment, on_plane);
 
   const bench::InstanceMatch m = bench::match_instances(s.detected, s.xyz, s.object, s.truth);
   EXPECT_EQ(m.true_instances, 2u);  // the plane and the outer wall
   EXPECT_EQ(m.found, 2u);
-  EXPECT_EQ(m.detections, 6u);  // all but the tiny one
+  EXPECT_EQ(m.detections, 8u);  // all but the tiny one
   EXPECT_EQ(m.correct, 2u);
   ASSERT_EQ(m.pairs.size(), 2u);
   EXPECT_EQ(m.pairs[0].truth, 0u);
