@@ -47,6 +47,9 @@ struct Arguments {
   std::string model;
   int scenes = 4, threads = 2;
   std::uint64_t first_seed = 3000;  // the test set's seeds (synth::SceneSet::kTest)
+  // CGAL's search endurance and connectivity, to check the comparison does not hinge on them.
+  double cgal_probability = 0.01;
+  double cgal_cluster_spacings = 4;  // cluster epsilon in median point spacings
 };
 
 // A curved surface the generator placed: its model, class and true parameters (world frame).
@@ -325,7 +328,9 @@ int run(const Arguments& args) {
         instances, match_options, truth_instances);
 #ifdef PRIMLABEL_HAVE_CGAL
     // The same points with primlabel's normals (label_cloud left them in the cloud).
-    const auto cgal_parameters = bench::CgalRansacParameters::for_spacing(result.point_spacing);
+    auto cgal_parameters = bench::CgalRansacParameters::for_spacing(result.point_spacing);
+    cgal_parameters.probability = args.cgal_probability;
+    cgal_parameters.cluster_epsilon *= args.cgal_cluster_spacings / 4;
     const bench::CgalDetections cgal =
         bench::detect_with_cgal(g.cloud.xyz, g.cloud.normals, cgal_parameters);
     cgal_instances.seconds += cgal.seconds;
@@ -399,6 +404,15 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100));
   app.add_option("--first-seed", args.first_seed, "seed of the first scene");
   app.add_option("--threads", args.threads, "worker threads")->check(CLI::PositiveNumber);
+  app.add_option(
+         "--cgal-probability", args.cgal_probability,
+         "CGAL Efficient RANSAC: chance of missing the largest shape (lower: longer search)")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->capture_default_str();
+  app.add_option("--cgal-cluster-spacings", args.cgal_cluster_spacings,
+                 "CGAL Efficient RANSAC: cluster epsilon in median point spacings")
+      ->check(CLI::Range(0.5, 100.0))
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
