@@ -13,7 +13,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <stdexcept>
 #include <tuple>
 
@@ -134,63 +133,49 @@ primitives::CylinderModel cylinder_of_torus(const primitives::TorusModel& torus,
   return cylinder_through(on_circle, torus.axis.cross(radial), torus.minor_radius, m);
 }
 
-primitives::Model to_model(const Ransac::Shape& shape, const Members& m,
-                           const CgalRansacParameters& parameters, std::uint32_t& class_id_out,
-                           bool& degenerate) {
-  const double limit = parameters.degenerate_radius;
-  degenerate = false;
-  std::optional<primitives::PlaneModel> plane_of;
+// CGAL's shape as primlabel's model, before degenerate_limit.
+primitives::Model raw_model(const Ransac::Shape& shape, const Members& m) {
   if (const auto* plane = dynamic_cast<const CgalPlane*>(&shape))
     // CGAL's Plane_3 convention: n.x + d = 0.
-    plane_of = plane_model(to_eigen(plane->plane_normal()), plane->d(), m);
-  if (const auto* cylinder = dynamic_cast<const CgalCylinder*>(&shape);
-      cylinder && limit > 0 && cylinder->radius() > limit) {
-    const Vec3d axis = to_eigen(cylinder->axis().to_vector()).normalized();
-    plane_of = tangent_plane(to_eigen(cylinder->axis().point()), &axis, cylinder->radius(), m);
-    degenerate = true;
-  }
-  if (const auto* sphere = dynamic_cast<const CgalSphere*>(&shape);
-      sphere && limit > 0 && sphere->radius() > limit) {
-    plane_of = tangent_plane(to_eigen(sphere->center()), nullptr, sphere->radius(), m);
-    degenerate = true;
-  }
-  if (plane_of) {
-    class_id_out = class_id(C::kPlane);
-    return *plane_of;
-  }
-  std::optional<primitives::CylinderModel> cylinder_model;
-  if (const auto* torus = dynamic_cast<const CgalTorus*>(&shape)) {
-    const primitives::TorusModel model{to_eigen(torus->center()),
-                                       to_eigen(torus->axis()).normalized(), torus->major_radius(),
-                                       torus->minor_radius()};
-    if (!(limit > 0 && model.major_radius > limit)) {
-      class_id_out = class_id(C::kTorusConvex);
-      return model;
-    }
-    cylinder_model = cylinder_of_torus(model, m);
-    degenerate = true;
-  }
+    return plane_model(to_eigen(plane->plane_normal()), plane->d(), m);
   if (const auto* cylinder = dynamic_cast<const CgalCylinder*>(&shape)) {
     const Kernel::Line_3 axis = cylinder->axis();
-    cylinder_model =
-        cylinder_through(to_eigen(axis.point()), to_eigen(axis.to_vector()), cylinder->radius(), m);
+    return cylinder_through(to_eigen(axis.point()), to_eigen(axis.to_vector()), cylinder->radius(),
+                            m);
   }
-  if (cylinder_model) {
-    class_id_out =
-        class_id(m.convex(cylinder_model->center, &cylinder_model->axis) ? C::kCylinderConvex
-                                                                         : C::kCylinderConcave);
-    return *cylinder_model;
-  }
-  if (const auto* sphere = dynamic_cast<const CgalSphere*>(&shape)) {
-    primitives::SphereModel model{to_eigen(sphere->center()), sphere->radius()};
-    class_id_out = class_id(m.convex(model.center, nullptr) ? C::kSphereConvex : C::kSphereConcave);
-    return model;
-  }
-  class_id_out = class_id(C::kUnknown);
+  if (const auto* sphere = dynamic_cast<const CgalSphere*>(&shape))
+    return primitives::SphereModel{to_eigen(sphere->center()), sphere->radius()};
+  if (const auto* torus = dynamic_cast<const CgalTorus*>(&shape))
+    return primitives::TorusModel{to_eigen(torus->center()), to_eigen(torus->axis()).normalized(),
+                                  torus->major_radius(), torus->minor_radius()};
   return std::monostate{};
 }
 
+// The taxonomy class of a model on these points: convex or concave by their normals.
+std::uint32_t class_of(const primitives::Model& model, const Members& m) {
+  if (std::holds_alternative<primitives::PlaneModel>(model)) return class_id(C::kPlane);
+  if (const auto* c = std::get_if<primitives::CylinderModel>(&model))
+    return class_id(m.convex(c->center, &c->axis) ? C::kCylinderConvex : C::kCylinderConcave);
+  if (const auto* s = std::get_if<primitives::SphereModel>(&model))
+    return class_id(m.convex(s->center, nullptr) ? C::kSphereConvex : C::kSphereConcave);
+  if (std::holds_alternative<primitives::TorusModel>(model)) return class_id(C::kTorusConvex);
+  return class_id(C::kUnknown);
+}
+
 }  // namespace
+
+primitives::Model degenerate_limit(const primitives::Model& model, const std::vector<Vec3f>& xyz,
+                                   std::span<const std::uint32_t> points, double limit) {
+  if (!(limit > 0) || points.empty()) return model;
+  const Members m{xyz, {}, {points.begin(), points.end()}};
+  if (const auto* c = std::get_if<primitives::CylinderModel>(&model); c && c->radius > limit)
+    return tangent_plane(c->center, &c->axis, c->radius, m);
+  if (const auto* s = std::get_if<primitives::SphereModel>(&model); s && s->radius > limit)
+    return tangent_plane(s->center, nullptr, s->radius, m);
+  if (const auto* t = std::get_if<primitives::TorusModel>(&model); t && t->major_radius > limit)
+    return cylinder_of_torus(*t, m);
+  return model;
+}
 
 CgalRansacParameters CgalRansacParameters::for_spacing(double point_spacing) {
   CgalRansacParameters p;
@@ -239,9 +224,10 @@ CgalDetections detect_with_cgal(const std::vector<Vec3f>& xyz, std::span<const V
     if (members.indices.empty()) continue;
     std::sort(members.indices.begin(), members.indices.end());
     primitives::Primitive p;
-    bool degenerate = false;
-    p.model = to_model(*shape, members, parameters, p.class_id, degenerate);
-    if (degenerate) ++out.degenerate;
+    const primitives::Model raw = raw_model(*shape, members);
+    p.model = degenerate_limit(raw, xyz, members.indices, parameters.degenerate_radius);
+    if (p.model.index() != raw.index()) ++out.degenerate;
+    p.class_id = class_of(p.model, members);
     p.points = p.inliers = members.indices.size();
     p.first_point = members.indices.front();
     p.centroid = members.centroid();

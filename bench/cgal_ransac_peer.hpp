@@ -49,6 +49,13 @@ struct CgalDetections {
   std::size_t degenerate = 0;  // shapes reported as their limit (see degenerate_radius)
 };
 
+// What a CGAL shape of (major) radius over `limit` is near its points (xyz[points]): a cylinder
+// or sphere the plane tangent where the direction from its axis or centre through the points'
+// centroid meets it, a torus the cylinder (minor radius) around its centre circle's tangent
+// there. Other models, and any model when limit <= 0, come back unchanged.
+primitives::Model degenerate_limit(const primitives::Model& model, const std::vector<Vec3f>& xyz,
+                                   std::span<const std::uint32_t> points, double limit);
+
 // `normals` holds one normal per point. Points or normals that are not finite take no part.
 // Throws std::invalid_argument when the sizes differ.
 CgalDetections detect_with_cgal(const std::vector<Vec3f>& xyz, std::span<const Vec3f> normals,

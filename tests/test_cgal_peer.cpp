@@ -1,9 +1,9 @@
 // The CGAL Efficient RANSAC peer (bench/cgal_ransac_peer.hpp) on a tiny cloud of known shapes:
 // a 20 x 12 cm plane and, beside it, a 40 mm cylinder, sampled at 3 mm with 0.3 mm noise and
 // their exact normals. CGAL's shapes, converted to primlabel Primitives, come back with the
-// right parameters (CGAL often returns the can as a torus of kilometres' major radius: the
-// adaptor reports it as the cylinder it is), and the shared matcher finds both true instances.
-// Built only with CGAL.
+// right parameters and the shared matcher finds both true instances; degenerate CGAL shapes (a
+// can as a torus of kilometres' major radius) come back as the shape they tend to. Built only
+// with CGAL.
 
 #include <gtest/gtest.h>
 
@@ -109,6 +109,41 @@ TEST(CgalPeer, FindsThePlaneAndTheCylinderWithTheirParameters) {
       EXPECT_EQ(p.class_id, class_id(PrimitiveClass::kPlane));
     }
   }
+}
+
+// CGAL's tori of kilometres and cylinders of tens of metres are the cylinder and plane they tend
+// to near the points.
+TEST(CgalPeer, DegenerateShapesBecomeTheirLimit) {
+  const Cloud c = plane_and_cylinder();
+  std::vector<std::uint32_t> plane_points, cylinder_points;
+  for (std::uint32_t i = 0; i < c.xyz.size(); ++i)
+    (c.object[i] == 0 ? plane_points : cylinder_points).push_back(i);
+
+  const Vec3d across = kAxis.unitOrthogonal(), out = across.cross(kAxis);
+  const double major = 1000;
+  const primitives::TorusModel torus{kBase + 0.06 * kAxis - major * out, across, major, kRadius};
+  const auto as_cylinder = bench::degenerate_limit(torus, c.xyz, cylinder_points, 2.0);
+  const auto* cylinder = std::get_if<primitives::CylinderModel>(&as_cylinder);
+  ASSERT_NE(cylinder, nullptr);
+  EXPECT_DOUBLE_EQ(cylinder->radius, kRadius);
+  EXPECT_LT(bench::axis_angle_deg(cylinder->axis, kAxis), 0.01);
+  EXPECT_NEAR(cylinder->height, 0.12, 0.005);
+  EXPECT_LT((cylinder->center - (kBase + 0.06 * kAxis)).norm(), 0.005);
+
+  const primitives::CylinderModel wide{{0.1, 0.06, -30}, Vec3d::UnitX(), 30, 0.2};
+  const auto as_plane = bench::degenerate_limit(wide, c.xyz, plane_points, 2.0);
+  const auto* plane = std::get_if<primitives::PlaneModel>(&as_plane);
+  ASSERT_NE(plane, nullptr);
+  EXPECT_LT(bench::axis_angle_deg(plane->normal, Vec3d::UnitZ()), 0.01);
+  EXPECT_NEAR(plane->offset, 0, 1e-4);
+  EXPECT_NEAR(plane->extent_u, 0.2, 0.01);
+
+  // Under the limit, or with the limit off, a shape stays what CGAL found.
+  const primitives::SphereModel ball{{0, 0, 0}, 1.5};
+  EXPECT_TRUE(std::holds_alternative<primitives::SphereModel>(
+      bench::degenerate_limit(ball, c.xyz, plane_points, 2.0)));
+  EXPECT_TRUE(std::holds_alternative<primitives::TorusModel>(
+      bench::degenerate_limit(torus, c.xyz, cylinder_points, 0)));
 }
 
 TEST(CgalPeer, SameSeedSameShapes) {
