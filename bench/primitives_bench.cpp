@@ -4,7 +4,13 @@
 // labels (the fit alone). A true surface is an object's curved part (can or mug side, the inside
 // of a mug, a ball, a bowl's outside or inside, a ring) with 50 or more truly labeled points; it
 // is found when a primitive of its model and class has most of its points on that object. Prints
-// a row per scene, the radius and axis errors of the found surfaces and the time to fit; last
+// a row per scene, the radius and axis errors of the found surfaces and the time to fit.
+//
+// Then instances (primitive_matching.hpp): every true primitive with 50 or more scan points
+// (planes too) against the detections of each detector, scored by the same rule: primlabel from
+// the predicted labels, primlabel from the true labels and, when built with CGAL, CGAL's
+// Efficient RANSAC (cgal_ransac_peer.hpp) on the same points with the normals primlabel computed.
+// Recall, precision, radius and axis errors and wall time of each, and the speed ratio. Last
 // line: JSON.
 //
 //   primlabel-bench-primitives --model build/models/tabletop-lms400/1/model.plm --scenes 4
@@ -17,6 +23,7 @@
 #include <map>
 #include <optional>
 
+#include "primitive_matching.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/json_text.hpp"
@@ -26,6 +33,9 @@
 #include "primlabel/primitives/fit_primitives.hpp"
 #include "primlabel/synth/generate.hpp"
 #include "primlabel/synth/true_primitives.hpp"
+#ifdef PRIMLABEL_HAVE_CGAL
+#include "cgal_ransac_peer.hpp"
+#endif
 
 namespace {
 
@@ -37,6 +47,9 @@ struct Arguments {
   std::string model;
   int scenes = 4, threads = 2;
   std::uint64_t first_seed = 3000;  // the test set's seeds (synth::SceneSet::kTest)
+  // CGAL's search endurance and connectivity, to check the comparison does not hinge on them.
+  double cgal_probability = 0.01;
+  double cgal_cluster_spacings = 4;  // cluster epsilon in median point spacings
 };
 
 // A curved surface the generator placed: its model, class and true parameters (world frame).
@@ -79,9 +92,7 @@ struct Figures {
   double seconds = 0;
 };
 
-double axis_angle_deg(const Vec3d& a, const Vec3d& b) {
-  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180 / M_PI;
-}
+using bench::axis_angle_deg;
 
 // The object most points of each primitive's segment lie on.
 std::vector<int> majority_objects(const primitives::PrimitiveSet& set, const FloatField& object) {
@@ -175,10 +186,106 @@ void print(const char* what, const Figures& f, int scenes) {
   std::printf("\n");
 }
 
+// One detector's instance figures over the scenes (primitive_matching.hpp's rule).
+struct InstanceFigures {
+  std::size_t true_instances = 0, found = 0, detections = 0, correct = 0;
+  std::map<PrimitiveKind, std::pair<std::size_t, std::size_t>> by_kind;  // found, true
+  std::vector<double> cylinder_radius, sphere_radius, torus_radius, axis_deg, plane_normal_deg;
+  double seconds = 0;  // the detector's own time (fit or detection)
+};
+
+void add_match(const bench::InstanceMatch& m, const std::vector<synth::TruePrimitive>& truth,
+               const bench::MatchOptions& options, InstanceFigures& f) {
+  f.true_instances += m.true_instances;
+  f.found += m.found;
+  f.detections += m.detections;
+  f.correct += m.correct;
+  for (const auto& t : truth)
+    if (t.primitive.points >= options.min_true_points) ++f.by_kind[t.primitive.kind()].second;
+  for (const bench::MatchedPair& pair : m.pairs) {
+    const primitives::Primitive& t = truth[pair.truth].primitive;
+    if (t.points < options.min_true_points) continue;
+    ++f.by_kind[t.kind()].first;
+    switch (t.kind()) {
+      case PrimitiveKind::kCylinder:
+        f.cylinder_radius.push_back(pair.radius_error);
+        f.axis_deg.push_back(pair.axis_error_deg);
+        break;
+      case PrimitiveKind::kSphere:
+        f.sphere_radius.push_back(pair.radius_error);
+        break;
+      case PrimitiveKind::kTorus:
+        f.torus_radius.push_back(pair.radius_error);
+        f.axis_deg.push_back(pair.axis_error_deg);
+        break;
+      case PrimitiveKind::kPlane:
+        f.plane_normal_deg.push_back(pair.axis_error_deg);
+        break;
+      default:
+        break;
+    }
+  }
+}
+
+double ratio(std::size_t a, std::size_t b) { return b ? double(a) / double(b) : NAN; }
+
+json::Json instance_json(const InstanceFigures& f, int scenes) {
+  json::Json kinds = json::Json::object();
+  for (const auto& [kind, n] : f.by_kind)
+    kinds[std::string(primitives::kind_name(kind))] = {{"found", n.first}, {"true", n.second}};
+  auto mm = [](double m) { return json::rounded(1000 * m, "%.3f"); };
+  std::vector<double> radius = f.cylinder_radius;
+  radius.insert(radius.end(), f.sphere_radius.begin(), f.sphere_radius.end());
+  return {{"true_instances", f.true_instances},
+          {"found", f.found},
+          {"recall", json::rounded(ratio(f.found, f.true_instances), "%.4f")},
+          {"detections", f.detections},
+          {"correct", f.correct},
+          {"precision", json::rounded(ratio(f.correct, f.detections), "%.4f")},
+          {"by_kind", std::move(kinds)},
+          {"cylinder_sphere_radius_error_mm_median", mm(median(radius))},
+          {"cylinder_sphere_radius_error_mm_p90", mm(percentile90(radius))},
+          {"cylinder_radius_error_mm_median", mm(median(f.cylinder_radius))},
+          {"cylinder_radius_error_mm_p90", mm(percentile90(f.cylinder_radius))},
+          {"sphere_radius_error_mm_median", mm(median(f.sphere_radius))},
+          {"sphere_radius_error_mm_p90", mm(percentile90(f.sphere_radius))},
+          {"torus_major_radius_error_mm_median", mm(median(f.torus_radius))},
+          {"axis_error_deg_median", json::rounded(median(f.axis_deg), "%.3f")},
+          {"plane_normal_error_deg_median", json::rounded(median(f.plane_normal_deg), "%.3f")},
+          {"ms_per_scan", json::rounded(1000 * f.seconds / std::max(scenes, 1), "%.1f")}};
+}
+
+void print_instances(const char* what, const InstanceFigures& f, int scenes) {
+  std::vector<double> radius = f.cylinder_radius;
+  radius.insert(radius.end(), f.sphere_radius.begin(), f.sphere_radius.end());
+  std::printf(
+      "%-22s recall %zu/%zu = %.3f, precision %zu/%zu = %.3f; radius error median/p90 (mm): "
+      "cylinders %.2f/%.2f (%zu), spheres %.2f/%.2f (%zu), both %.2f/%.2f; axes %.2f deg; "
+      "plane normals %.2f deg; %.0f ms/scan\n",
+      what, f.found, f.true_instances, ratio(f.found, f.true_instances), f.correct, f.detections,
+      ratio(f.correct, f.detections), 1000 * median(f.cylinder_radius),
+      1000 * percentile90(f.cylinder_radius), f.cylinder_radius.size(),
+      1000 * median(f.sphere_radius), 1000 * percentile90(f.sphere_radius), f.sphere_radius.size(),
+      1000 * median(radius), 1000 * percentile90(radius), median(f.axis_deg),
+      median(f.plane_normal_deg), 1000 * f.seconds / scenes);
+  std::printf("%-22s found/true by kind:", "");
+  for (const auto& [kind, n] : f.by_kind)
+    std::printf(" %s %zu/%zu", std::string(primitives::kind_name(kind)).c_str(), n.first, n.second);
+  std::printf("\n");
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 int run(const Arguments& args) {
   const LabelModel model = load_model(args.model);
   const RunContext context{args.threads, {}, {}};
   Figures predicted, truth;
+  const bench::MatchOptions match_options;
+  InstanceFigures predicted_instances, truth_instances, cgal_instances;
+  double label_seconds = 0;  // label_cloud end to end: normals, descriptors, CRF, primitives
+  [[maybe_unused]] std::size_t cgal_degenerate = 0;
   for (int s = 0; s < args.scenes; ++s) {
     synth::GenerateOptions options;
     options.seed = args.first_seed + std::uint64_t(s);
@@ -194,19 +301,52 @@ int run(const Arguments& args) {
         if (int(objects.values[i]) == surfaces[t].object && true_labels[i] == surfaces[t].class_id)
           ++true_points[t];
 
+    std::vector<synth::TruePrimitive> instances = synth::true_primitives(g.scene);
+    synth::count_points_on(instances, g.cloud, match_options.tolerance);
+
     pipeline::LabelingOptions labeling;
     labeling.want_primitives = true;
+    const auto label_start = std::chrono::steady_clock::now();
     const pipeline::LabelingResult result =
         pipeline::label_cloud(model, g.cloud, labeling, context);
+    label_seconds += seconds_since(label_start);
     predicted.seconds += result.primitive_seconds;
     score(*result.primitives, surfaces, true_points, objects, predicted);
+    predicted_instances.seconds += result.primitive_seconds;
+    add_match(bench::match_instances(*result.primitives, g.cloud.xyz, objects.values, instances,
+                                     match_options),
+              instances, match_options, predicted_instances);
 
     const auto start = std::chrono::steady_clock::now();
     const primitives::PrimitiveSet from_truth = primitives::fit_primitives(
         g.cloud.xyz, g.cloud.normals, true_labels, labeling.primitives, context);
-    truth.seconds +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    truth.seconds += seconds_since(start);
+    truth_instances.seconds += seconds_since(start);
     score(from_truth, surfaces, true_points, objects, truth);
+    add_match(
+        bench::match_instances(from_truth, g.cloud.xyz, objects.values, instances, match_options),
+        instances, match_options, truth_instances);
+#ifdef PRIMLABEL_HAVE_CGAL
+    // The same points with primlabel's normals (label_cloud left them in the cloud).
+    auto cgal_parameters = bench::CgalRansacParameters::for_spacing(result.point_spacing);
+    cgal_parameters.probability = args.cgal_probability;
+    cgal_parameters.cluster_epsilon *= args.cgal_cluster_spacings / 4;
+    const bench::CgalDetections cgal =
+        bench::detect_with_cgal(g.cloud.xyz, g.cloud.normals, cgal_parameters);
+    cgal_instances.seconds += cgal.seconds;
+    cgal_degenerate += cgal.degenerate;
+    add_match(
+        bench::match_instances(cgal.set, g.cloud.xyz, objects.values, instances, match_options),
+        instances, match_options, cgal_instances);
+    std::printf(
+        "seed %llu: CGAL Efficient RANSAC %zu shapes (%zu degenerate, reported as their limit) "
+        "in %.0f ms; epsilon %.1f mm, normals within %.0f deg, cluster epsilon %.1f mm, min "
+        "points %zu\n",
+        static_cast<unsigned long long>(options.seed), cgal.set.primitives.size(), cgal.degenerate,
+        1000 * cgal.seconds, 1000 * cgal_parameters.epsilon,
+        std::acos(cgal_parameters.normal_threshold) * 180 / M_PI,
+        1000 * cgal_parameters.cluster_epsilon, cgal_parameters.min_points);
+#endif
     std::printf(
         "seed %llu: %zu points, %s; %zu primitives from predicted labels in %.0f ms "
         "(segments %.0f ms)\n",
@@ -216,10 +356,37 @@ int run(const Arguments& args) {
   }
   print("predicted labels", predicted, args.scenes);
   print("true labels", truth, args.scenes);
-  const json::Json line = {{"scenes", args.scenes},
-                           {"threads", args.threads},
-                           {"predicted_labels", figures_json(predicted, args.scenes)},
-                           {"true_labels", figures_json(truth, args.scenes)}};
+  std::printf("instances (all true primitives with >= %zu points, planes included):\n",
+              match_options.min_true_points);
+  print_instances("primlabel, predicted", predicted_instances, args.scenes);
+  print_instances("primlabel, true labels", truth_instances, args.scenes);
+  std::printf("%-22s label_cloud end to end %.0f ms/scan (%d threads)\n", "",
+              1000 * label_seconds / args.scenes, args.threads);
+  json::Json line = {
+      {"scenes", args.scenes},
+      {"threads", args.threads},
+      {"predicted_labels", figures_json(predicted, args.scenes)},
+      {"true_labels", figures_json(truth, args.scenes)},
+      {"instances_predicted_labels", instance_json(predicted_instances, args.scenes)},
+      {"instances_true_labels", instance_json(truth_instances, args.scenes)},
+      {"label_cloud_ms_per_scan", json::rounded(1000 * label_seconds / args.scenes, "%.1f")}};
+#ifdef PRIMLABEL_HAVE_CGAL
+  print_instances("CGAL Efficient RANSAC", cgal_instances, args.scenes);
+  const double fit_speedup = cgal_instances.seconds / predicted_instances.seconds;
+  const double end_to_end_speedup = cgal_instances.seconds / label_seconds;
+  std::printf(
+      "%-22s CGAL is single-threaded; primlabel on %d threads is %.1fx faster fitting (%.1fx "
+      "with labeling end to end, normals excluded from CGAL's time)\n",
+      "", args.threads, fit_speedup, end_to_end_speedup);
+  line["instances_cgal"] = instance_json(cgal_instances, args.scenes);
+  line["cgal_degenerate_shapes"] = cgal_degenerate;
+  line["cgal_over_primlabel_fit_time"] = json::rounded(fit_speedup, "%.2f");
+  line["cgal_over_primlabel_label_cloud_time"] = json::rounded(end_to_end_speedup, "%.2f");
+#else
+  std::printf(
+      "CGAL not found at build time: no Efficient RANSAC comparison (install libcgal-dev)\n");
+  line["instances_cgal"] = nullptr;
+#endif
   std::printf("%s\n", json::dump(line).c_str());
   return kExitOk;
 }
@@ -237,6 +404,15 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 100));
   app.add_option("--first-seed", args.first_seed, "seed of the first scene");
   app.add_option("--threads", args.threads, "worker threads")->check(CLI::PositiveNumber);
+  app.add_option(
+         "--cgal-probability", args.cgal_probability,
+         "CGAL Efficient RANSAC: chance of missing the largest shape (lower: longer search)")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->capture_default_str();
+  app.add_option("--cgal-cluster-spacings", args.cgal_cluster_spacings,
+                 "CGAL Efficient RANSAC: cluster epsilon in median point spacings")
+      ->check(CLI::Range(0.5, 100.0))
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

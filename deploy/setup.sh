@@ -13,7 +13,8 @@
 #                           DIR/tabletop-kinect/1/model.plm
 #
 # Environment: BUILD_DIR (default build), BUILD_TYPE (Release), JOBS (nproc),
-#              PRIMLABEL_WITH_PCL=1 also installs libpcl-dev so benchmarks compare against PCL,
+#              PRIMLABEL_WITH_PCL=1 also installs libpcl-dev and libcgal-dev so benchmarks compare
+#              against PCL and CGAL (`test` installs libcgal-dev too),
 #              CMAKE_ARGS extra arguments for cmake (e.g. -DPRIMLABEL_NATIVE=ON).
 set -euo pipefail
 
@@ -38,12 +39,14 @@ PACKAGES=(
 # three-replica proof), TLS certificates made on the fly, clang with libFuzzer for the fuzz
 # targets (tests/fuzz), the Python client's runtime and pytest (client/python; its stubs come
 # from protoc and protobuf-compiler-grpc's grpc_python_plugin, above), Open3D for the
-# interoperability check (tests/interop), and ROS 1 (roscpp, sensor_msgs, std_msgs and rosmaster)
-# for the ROS node client/ros and its test ros.LabelsPointCloud2.
+# interoperability check (tests/interop), CGAL for the Efficient RANSAC peer's test
+# (tests/test_cgal_peer), and ROS 1 (roscpp, sensor_msgs, std_msgs and rosmaster) for the ROS
+# node client/ros and its test ros.LabelsPointCloud2.
 TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl clang-14 libclang-rt-14-dev
-  python3-grpcio python3-numpy python3-protobuf python3-pytest python3-open3d
+  python3-grpcio python3-numpy python3-protobuf python3-pytest python3-open3d libcgal-dev
   libroscpp-dev libsensor-msgs-dev libstd-msgs-dev python3-rosmaster)
-[[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev)
+# The benchmarks' peers: PCL (features, table-top) and CGAL's Efficient RANSAC (primitives).
+[[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev libcgal-dev)
 [[ "${1:-}" == test ]] && PACKAGES+=("${TEST_PACKAGES[@]}")
 
 log() { echo "[setup] $*" >&2; }
