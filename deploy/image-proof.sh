@@ -169,6 +169,7 @@ entrypoint=$(inspect '{{json .Config.Entrypoint}}')
 mkdir -p "$ROOTFS"
 cid=$("$PODMAN" create --pull=never "$IMAGE")
 "$PODMAN" export "$cid" | tar -C "$ROOTFS" -x
+chmod 755 "$ROOTFS"
 "$PODMAN" rm "$cid" >/dev/null
 [[ ! -e "$ROOTFS/src" ]] && pass "no build tree in the runtime image" || fail "/src in the runtime image"
 mount -t proc proc "$ROOTFS/proc" && MOUNTS+=("$ROOTFS/proc")

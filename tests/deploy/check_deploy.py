@@ -125,7 +125,7 @@ def check_dockerfile(path):
     # The build stage compiles only what the image ships and what make-default-model.sh runs.
     build_env = " ".join(rest for stage in build_stages for k, rest in stage["instructions"]
                          if k in ("ENV", "ARG"))
-    targets_match = re.search(r'BUILD_TARGETS="([^"]*)"', build_env)
+    targets_match = re.search(r'\bBUILD_TARGETS="([^"]*)"', build_env)
     if not targets_match:
         problems.add("the build stage sets no BUILD_TARGETS (it would build every tool)")
     else:
