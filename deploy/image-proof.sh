@@ -5,7 +5,7 @@
 #      into podman as debian:12 (cached: made once, then reused);
 #   2. build: `podman build --format docker` of deploy/Dockerfile from the repository root (the
 #      docker format keeps the HEALTHCHECK, which OCI drops); checks the image's user, ports,
-#      healthcheck and entrypoint, and prints its size;
+#      healthcheck and entrypoint, and prints its size (--no-build checks an IMAGE built before);
 #   3. run: primlabel-server from the image on 127.0.0.1 with free ports (`podman run` where the
 #      sandbox allows containers, else the image's exported root filesystem under chroot, as the
 #      image's user 10001 with the image's environment);
@@ -15,7 +15,7 @@
 #   5. compose: the nginx and Prometheus images of deploy/compose.yaml build and hold Debian's
 #      nginx 1.22 and Prometheus 2.42, the versions deploy/local-proof.sh runs (--no-compose skips).
 #
-#   deploy/image-proof.sh [--no-compose] [--rebuild-base]
+#   deploy/image-proof.sh [--no-compose] [--rebuild-base] [--no-build]
 #
 # About 20-25 minutes on 2 cores the first time (the build stage compiles the server and trains
 # the default models); later runs reuse podman's layer cache while the sources are unchanged.
@@ -39,6 +39,7 @@ SAMPLE=${SAMPLE:-/work/shared/data/pcl/bun0.pcd}
 [[ -f "$SAMPLE" ]] || SAMPLE=$ROOT/tests/data/samples/bun0.pcd
 COMPOSE=1
 REBUILD_BASE=0
+BUILD=1
 SKIP=77
 
 usage() { sed -n '18p' "${BASH_SOURCE[0]}" | sed 's/^#   /usage: /'; }
@@ -46,6 +47,7 @@ while [[ $# -gt 0 ]]; do
   case $1 in
     --no-compose) COMPOSE=0; shift ;;
     --rebuild-base) REBUILD_BASE=1; shift ;;
+    --no-build) BUILD=0; shift ;;
     -h | --help) usage; exit 0 ;;
     *) usage >&2; exit 2 ;;
   esac
@@ -148,9 +150,14 @@ build_image() {  # TAG CONTEXT DOCKERFILE
   "$PODMAN" build --format docker --pull=never "${ISOLATION[@]}" --network host \
     -f "$3" -t "$1" "$2" >"$WORK/build-${1##*/}.log" 2>&1
 }
-build_started=$SECONDS
-build_image "$IMAGE" "$ROOT" "$ROOT/deploy/Dockerfile" || die "the image did not build"
-pass "built $IMAGE in $((SECONDS - build_started)) s ($(grep -c 'Using cache' "$WORK/build-${IMAGE##*/}.log" || true) cached steps)"
+if [[ $BUILD -eq 1 ]]; then
+  build_started=$SECONDS
+  build_image "$IMAGE" "$ROOT" "$ROOT/deploy/Dockerfile" || die "the image did not build"
+  pass "built $IMAGE in $((SECONDS - build_started)) s ($(grep -c 'Using cache' "$WORK/build-${IMAGE##*/}.log" || true) cached steps)"
+else
+  "$PODMAN" image exists "$IMAGE" || die "--no-build: no image $IMAGE"
+  log "--no-build: checking $IMAGE as it is"
+fi
 
 inspect() { "$PODMAN" image inspect --format "$1" "$IMAGE"; }
 size=$(inspect '{{.Size}}')
