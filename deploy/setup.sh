@@ -15,7 +15,10 @@
 # Environment: BUILD_DIR (default build), BUILD_TYPE (Release), JOBS (nproc),
 #              PRIMLABEL_WITH_PCL=1 also installs libpcl-dev and libcgal-dev so benchmarks compare
 #              against PCL and CGAL (`test` installs libcgal-dev too),
-#              CMAKE_ARGS extra arguments for cmake (e.g. -DPRIMLABEL_NATIVE=ON).
+#              CMAKE_ARGS extra arguments for cmake (e.g. -DPRIMLABEL_NATIVE=ON),
+#              BUILD_TARGETS builds only these targets (default: all; the image's build stage
+#              names the three it needs), PRIMLABEL_IMAGE_PROOF=1 also installs podman, buildah
+#              and debootstrap for deploy/image-proof.sh.
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -48,6 +51,9 @@ TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl clang-14 libclang-r
 # The benchmarks' peers: PCL (features, table-top) and CGAL's Efficient RANSAC (primitives).
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev libcgal-dev)
 [[ "${1:-}" == test ]] && PACKAGES+=("${TEST_PACKAGES[@]}")
+# Only deploy/image-proof.sh needs these (it builds the image from a debootstrapped base).
+IMAGE_PROOF_PACKAGES=(podman buildah debootstrap fuse-overlayfs uidmap curl)
+[[ "${PRIMLABEL_IMAGE_PROOF:-0}" == 1 ]] && PACKAGES+=("${IMAGE_PROOF_PACKAGES[@]}")
 
 log() { echo "[setup] $*" >&2; }
 
@@ -71,7 +77,10 @@ install_packages() {
 build() {
   # shellcheck disable=SC2086
   cmake -S "$ROOT" -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE="$BUILD_TYPE" ${CMAKE_ARGS:-} >/dev/null
-  cmake --build "$BUILD_DIR" -j "$JOBS"
+  local targets=()
+  # shellcheck disable=SC2206
+  [[ -n "${BUILD_TARGETS:-}" ]] && targets=(--target ${BUILD_TARGETS})
+  cmake --build "$BUILD_DIR" -j "$JOBS" "${targets[@]}"
 }
 
 # The default model repository: one CRF + FPFH model per sensor, each from 8 synthetic table

@@ -122,6 +122,19 @@ def check_dockerfile(path):
                    "no build stage runs deploy/setup.sh build")
     problems.check(any("deploy/make-default-model.sh" in run for run in build_runs),
                    "no build stage runs deploy/make-default-model.sh")
+    # The build stage compiles only what the image ships and what make-default-model.sh runs.
+    build_env = " ".join(rest for stage in build_stages for k, rest in stage["instructions"]
+                         if k in ("ENV", "ARG"))
+    targets_match = re.search(r'\bBUILD_TARGETS="([^"]*)"', build_env)
+    if not targets_match:
+        problems.add("the build stage sets no BUILD_TARGETS (it would build every tool)")
+    else:
+        targets = set(targets_match.group(1).split())
+        shipped = set(re.findall(r"/src/build/bin/([\w.-]+)",
+                                 " ".join(rest for k, rest in stages[-1]["instructions"]
+                                          if k == "COPY")))
+        for target in sorted(shipped | {"primlabel-train"}):
+            problems.check(target in targets, "BUILD_TARGETS lacks %s" % target)
 
     final_args = lambda key: [rest for k, rest in final["instructions"] if k == key]
     users = final_args("USER")
@@ -403,6 +416,110 @@ def check_k8s(directory):
     return problems.finish()
 
 
+# ---------------------------------------------------------------------------------------------
+# .dockerignore (the build context of deploy/Dockerfile is the repository root)
+
+
+def dockerignore_pattern(pattern):
+    """A regular expression for one .dockerignore pattern (Go filepath.Match plus **)."""
+    out, i = "", 0
+    while i < len(pattern):
+        if pattern.startswith("**", i):
+            out += ".*"
+            i += 2
+            if pattern.startswith("/", i):
+                out, i = out[:-2] + "(.*/)?", i + 1
+        elif pattern[i] == "*":
+            out, i = out + "[^/]*", i + 1
+        elif pattern[i] == "?":
+            out, i = out + "[^/]", i + 1
+        else:
+            out, i = out + re.escape(pattern[i]), i + 1
+    return re.compile(out + r"\Z")
+
+
+def dockerignored(rules, path):
+    """Whether `path` (relative to the context) is left out: it or a parent matches, last rule wins."""
+    parts = path.split("/")
+    candidates = ["/".join(parts[:n]) for n in range(1, len(parts) + 1)]
+    excluded = False
+    for negated, regex in rules:
+        if any(regex.match(candidate) for candidate in candidates):
+            excluded = not negated
+    return excluded
+
+
+def check_dockerignore(root):
+    problems = Problems()
+    path = os.path.join(root, ".dockerignore")
+    if not os.path.isfile(path):
+        problems.add("no .dockerignore at the repository root (the build context)")
+        return problems.finish()
+    rules = []
+    with open(path, encoding="utf-8") as stream:
+        for line in stream:
+            line = line.strip()
+            if not line or line.startswith("#"):
+                continue
+            negated = line.startswith("!")
+            line = os.path.normpath(line.lstrip("!").strip()).lstrip("/")
+            rules.append((negated, dockerignore_pattern(line)))
+    for left_out in (".git/HEAD", "build/CMakeCache.txt", "build/bin/primlabel-server",
+                     "build-asan/CMakeCache.txt", "models/tabletop-lms400/1/model.plm",
+                     "out/scan_labeled.pcd"):
+        problems.check(dockerignored(rules, left_out), ".dockerignore keeps %s" % left_out)
+    for needed in ("CMakeLists.txt", "deploy/setup.sh", "deploy/make-default-model.sh",
+                   "deploy/Dockerfile", "core/CMakeLists.txt", "server/src/server_main.cpp",
+                   "client/CMakeLists.txt", "api/primlabel/v1/model.proto"):
+        problems.check(not dockerignored(rules, needed), ".dockerignore leaves out %s" % needed)
+    # BuildKit prefers <Dockerfile>.dockerignore over the root file and podman ignores it: one file.
+    problems.check(not os.path.exists(os.path.join(root, "deploy", "Dockerfile.dockerignore")),
+                   "deploy/Dockerfile.dockerignore overrides .dockerignore under BuildKit only")
+    return problems.finish()
+
+
+# Compose's nginx and Prometheus: the Debian 12 packages deploy/local-proof.sh runs.
+COMPOSE_DEBIAN_PACKAGES = {"nginx": "1.22", "prometheus": "2.42"}
+
+
+def check_compose_versions(path):
+    try:
+        import yaml  # noqa: F401
+    except ImportError:
+        return skip("PyYAML not installed (Debian: python3-yaml)")
+    problems = Problems()
+    base = os.path.dirname(os.path.abspath(path))
+    services = load_yaml_documents(path)[0].get("services", {})
+    for package, version in COMPOSE_DEBIAN_PACKAGES.items():
+        build = (services.get(package) or {}).get("build")
+        if not isinstance(build, dict):
+            problems.add("%s: not built from Debian's %s %s (image %s)"
+                         % (package, package, version, (services.get(package) or {}).get("image")))
+            continue
+        dockerfile = os.path.join(base, build.get("context", "."), build.get("dockerfile", "Dockerfile"))
+        if not os.path.isfile(dockerfile):
+            problems.add("%s: Dockerfile %s missing" % (package, dockerfile))
+            continue
+        stages = dockerfile_stages(dockerfile)
+        problems.check(stages and re.fullmatch(r"debian:(12|bookworm)(-slim)?", stages[-1]["from"]),
+                       "%s: image is not FROM debian:12" % package)
+        pins = installed_runtime_packages(stages[-1]) if stages else []
+        problems.check("%s=%s.*" % (package, version) in pins,
+                       "%s: Dockerfile does not install %s=%s.* (installs %s)"
+                       % (package, package, version, " ".join(pins) or "nothing"))
+        tag = str(services[package].get("image", ""))
+        problems.check(tag.split(":")[-1].startswith(version),
+                       "%s: image tag %s does not name %s" % (package, tag, version))
+        # The local proof runs the host's package: it must be the pinned major.minor.
+        host = subprocess.run(["dpkg-query", "-W", "-f", "${Version}", package],
+                              capture_output=True, text=True) if shutil.which("dpkg-query") else None
+        if host and host.returncode == 0 and host.stdout:
+            problems.check(host.stdout.startswith(version + "."),
+                           "%s: the local proof runs %s %s, compose pins %s"
+                           % (package, package, host.stdout, version))
+    return problems.finish()
+
+
 def compose_replicas(compose):
     return sorted(name for name, service in compose.get("services", {}).items()
                   if str((service.get("build") or {}).get("dockerfile", "")).endswith("deploy/Dockerfile")
@@ -545,6 +662,8 @@ CHECKS = {
     "yaml": check_yaml,
     "k8s": check_k8s,
     "compose": check_compose,
+    "compose-versions": check_compose_versions,
+    "dockerignore": check_dockerignore,
     "targets": check_prometheus_targets,
     "alert-metrics": check_alert_metrics,
     "promtool": check_promtool,

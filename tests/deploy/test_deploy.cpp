@@ -124,9 +124,26 @@ TEST(Deploy, MakeDefaultModelIsExecutableAndWrapsSetup) {
   EXPECT_EQ(run_command(script).exit_code, 2);  // usage
 }
 
+TEST(Deploy, DockerignoreKeepsBuildTreesAndGitOutOfTheImage) {
+  EXPECT_CHECK_PASSES("dockerignore " + std::string(PRIMLABEL_SOURCE_DIR));
+}
+
+TEST(Deploy, ComposeNginxAndPrometheusAreTheLocalProofsDebianVersions) {
+  EXPECT_CHECK_PASSES("compose-versions " + source_path("deploy/compose.yaml"));
+}
+
+// The image proof itself is opt-in (about 20 min, deploy/README.md); here only its exit codes.
+TEST(Deploy, ImageProofRejectsBadUsageAndSkipsWithoutItsTools) {
+  const std::string script = source_path("deploy/image-proof.sh");
+  EXPECT_EQ(run_command(script + " --no-such-option").exit_code, 2);
+  const auto missing = run_command("PODMAN=/nonexistent/podman " + script);
+  EXPECT_EQ(missing.exit_code, kSkipped) << missing.output;
+  EXPECT_NE(missing.output.find("SKIP"), std::string::npos) << missing.output;
+}
+
 TEST(Deploy, ShellScriptsParse) {
-  for (const char* script :
-       {"deploy/setup.sh", "deploy/make-default-model.sh", "deploy/local-proof.sh"}) {
+  for (const char* script : {"deploy/setup.sh", "deploy/make-default-model.sh",
+                             "deploy/local-proof.sh", "deploy/image-proof.sh"}) {
     const auto result = run_command("bash -n " + source_path(script));
     EXPECT_EQ(result.exit_code, 0) << script << "\n" << result.output;
     EXPECT_EQ(access(source_path(script).c_str(), X_OK), 0) << script << " is not executable";
@@ -148,6 +165,50 @@ TEST_F(BrokenCopy, DockerfileWithoutUserMetricsPortOrHealthcheckFails) {
   const auto result = run_check("dockerfile " + path("deploy/Dockerfile"));
   EXPECT_EQ(result.exit_code, 1);
   for (const char* expected : {"no USER", "EXPOSE 9464", "no HEALTHCHECK", "setup.sh build"})
+    EXPECT_NE(result.output.find(expected), std::string::npos) << expected << "\n" << result.output;
+}
+
+TEST_F(BrokenCopy, BuildStageBuildingTooLittleFails) {
+  edit("deploy/Dockerfile", "BUILD_TARGETS=\"primlabel-server primlabel primlabel-train\"",
+       "BUILD_TARGETS=\"primlabel-server\"");
+  const auto result = run_check("dockerfile " + path("deploy/Dockerfile"));
+  EXPECT_EQ(result.exit_code, 1);
+  for (const char* expected : {"BUILD_TARGETS lacks primlabel\n", "lacks primlabel-train"})
+    EXPECT_NE(result.output.find(expected), std::string::npos) << expected << "\n" << result.output;
+}
+
+TEST_F(BrokenCopy, BuildStageBuildingEveryToolFails) {
+  edit("deploy/Dockerfile", "BUILD_TARGETS=", "NOT_BUILD_TARGETS=");
+  EXPECT_CHECK_FAILS_WITH("dockerfile " + path("deploy/Dockerfile"), "sets no BUILD_TARGETS");
+}
+
+TEST_F(BrokenCopy, DockerignoreKeepingBuildOrGitFails) {
+  fs::copy_file(source_path(".dockerignore"), path(".dockerignore"));
+  edit(".dockerignore", "\n.git\n", "\n");
+  edit(".dockerignore", "\nbuild\n", "\n");
+  const auto result = run_check("dockerignore " + root_);
+  EXPECT_EQ(result.exit_code, 1);
+  for (const char* expected : {"keeps .git/HEAD", "keeps build/CMakeCache.txt"})
+    EXPECT_NE(result.output.find(expected), std::string::npos) << expected << "\n" << result.output;
+}
+
+TEST_F(BrokenCopy, MissingOrOverriddenDockerignoreFails) {
+  EXPECT_CHECK_FAILS_WITH("dockerignore " + root_, "no .dockerignore at the repository root");
+  fs::copy_file(source_path(".dockerignore"), path(".dockerignore"));
+  std::ofstream(path("deploy/Dockerfile.dockerignore")) << ".git\n";
+  EXPECT_CHECK_FAILS_WITH("dockerignore " + root_, "deploy/Dockerfile.dockerignore overrides");
+}
+
+TEST_F(BrokenCopy, ComposeWithUpstreamNginxOrUnpinnedPrometheusFails) {
+  edit("deploy/compose.yaml",
+       "image: primlabel-nginx:1.22-bookworm\n    build:\n      context: ./nginx\n"
+       "      dockerfile: Dockerfile\n",
+       "image: nginx:1.27-bookworm\n");
+  edit("deploy/prometheus/Dockerfile", "'prometheus=2.42.*'", "prometheus");
+  const auto result = run_check("compose-versions " + path("deploy/compose.yaml"));
+  EXPECT_EQ(result.exit_code, 1);
+  for (const char* expected :
+       {"nginx: not built from Debian's nginx 1.22", "does not install prometheus=2.42.*"})
     EXPECT_NE(result.output.find(expected), std::string::npos) << expected << "\n" << result.output;
 }
 
