@@ -35,7 +35,8 @@ struct Arguments {
   std::size_t svm_max_points = 20000;
   std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
   float feature_radius = 0.025f, normal_radius = 0.01f;
-  float voxel_size = 0.0f;  // > 0: train on voxels of this edge and record it in the model
+  float voxel_size = 0.0f;      // > 0: train on voxels of this edge and record it in the model
+  float feature_sample = 0.0f;  // > 0: FPFH against one point per voxel of this edge
   std::vector<std::string> train_files, val_files;
   std::string classes, output, curve_csv, curve_png, name, augment;
   synth::Augmentation augmentation;  // --augment, parsed
@@ -108,6 +109,7 @@ int run(const Arguments& args) {
       args.fpfh_variant == "paper" ? FpfhVariant::kWithOwnSpfh : FpfhVariant::kPcl;
   features.normals = Neighborhood::Radius(args.normal_radius);
   features.features = Neighborhood::Radius(args.feature_radius);
+  features.feature_sample_size = args.feature_sample;
   crf::GraphSettings graph;
   graph.neighborhood = Neighborhood::Knn(args.graph_k);
 
@@ -243,6 +245,11 @@ int main(int argc, char** argv) {
   app.add_option("--voxel-size", args.voxel_size,
                  "train on voxel centroids of this edge (m) and record it: the model is served "
                  "at that density (default 0: every point)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--feature-sample", args.feature_sample,
+                 "FPFH neighbourhoods hold one point per voxel of this edge (m; every point is "
+                 "still described and labeled) and the model records it (default 0: every "
+                 "neighbour)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--normal-radius", args.normal_radius, "normal radius (m, default 0.01)")
       ->check(CLI::PositiveNumber);

@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -104,6 +105,7 @@ v1::Model to_proto(const LabelModel& m) {
   set_neighborhood(m.features.features, &radius, &k, &max_nn);
   f->set_feature_radius(radius), f->set_feature_k(k), f->set_max_neighbors(max_nn);
   f->set_voxel_size(m.features.voxel_size);
+  f->set_feature_sample_size(m.features.feature_sample_size);
   f->set_radii_overridable(m.features.radii_overridable);
 
   v1::GraphParameters* g = out.mutable_graph();
@@ -198,6 +200,9 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
   m.features.features =
       neighborhood_from(f.feature_radius(), f.feature_k(), f.max_neighbors(), source, "feature");
   m.features.voxel_size = f.voxel_size();
+  m.features.feature_sample_size = f.feature_sample_size();
+  if (!(m.features.feature_sample_size >= 0.0f) || !std::isfinite(m.features.feature_sample_size))
+    fail(source, "feature_sample_size must be finite and >= 0");
   m.features.radii_overridable = f.radii_overridable();
 
   const v1::GraphParameters& g = in.graph();

@@ -10,6 +10,7 @@
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/normals.hpp"
 #include "primlabel/geometry/point_spacing.hpp"
+#include "primlabel/pipeline/feature_sample.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 
 namespace primlabel::pipeline {
@@ -88,10 +89,16 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   const RunContext stage{context.threads, context.stop, {}};
   const Neighborhood normal_hood = capped(settings.normals);
   const Neighborhood feature_hood = capped(settings.features);
+  const bool fpfh = settings.descriptor == DescriptorKind::kFpfh;
+  // A sampled FPFH searches the sample, not the cloud: only normals and the graph share lists.
+  const bool sampled = fpfh && settings.feature_sample_size > 0.0f;
   const std::optional<Neighborhood> shared =
-      shared_neighborhood(options.use_cloud_normals ? feature_hood : normal_hood, feature_hood);
+      sampled ? (options.use_cloud_normals ? std::nullopt
+                                           : shared_neighborhood(normal_hood, normal_hood))
+              : shared_neighborhood(options.use_cloud_normals ? feature_hood : normal_hood,
+                                    feature_hood);
   const auto lists_start = std::chrono::steady_clock::now();
-  if (shared && options.share_neighbor_lists && settings.descriptor == DescriptorKind::kFpfh &&
+  if (shared && options.share_neighbor_lists && fpfh &&
       sharing_pays(cloud.xyz, *out.search, *shared)) {
     out.lists =
         std::make_unique<NeighborLists>(cloud.xyz, *out.search, *shared, kSharedListBytes, stage);
@@ -113,10 +120,16 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   FeatureOptions feature_options;
   feature_options.neighborhood = feature_hood;
   feature_options.fpfh_variant = settings.fpfh_variant;
-  const bool fpfh = settings.descriptor == DescriptorKind::kFpfh;
-  out.descriptors =
-      fpfh ? compute_fpfh(cloud, feature_options, stage, nullptr, out.search.get(), out.lists.get())
-           : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
+  if (sampled) {
+    // Every point described against the sample's points (same indices as the cloud).
+    const std::vector<Vec3f> sample = voxel_sample(cloud.xyz, settings.feature_sample_size, stage);
+    const NeighborSearch sample_search(sample, context.stop);
+    out.descriptors = compute_fpfh(cloud, feature_options, stage, nullptr, &sample_search, nullptr);
+  } else {
+    out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, stage, nullptr, out.search.get(),
+                                          out.lists.get())
+                           : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
+  }
   out.feature_seconds = seconds_since(start);
   return out;
 }

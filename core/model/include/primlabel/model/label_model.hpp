@@ -36,7 +36,10 @@ struct FeatureSettings {
   FpfhVariant fpfh_variant = FpfhVariant::kPcl;
   Neighborhood normals = Neighborhood::Radius(0.01f);
   Neighborhood features = Neighborhood::Radius(0.025f);
-  float voxel_size = 0.0f;         // downsampling before features; 0 = none
+  float voxel_size = 0.0f;  // downsampling before features; 0 = none
+  // > 0: FPFH neighbourhoods hold one point per voxel of this edge (every point is still
+  // described, against the sample): fewer pairs per point on dense scans; 0 = every neighbour.
+  float feature_sample_size = 0.0f;
   bool radii_overridable = false;  // whether a request may change the radii
 
   int descriptor_dim() const { return descriptor == DescriptorKind::kFpfh ? kFpfhSize : kPfhSize; }
