@@ -8,6 +8,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <limits>
 
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/model/label_model.hpp"
@@ -60,6 +61,11 @@ LabelModel sample_svm() {
   m.svm_class_ids = m.weights.class_ids;
   m.weights.feature_scale = 0.02f;
   return m;
+}
+
+LabelModel load_model_bytes_roundtrip(const test::TempDir& dir, const LabelModel& model) {
+  save_model(dir.file("roundtrip.plm"), model);
+  return load_model(dir.file("roundtrip.plm"));
 }
 
 TEST(LabelModel, CrfRoundTrip) {
@@ -231,6 +237,23 @@ std::string load_error(const std::string& path) {
     return e.what();
   }
   return "";
+}
+
+// The opt-in sampled FPFH (feature_sample_size) survives a save, and a model that carries a
+// negative or non-finite one is refused on load instead of describing nothing.
+TEST(LabelModel, FeatureSampleSizeRoundTripsAndBadValuesAreRefused) {
+  test::TempDir dir;
+  LabelModel saved = sample_crf();
+  EXPECT_EQ(load_model_bytes_roundtrip(dir, saved).features.feature_sample_size, 0.0f);
+  saved.features.feature_sample_size = 0.004f;
+  EXPECT_EQ(load_model_bytes_roundtrip(dir, saved).features.feature_sample_size, 0.004f);
+  for (const float bad :
+       {-0.004f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    saved.features.feature_sample_size = bad;
+    save_model(dir.file("bad.plm"), saved);
+    EXPECT_NE(load_error(dir.file("bad.plm")).find("feature_sample_size"), std::string::npos)
+        << bad;
+  }
 }
 
 TEST(LabelModel, BrokenFilesAreRefusedWithTheirNameAndReason) {

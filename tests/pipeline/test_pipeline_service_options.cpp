@@ -134,6 +134,44 @@ TEST(PipelineServiceOptions, RadiusOverridesOnlyWhenTheModelAllowsThem) {
   EXPECT_NE(wider.descriptors, own.descriptors);
 }
 
+// feature_sample_size: every point keeps its own descriptor, computed against one point per
+// voxel, so descriptors change but stay close to the full ones; the same for any thread count.
+TEST(PipelineServiceOptions, SampledFpfhDescribesEveryPointAgainstOnePointPerVoxel) {
+  LabelModel model = random_label_model();
+  pipeline::LabelingOptions options;
+  options.want_descriptors = true;
+  PointCloud full_cloud = table_with_box_cloud(0.0025f);
+  const auto full = pipeline::label_cloud(model, full_cloud, options, RunContext{2});
+  model.features.feature_sample_size = 0.005f;
+  PointCloud cloud = table_with_box_cloud(0.0025f);
+  const auto sampled = pipeline::label_cloud(model, cloud, options, RunContext{1});
+  ASSERT_EQ(sampled.labels.size(), cloud.size());
+  EXPECT_EQ(sampled.described_points, full.described_points);  // no point loses its descriptor
+  ASSERT_EQ(sampled.descriptors.values.size(), full.descriptors.values.size());
+  EXPECT_NE(sampled.descriptors.values, full.descriptors.values);
+  // Each sub-histogram still sums to 100 (PCL's normalisation), and rows stay near the full ones.
+  double mean_l1 = 0.0;
+  std::size_t rows = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const float* a = &sampled.descriptors.values[i * kFpfhSize];
+    const float* b = &full.descriptors.values[i * kFpfhSize];
+    if (std::isnan(a[0]) || std::isnan(b[0])) continue;
+    float sum = 0.0f;
+    for (int k = 0; k < kFpfhBinsPerFeature; ++k) sum += a[k];
+    if (sum == 0.0f) continue;  // isolated: zero rows in both
+    ASSERT_NEAR(sum, 100.0f, 0.05f) << i;
+    double l1 = 0.0;
+    for (int k = 0; k < kFpfhSize; ++k) l1 += std::fabs(double(a[k]) - double(b[k]));
+    mean_l1 += l1, ++rows;
+  }
+  ASSERT_GT(rows, cloud.size() / 2);
+  EXPECT_LT(mean_l1 / double(rows), 60.0);  // of 300: the same surfaces, a sparser sample
+  PointCloud again = table_with_box_cloud(0.0025f);
+  const auto two_threads = pipeline::label_cloud(model, again, options, RunContext{2});
+  EXPECT_EQ(two_threads.labels, sampled.labels);
+  EXPECT_EQ(two_threads.descriptors.values, sampled.descriptors.values);
+}
+
 TEST(PipelineServiceOptions, VoxelDownsamplingGivesEveryPointItsVoxelsResults) {
   const LabelModel model = random_label_model();
   PointCloud cloud = table_with_box_cloud(0.0025f);
