@@ -30,6 +30,23 @@ void exact_bins(const Vec3f& p1, const Vec3f& n1, const PairTargets& t, std::siz
   theta[j] = static_cast<std::uint8_t>(cosine_bin(f.theta, bins));
 }
 
+// The bins of `lanes` pairs from j on: the fast path's, except the lanes set in `redo`, which
+// the exact path recomputes. Shared by the SSE2 and AVX2 loops.
+void store_lanes(int lanes, int redo, const int* alpha_bins, const int* phi_bins,
+                 const int* theta_bins, const Vec3f& p1, const Vec3f& n1, const PairTargets& t,
+                 std::size_t j, int bins, std::uint8_t* alpha, std::uint8_t* phi,
+                 std::uint8_t* theta) {
+  for (int lane = 0; lane < lanes; ++lane) {
+    if (redo & (1 << lane)) {
+      exact_bins(p1, n1, t, j + lane, bins, alpha, phi, theta);
+      continue;
+    }
+    alpha[j + lane] = static_cast<std::uint8_t>(std::clamp(alpha_bins[lane], 0, bins - 1));
+    phi[j + lane] = static_cast<std::uint8_t>(phi_bins[lane]);
+    theta[j + lane] = static_cast<std::uint8_t>(theta_bins[lane]);
+  }
+}
+
 #if defined(__SSE2__)
 
 inline __m128 select(__m128 mask, __m128 if_true, __m128 if_false) {
@@ -164,16 +181,8 @@ __attribute__((target("avx2"))) std::size_t pair_bins_avx2(const Vec3f& p1, cons
     _mm256_store_si256(reinterpret_cast<__m256i*>(alpha_bins), whole);
     cosine_bins8(phi_value, bins, phi_bins);
     cosine_bins8(theta_value, bins, theta_bins);
-    const int redo = _mm256_movemask_ps(exact);
-    for (int lane = 0; lane < 8; ++lane) {
-      if (redo & (1 << lane)) {
-        exact_bins(p1, n1, t, j + lane, bins, alpha, phi, theta);
-        continue;
-      }
-      alpha[j + lane] = static_cast<std::uint8_t>(std::clamp(alpha_bins[lane], 0, bins - 1));
-      phi[j + lane] = static_cast<std::uint8_t>(phi_bins[lane]);
-      theta[j + lane] = static_cast<std::uint8_t>(theta_bins[lane]);
-    }
+    store_lanes(8, _mm256_movemask_ps(exact), alpha_bins, phi_bins, theta_bins, p1, n1, t, j, bins,
+                alpha, phi, theta);
   }
   return j;
 }
@@ -268,16 +277,8 @@ void pair_bins_batch(const Vec3f& p1, const Vec3f& n1, const PairTargets& t, std
     _mm_store_si128(reinterpret_cast<__m128i*>(alpha_bins), whole);
     cosine_bins(phi_value, bins, phi_bins);
     cosine_bins(theta_value, bins, theta_bins);
-    const int redo = _mm_movemask_ps(exact);
-    for (int lane = 0; lane < 4; ++lane) {
-      if (redo & (1 << lane)) {
-        exact_bins(p1, n1, t, j + lane, bins, alpha, phi, theta);
-        continue;
-      }
-      alpha[j + lane] = static_cast<std::uint8_t>(std::clamp(alpha_bins[lane], 0, bins - 1));
-      phi[j + lane] = static_cast<std::uint8_t>(phi_bins[lane]);
-      theta[j + lane] = static_cast<std::uint8_t>(theta_bins[lane]);
-    }
+    store_lanes(4, _mm_movemask_ps(exact), alpha_bins, phi_bins, theta_bins, p1, n1, t, j, bins,
+                alpha, phi, theta);
   }
 #endif
   for (; j < count; ++j) exact_bins(p1, n1, t, j, bins, alpha, phi, theta);
