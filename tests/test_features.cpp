@@ -2,12 +2,14 @@
 
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <numeric>
 #include <random>
 
 #include "pair_features_inline.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/features.hpp"
+#include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/normals.hpp"
 #include "test_util.hpp"
 
@@ -263,6 +265,122 @@ TEST(Features, RejectCloudsWithoutNormalsAndBadNeighbourhoods) {
   PointCloud empty;
   options.neighborhood = Neighborhood::Knn(5);
   EXPECT_TRUE(compute_fpfh(empty, options).empty());
+}
+
+// FPFH straight from its definition: every ordered pair computed by the scalar pair features,
+// SPFH bins as repeated additions, neighbours weighted in the search's order.
+Descriptors reference_fpfh(const PointCloud& cloud, const Neighborhood& hood) {
+  const NeighborSearch search(cloud.xyz);
+  const std::size_t n = cloud.size();
+  const auto usable = [&](std::size_t i) {
+    return is_finite(cloud.xyz[i]) && is_finite(cloud.normals[i]);
+  };
+  std::vector<std::vector<std::uint32_t>> lists(n);
+  for (std::size_t p = 0; p < n; ++p) {
+    if (!usable(p)) continue;
+    NeighborList found;
+    search.find(cloud.xyz[p], hood, found, /*sorted=*/false);
+    for (std::uint32_t q : found.indices)
+      if (usable(q)) lists[p].push_back(q);
+  }
+  constexpr int kBins = kFpfhBinsPerFeature;
+  std::vector<float> spfh(n * kFpfhSize, 0.0f);
+  std::vector<double> sums(n * 3, 0.0);
+  for (std::size_t p = 0; p < n; ++p) {
+    if (lists[p].size() < 2) continue;
+    int counts[kFpfhSize] = {};
+    for (std::uint32_t q : lists[p]) {
+      if (q == p) continue;
+      detail::PairFeatures f;
+      detail::pair_features(cloud.xyz[p], cloud.normals[p], cloud.xyz[q], cloud.normals[q], f);
+      ++counts[detail::angle_bin(f.alpha, kBins)];
+      ++counts[kBins + detail::cosine_bin(f.phi, kBins)];
+      ++counts[2 * kBins + detail::cosine_bin(f.theta, kBins)];
+    }
+    const float increment = 100.0f / static_cast<float>(lists[p].size() - 1);
+    for (int b = 0; b < kFpfhSize; ++b) {
+      float value = 0.0f;
+      for (int c = 0; c < counts[b]; ++c) value += increment;
+      spfh[p * kFpfhSize + b] = value;
+      sums[3 * p + b / kBins] += value;
+    }
+  }
+  Descriptors out(kFpfhSize, std::vector<float>(n * kFpfhSize, 0.0f));
+  for (std::size_t p = 0; p < n; ++p) {
+    float* row = out.values.data() + p * kFpfhSize;
+    if (!usable(p)) {
+      std::fill(row, row + kFpfhSize, std::numeric_limits<float>::quiet_NaN());
+      continue;
+    }
+    if (lists[p].size() < 2) continue;
+    float accumulated[kFpfhSize] = {};
+    double sum[3] = {};
+    for (std::uint32_t q : lists[p]) {
+      const Vec3f& a = cloud.xyz[p];
+      const Vec3f& b = cloud.xyz[q];
+      const float dx = a.x() - b.x(), dy = a.y() - b.y(), dz = a.z() - b.z();
+      const float sq = (dx * dx + dy * dy) + dz * dz;
+      if (sq == 0.0f) continue;
+      const float weight = 1.0f / sq;
+      for (int k = 0; k < kFpfhSize; ++k) accumulated[k] += spfh[q * kFpfhSize + k] * weight;
+      for (int s = 0; s < 3; ++s) sum[s] += sums[3 * q + s] * weight;
+    }
+    for (int s = 0; s < 3; ++s) {
+      const double scale = sum[s] != 0.0 ? 100.0 / sum[s] : 0.0;
+      for (int k = s * kBins; k < (s + 1) * kBins; ++k)
+        row[k] = static_cast<float>(accumulated[k] * scale);
+    }
+  }
+  return out;
+}
+
+// compute_fpfh computes each pair of a radius neighbourhood once and counts it for both ends;
+// that must give the definition's bits where the two ends disagree too: an exact plane (the
+// angles to the line tie), coincident points, points without a normal, lists cut by a cap.
+TEST(Fpfh, PairsComputedOnceGiveTheDefinitionsBits) {
+  PointCloud cloud;
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j) {
+      cloud.xyz.emplace_back(0.004f * i, 0.004f * j, 0.0f);
+      cloud.normals.emplace_back(0.0f, 0.0f, 1.0f);
+    }
+  const PointCloud ball = sphere_with_normals(1500, 7);
+  for (std::size_t i = 0; i < ball.size(); ++i) {
+    cloud.xyz.push_back(ball.xyz[i] + Vec3f(0.05f, 0.05f, -0.9f));
+    cloud.normals.push_back(ball.normals[i]);
+  }
+  for (std::size_t i = 0; i < 40; ++i) {  // duplicates, some with another normal
+    cloud.xyz.push_back(cloud.xyz[i * 37]);
+    cloud.normals.push_back(i % 2 ? cloud.normals[i * 37] : Vec3f(0.0f, 0.6f, 0.8f));
+  }
+  // Pairs whose angles to the line tie exactly while their normals differ: each end is its own
+  // source, and theta changes sign.
+  for (int k = 0; k < 8; ++k) {
+    const Vec3f p(1.0f + 0.1f * k, 0.0f, 0.0f);
+    cloud.xyz.push_back(p), cloud.normals.emplace_back(0.6f, 0.8f, 0.0f);
+    cloud.xyz.push_back(p + Vec3f(0.004f, 0.0f, 0.0f)),
+        cloud.normals.emplace_back(0.6f, 0.0f, 0.8f);
+  }
+  for (std::size_t i = 5; i < cloud.size(); i += 97)
+    cloud.normals[i] = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  cloud.curvature.assign(cloud.size(), 0.0f);
+
+  for (const Neighborhood& hood :
+       {Neighborhood::Radius(0.013f), Neighborhood::Hybrid(0.013f, 20)}) {
+    const Descriptors expected = reference_fpfh(cloud, hood);
+    for (int threads : {1, 2}) {
+      FeatureOptions options;
+      options.neighborhood = hood;
+      const Descriptors got = compute_fpfh(cloud, options, RunContext{threads});
+      ASSERT_EQ(got.values.size(), expected.values.size());
+      for (std::size_t i = 0; i < got.values.size(); ++i) {
+        const float a = got.values[i], b = expected.values[i];
+        ASSERT_TRUE((std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, sizeof a) == 0)
+            << hood.describe() << ", " << threads << " threads: point " << i / kFpfhSize << " bin "
+            << i % kFpfhSize << ": " << a << " vs " << b;
+      }
+    }
+  }
 }
 
 TEST(Features, IdenticalForAnyThreadCount) {

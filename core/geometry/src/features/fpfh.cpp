@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <span>
 
 #include "feature_neighborhood.hpp"
 #include "pair_bins_batch.hpp"
@@ -32,7 +33,7 @@ class NeighborCache {
       : blocks_((points + kBlock - 1) / kBlock), budget_(budget_bytes) {}
 
   // Stores the list of `point`; called by the one thread that owns the point's block.
-  void store(std::size_t point, const NeighborList& list) {
+  void store(std::size_t point, std::span<const std::uint32_t> list) {
     Block& block = blocks_[point / kBlock];
     if (block.begin.empty()) block.begin.assign(kBlock + 1, kNotCached);
     const std::size_t bytes = list.size() * sizeof(std::uint32_t);
@@ -42,17 +43,18 @@ class NeighborCache {
     }
     const std::size_t slot = point % kBlock;
     block.begin[slot] = static_cast<std::uint32_t>(block.indices.size());
-    block.indices.insert(block.indices.end(), list.indices.begin(), list.indices.end());
+    block.indices.insert(block.indices.end(), list.begin(), list.end());
     block.end[slot] = static_cast<std::uint32_t>(block.indices.size());
   }
 
-  // The cached list of `point`, or false when it has to be searched again.
-  bool load(std::size_t point, NeighborList& out) const {
+  // The cached list of `point` (valid while the cache is), or false when it has to be
+  // searched again.
+  bool load(std::size_t point, std::span<const std::uint32_t>& out) const {
     const Block& block = blocks_[point / kBlock];
     const std::size_t slot = point % kBlock;
     if (block.begin.empty() || block.begin[slot] == kNotCached) return false;
-    out.indices.assign(block.indices.begin() + block.begin[slot],
-                       block.indices.begin() + block.end[slot]);
+    out = std::span<const std::uint32_t>(block.indices.data() + block.begin[slot],
+                                         block.end[slot] - block.begin[slot]);
     return true;
   }
 
@@ -98,23 +100,48 @@ class IncrementSums {
   std::vector<float> uncached_;
 };
 
-// Scratch space of one thread for compute_spfh.
+// Whether a neighbour takes part: every point when `usable` is null (all have normals).
+inline bool takes_part(const char* usable, std::uint32_t q) { return !usable || usable[q]; }
+
+// Scratch space of one thread for the SPFH pass.
 struct SpfhScratch {
+  NeighborList list;
   detail::PairTargets targets;
-  std::vector<std::uint8_t> alpha, phi, theta;
+  std::vector<std::uint32_t> target_index;  // cloud index of each target
+  std::vector<std::uint8_t> alpha, phi, theta, one_sided;
   IncrementSums sums;
+
+  // Room for up to `pairs` targets and their batch.
+  void reserve(std::size_t pairs) {
+    const std::size_t room = batch_size(pairs);
+    targets.resize(room), target_index.resize(room);
+    alpha.resize(room), phi.resize(room), theta.resize(room), one_sided.resize(room);
+  }
+  // The batch for `pairs` (> 0) targets: rounded up to the widest lane count so that no pair
+  // falls to the slower scalar tail; the padding repeats the last target, its bins are ignored.
+  std::size_t pad(std::size_t pairs) {
+    const std::size_t batch = batch_size(pairs);
+    for (std::size_t j = pairs; j < batch; ++j)
+      targets.set(j, Vec3f(targets.x[pairs - 1], targets.y[pairs - 1], targets.z[pairs - 1]),
+                  Vec3f(targets.nx[pairs - 1], targets.ny[pairs - 1], targets.nz[pairs - 1]));
+    return batch;
+  }
+  static std::size_t batch_size(std::size_t pairs) { return (pairs + 7) / 8 * 8; }
 };
 
-void compute_spfh(const PointCloud& cloud, std::size_t p, const NeighborList& neighbors,
-                  SpfhScratch& scratch, float* spfh) {
-  scratch.targets.resize(neighbors.size());
+// Row `spfh` of point p from its neighbour list, every pair computed here (`neighbors` = how
+// many of the list take part, p included).
+void compute_spfh(const PointCloud& cloud, std::size_t p, std::span<const std::uint32_t> list,
+                  const char* usable, std::size_t neighbors, SpfhScratch& scratch, float* spfh) {
+  scratch.reserve(list.size());
   std::size_t pairs = 0;
-  for (std::uint32_t q : neighbors.indices)
-    if (q != p) scratch.targets.set(pairs++, cloud.xyz[q], cloud.normals[q]);
-  scratch.alpha.resize(pairs), scratch.phi.resize(pairs), scratch.theta.resize(pairs);
+  for (std::uint32_t q : list)
+    if (q != p && takes_part(usable, q))
+      scratch.targets.set(pairs++, cloud.xyz[q], cloud.normals[q]);
   // A degenerate pair (coincident points) still counts, with zero features: PCL does the same.
-  detail::pair_bins_batch(cloud.xyz[p], cloud.normals[p], scratch.targets, pairs, kBins,
-                          scratch.alpha.data(), scratch.phi.data(), scratch.theta.data());
+  if (pairs > 0)
+    detail::pair_bins_batch(cloud.xyz[p], cloud.normals[p], scratch.targets, scratch.pad(pairs),
+                            kBins, scratch.alpha.data(), scratch.phi.data(), scratch.theta.data());
   std::uint32_t counts[kFpfhSize] = {};
   for (std::size_t j = 0; j < pairs; ++j) {
     ++counts[scratch.alpha[j]];
@@ -122,8 +149,73 @@ void compute_spfh(const PointCloud& cloud, std::size_t p, const NeighborList& ne
     ++counts[2 * kBins + scratch.theta[j]];
   }
   // Repeated float additions, not count * increment: the rounding then matches PCL's bit for bit.
-  const float* sum_of = scratch.sums.for_neighbors(neighbors.size());
+  const float* sum_of = scratch.sums.for_neighbors(neighbors);
   for (int b = 0; b < kFpfhSize; ++b) spfh[b] = sum_of[counts[b]];
+}
+
+// A point's tag for the check that every pair a point expects was counted for it once: a sum
+// of these tells one set of points from another (an odd multiplier spreads the indices' bits).
+inline std::uint64_t tag(std::uint64_t index) { return (index + 1) * 0x9e3779b97f4a7c15ull; }
+
+// One thread's bin counts for every point, in the symmetric SPFH pass: a pair's bins are the
+// same from either end (pair_bins_batch), so each pair is computed once, by its lower-index
+// point, and counted for both. Integer counts add up the same whatever thread counted them.
+struct PairCounts {
+  std::vector<std::uint16_t> counts;    // n x kFpfhSize
+  std::vector<std::uint64_t> received;  // per point: the tags of the lower points that counted
+                                        // a pair for it
+  void init(std::size_t n) {
+    counts.assign(n * kFpfhSize, 0);
+    received.assign(n, 0);
+  }
+};
+constexpr std::size_t kPairCountBytes = kFpfhSize * sizeof(std::uint16_t) + sizeof(std::uint64_t);
+// Per-thread counts above this many bytes in all: the per-point pass instead (no result changes).
+constexpr std::size_t kPairCountBudget = std::size_t(512) << 20;
+// A bin of a point with more neighbours than this could overflow the 16-bit counts: such a
+// point's row is computed by the per-point path.
+constexpr std::size_t kMaxCountedNeighbors = 65535;
+
+// Counts the pairs of p with its higher-index neighbours, for p and for them, into `mine`;
+// returns the sum of the tags of p's lower-index neighbours (what p should receive).
+std::uint64_t count_upper_pairs(const PointCloud& cloud, std::size_t p,
+                                std::span<const std::uint32_t> list, const char* usable,
+                                SpfhScratch& scratch, PairCounts& mine) {
+  scratch.reserve(list.size());
+  std::size_t pairs = 0;
+  std::uint64_t expected = 0;
+  for (std::uint32_t q : list) {
+    if (!takes_part(usable, q)) continue;
+    if (q < p) {
+      expected += tag(q);
+    } else if (q > p) {
+      scratch.targets.set(pairs, cloud.xyz[q], cloud.normals[q]);
+      scratch.target_index[pairs++] = q;
+    }
+  }
+  if (pairs == 0) return expected;
+  detail::pair_bins_batch(cloud.xyz[p], cloud.normals[p], scratch.targets, scratch.pad(pairs),
+                          kBins, scratch.alpha.data(), scratch.phi.data(), scratch.theta.data(),
+                          scratch.one_sided.data());
+  std::uint16_t* counts = mine.counts.data();
+  std::uint16_t* own = counts + p * kFpfhSize;
+  const std::uint64_t p_tag = tag(p);
+  for (std::size_t j = 0; j < pairs; ++j) {
+    const std::uint8_t a = scratch.alpha[j], f = scratch.phi[j], t = scratch.theta[j];
+    ++own[a], ++own[kBins + f], ++own[2 * kBins + t];
+    const std::uint32_t q = scratch.target_index[j];
+    std::uint16_t* other = counts + std::size_t(q) * kFpfhSize;
+    mine.received[q] += p_tag;
+    if (!scratch.one_sided[j]) {
+      ++other[a], ++other[kBins + f], ++other[2 * kBins + t];
+      continue;
+    }
+    std::uint8_t reversed[3];  // a tie or a degenerate pair: q's own view of it
+    detail::pair_bins_exact(cloud.xyz[q], cloud.normals[q], cloud.xyz[p], cloud.normals[p], kBins,
+                            reversed);
+    ++other[reversed[0]], ++other[kBins + reversed[1]], ++other[2 * kBins + reversed[2]];
+  }
+  return expected;
 }
 
 // Squared distance, recomputed the same way for cached and searched lists so that the weights
@@ -136,16 +228,19 @@ inline float squared_distance(const Vec3f& a, const Vec3f& b) {
 // Cloned for AVX2 (chosen at load time, so the binary still runs on any x86-64): the 33-bin
 // accumulation is a third of the pass. No FMA in either clone, and every bin is its own sum in
 // the same order, so both give the same bits.
+template <bool kFiltered>
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx2", "default")))
 #endif
-void weight_spfh(const PointCloud& cloud, std::size_t p, const std::vector<float>& spfh,
-                 const std::vector<double>& spfh_sums, const NeighborList& neighbors, float* fpfh) {
+void weight_spfh_of(const PointCloud& cloud, std::size_t p, const std::vector<float>& spfh,
+                    const std::vector<double>& spfh_sums, std::span<const std::uint32_t> list,
+                    const char* usable, float* fpfh) {
   alignas(16) float accumulated[kFpfhSize] = {};
   double sum[3] = {0.0, 0.0, 0.0};
-  for (std::uint32_t q : neighbors.indices) {
+  for (std::uint32_t q : list) {
     const float sq_dist = squared_distance(cloud.xyz[p], cloud.xyz[q]);
-    if (sq_dist == 0.0f) continue;  // the point itself (and exact duplicates)
+    // The point itself (and exact duplicates), and points without a normal.
+    if (sq_dist == 0.0f || (kFiltered && !usable[q])) continue;
     const float weight = 1.0f / sq_dist;
     const float* row = spfh.data() + std::size_t(q) * kFpfhSize;
     for (int b = 0; b < kFpfhSize; ++b) accumulated[b] += row[b] * weight;
@@ -156,6 +251,16 @@ void weight_spfh(const PointCloud& cloud, std::size_t p, const std::vector<float
     for (int b = s * kBins; b < (s + 1) * kBins; ++b)
       fpfh[b] = static_cast<float>(accumulated[b] * scale);
   }
+}
+
+void weight_spfh(const PointCloud& cloud, std::size_t p, const std::vector<float>& spfh,
+                 const std::vector<double>& spfh_sums, std::span<const std::uint32_t> list,
+                 const char* usable, float* fpfh) {
+  // Two loops, so that a cloud whose points all have normals pays no test per neighbour.
+  if (usable)
+    weight_spfh_of<true>(cloud, p, spfh, spfh_sums, list, usable, fpfh);
+  else
+    weight_spfh_of<false>(cloud, p, spfh, spfh_sums, list, usable, fpfh);
 }
 
 }  // namespace
@@ -178,45 +283,127 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
   const bool sorted = false;
   const bool use_lists = lists && options.neighborhood.radius > 0.0f &&
                          options.neighborhood.radius <= lists->neighborhood().radius;
-  // Point p's neighbours that have a normal, from the shared lists or a search.
-  const auto neighbors_of = [&](std::size_t p, NeighborList& out) {
-    if (!use_lists) {
-      detail::usable_neighbors(index, cloud, usable, p, options.neighborhood, sorted, out);
-      return;
-    }
-    lists->find(p, options.neighborhood, out);
-    detail::keep_usable(usable, out);
+  // Point p's neighbours (with or without a normal), from the shared lists (no copy where they
+  // answer as they are) or a search into `scratch`.
+  const auto neighbors_of = [&](std::size_t p, NeighborList& scratch) {
+    if (use_lists) return lists->view(p, options.neighborhood, scratch);
+    index.find(cloud.xyz[p], options.neighborhood, scratch, sorted);
+    return std::span<const std::uint32_t>(scratch.indices);
+  };
+  // Points without a normal are skipped where a list is read; null when every point has one.
+  const bool all_usable = std::all_of(usable.begin(), usable.end(), [](char u) { return u != 0; });
+  const char* usable_or_all = all_usable ? nullptr : usable.data();
+  const auto taking_part = [&](std::span<const std::uint32_t> list) {
+    if (all_usable) return list.size();
+    return std::size_t(
+        std::count_if(list.begin(), list.end(), [&](std::uint32_t q) { return usable[q] != 0; }));
   };
 
   std::vector<float> spfh;
-  std::vector<double> spfh_sums;  // per sub-histogram, for the normalisation
+  std::vector<double> spfh_sums;              // per sub-histogram, for the normalisation
+  std::vector<std::uint32_t> neighbor_count;  // per point: its list's points that take part
   detail::assign_checked(spfh, n * kFpfhSize, 0.0f, stop, "FPFH");
   detail::assign_checked(spfh_sums, n * 3, 0.0, stop, "FPFH");
-  NeighborCache cache(n, options.neighbor_cache_bytes);
+  detail::assign_checked(neighbor_count, n, std::uint32_t(0), stop, "FPFH");
+  // Shared lists are read again in pass 2 at no cost; searched ones are kept for it.
+  NeighborCache cache(n, use_lists ? 0 : options.neighbor_cache_bytes);
   detail::ProgressCounter progress(context.progress, 2 * n);
-  struct Pass1Scratch {
-    NeighborList neighbors;
-    SpfhScratch pairs;
+  const auto finish_row = [&](std::size_t p) {
+    const float* row = &spfh[p * kFpfhSize];
+    for (int b = 0; b < kFpfhSize; ++b) spfh_sums[3 * p + b / kBins] += row[b];
   };
-  detail::for_each_block(
-      blocks, context.with_threads(threads), [] { return Pass1Scratch(); },
-      [&](Pass1Scratch& scratch, std::ptrdiff_t block) {
-        const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
-        for (std::size_t p = first; p < last; ++p) {
-          // Per point: a stop is honoured within one (capped) neighbourhood's time.
-          if (stop.stop_requested()) return;
-          if (!usable[p]) continue;
-          NeighborList& neighbors = scratch.neighbors;
-          neighbors_of(p, neighbors);
-          cache.store(p, neighbors);
-          if (neighbors.size() < 2) continue;
-          float* row = &spfh[p * kFpfhSize];
-          compute_spfh(cloud, p, neighbors, scratch.pairs, row);
-          for (int b = 0; b < kFpfhSize; ++b) spfh_sums[3 * p + b / kBins] += row[b];
-        }
-        progress.add(last - first);
-      });
 
+  // Pass 1, SPFH. Radius neighbourhoods are symmetric (q is within r of p exactly when p is
+  // within r of q: the same float distance), so each pair is computed once. A list cut by the
+  // cap is not the whole ball: its point's row, and the rows of points that then miss a pair,
+  // take the per-point path, as do k-nearest neighbourhoods and counts beyond the memory bound.
+  const Neighborhood& hood = options.neighborhood;
+  const bool symmetric = hood.radius > 0.0f && hood.k == 0 &&
+                         n * kPairCountBytes * std::size_t(threads) <= kPairCountBudget;
+  if (symmetric) {
+    std::vector<PairCounts> per_thread(static_cast<std::size_t>(threads));
+    std::vector<std::uint64_t> expected(n, 0);
+    std::vector<std::uint8_t> cut(n, 0);
+    std::atomic<std::size_t> next_thread{0};
+    struct CountScratch {
+      SpfhScratch pairs;
+      PairCounts* counts;
+    };
+    detail::for_each_block(
+        blocks, context.with_threads(threads),
+        [&] {
+          PairCounts* mine = &per_thread[next_thread++];
+          mine->init(n);
+          return CountScratch{SpfhScratch(), mine};
+        },
+        [&](CountScratch& scratch, std::ptrdiff_t block) {
+          const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+          for (std::size_t p = first; p < last; ++p) {
+            if (stop.stop_requested()) return;
+            if (!usable[p]) continue;
+            const std::span<const std::uint32_t> list = neighbors_of(p, scratch.pairs.list);
+            cache.store(p, list);
+            neighbor_count[p] = static_cast<std::uint32_t>(std::min<std::size_t>(
+                taking_part(list), std::numeric_limits<std::uint32_t>::max()));
+            cut[p] = hood.max_neighbors > 0 && list.size() >= std::size_t(hood.max_neighbors);
+            expected[p] =
+                count_upper_pairs(cloud, p, list, usable_or_all, scratch.pairs, *scratch.counts);
+          }
+          progress.add((last - first) / 2);
+        });
+    throw_if_stopped(stop, "FPFH");
+    const std::size_t used = next_thread.load();
+    // Rows from the summed counts. A point whose list was cut, that did not receive exactly the
+    // pairs its own list expects (a lower neighbour's cut list, or a search that is not
+    // symmetric after all), or whose counts could overflow, gets its row by the per-point path:
+    // the result is the same either way.
+    detail::for_each_block(
+        blocks, context.with_threads(threads), [] { return SpfhScratch(); },
+        [&](SpfhScratch& scratch, std::ptrdiff_t block) {
+          const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+          for (std::size_t p = first; p < last; ++p) {
+            if (stop.stop_requested()) return;
+            if (!usable[p] || neighbor_count[p] < 2) continue;
+            std::uint64_t received = 0;
+            std::uint32_t counts[kFpfhSize] = {};
+            for (std::size_t t = 0; t < used; ++t) {
+              received += per_thread[t].received[p];
+              const std::uint16_t* row = per_thread[t].counts.data() + p * kFpfhSize;
+              for (int b = 0; b < kFpfhSize; ++b) counts[b] += row[b];
+            }
+            float* row = &spfh[p * kFpfhSize];
+            if (cut[p] || received != expected[p] || neighbor_count[p] > kMaxCountedNeighbors) {
+              const std::span<const std::uint32_t> list = neighbors_of(p, scratch.list);
+              compute_spfh(cloud, p, list, usable_or_all, neighbor_count[p], scratch, row);
+            } else {
+              const float* sum_of = scratch.sums.for_neighbors(neighbor_count[p]);
+              for (int b = 0; b < kFpfhSize; ++b) row[b] = sum_of[counts[b]];
+            }
+            finish_row(p);
+          }
+          progress.add(last - first - (last - first) / 2);
+        });
+  } else {
+    detail::for_each_block(
+        blocks, context.with_threads(threads), [] { return SpfhScratch(); },
+        [&](SpfhScratch& scratch, std::ptrdiff_t block) {
+          const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+          for (std::size_t p = first; p < last; ++p) {
+            // Per point: a stop is honoured within one (capped) neighbourhood's time.
+            if (stop.stop_requested()) return;
+            if (!usable[p]) continue;
+            const std::span<const std::uint32_t> list = neighbors_of(p, scratch.list);
+            cache.store(p, list);
+            neighbor_count[p] = static_cast<std::uint32_t>(std::min<std::size_t>(
+                taking_part(list), std::numeric_limits<std::uint32_t>::max()));
+            if (neighbor_count[p] < 2) continue;
+            compute_spfh(cloud, p, list, usable_or_all, neighbor_count[p], scratch,
+                         &spfh[p * kFpfhSize]);
+            finish_row(p);
+          }
+          progress.add(last - first);
+        });
+  }
   throw_if_stopped(stop, "FPFH");
 
   std::vector<float> fpfh;
@@ -224,7 +411,7 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
   std::atomic<std::size_t> computed{0}, isolated{0};
   detail::for_each_block(
       blocks, context.with_threads(threads), [] { return NeighborList(); },
-      [&](NeighborList& neighbors, std::ptrdiff_t block) {
+      [&](NeighborList& scratch, std::ptrdiff_t block) {
         std::size_t block_computed = 0, block_isolated = 0;
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
         for (std::size_t p = first; p < last; ++p) {
@@ -234,12 +421,13 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
             std::fill(out, out + kFpfhSize, std::numeric_limits<float>::quiet_NaN());
             continue;
           }
-          if (!cache.load(p, neighbors)) neighbors_of(p, neighbors);
-          if (neighbors.size() < 2) {
+          if (neighbor_count[p] < 2) {
             ++block_isolated;  // stays all zero, as in PCL
             continue;
           }
-          weight_spfh(cloud, p, spfh, spfh_sums, neighbors, out);
+          std::span<const std::uint32_t> list;
+          if (!cache.load(p, list)) list = neighbors_of(p, scratch);
+          weight_spfh(cloud, p, spfh, spfh_sums, list, usable_or_all, out);
           if (options.fpfh_variant == FpfhVariant::kWithOwnSpfh)
             for (int b = 0; b < kFpfhSize; ++b) out[b] += spfh[p * kFpfhSize + b];
           ++block_computed;

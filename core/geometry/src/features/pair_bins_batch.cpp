@@ -23,19 +23,21 @@ namespace {
 
 void exact_bins(const Vec3f& p1, const Vec3f& n1, const PairTargets& t, std::size_t j, int bins,
                 std::uint8_t* alpha, std::uint8_t* phi, std::uint8_t* theta) {
-  PairFeatures f;
-  pair_features(p1, n1, Vec3f(t.x[j], t.y[j], t.z[j]), Vec3f(t.nx[j], t.ny[j], t.nz[j]), f);
-  alpha[j] = static_cast<std::uint8_t>(angle_bin(f.alpha, bins));
-  phi[j] = static_cast<std::uint8_t>(cosine_bin(f.phi, bins));
-  theta[j] = static_cast<std::uint8_t>(cosine_bin(f.theta, bins));
+  std::uint8_t b[3];
+  pair_bins_exact(p1, n1, Vec3f(t.x[j], t.y[j], t.z[j]), Vec3f(t.nx[j], t.ny[j], t.nz[j]), bins, b);
+  alpha[j] = b[0], phi[j] = b[1], theta[j] = b[2];
 }
 
 // The bins of `lanes` pairs from j on: the fast path's, except the lanes set in `redo`, which
-// the exact path recomputes. Shared by the SSE2 and AVX2 loops.
-void store_lanes(int lanes, int redo, const int* alpha_bins, const int* phi_bins,
+// the exact path recomputes; with one_sided, the lanes set in `redo | tie` are marked there.
+// Shared by the SSE2 and AVX2 loops.
+void store_lanes(int lanes, int redo, int tie, const int* alpha_bins, const int* phi_bins,
                  const int* theta_bins, const Vec3f& p1, const Vec3f& n1, const PairTargets& t,
                  std::size_t j, int bins, std::uint8_t* alpha, std::uint8_t* phi,
-                 std::uint8_t* theta) {
+                 std::uint8_t* theta, std::uint8_t* one_sided) {
+  if (one_sided)
+    for (int lane = 0; lane < lanes; ++lane)
+      one_sided[j + lane] = static_cast<std::uint8_t>(((redo | tie) >> lane) & 1);
   for (int lane = 0; lane < lanes; ++lane) {
     if (redo & (1 << lane)) {
       exact_bins(p1, n1, t, j + lane, bins, alpha, phi, theta);
@@ -104,7 +106,8 @@ PRIMLABEL_AVX2 void cosine_bins8(__m256 c, int bins, int out[8]) {
 __attribute__((target("avx2"))) std::size_t pair_bins_avx2(const Vec3f& p1, const Vec3f& n1,
                                                            const PairTargets& t, std::size_t count,
                                                            int bins, std::uint8_t* alpha,
-                                                           std::uint8_t* phi, std::uint8_t* theta) {
+                                                           std::uint8_t* phi, std::uint8_t* theta,
+                                                           std::uint8_t* one_sided) {
   const __m256 sign = _mm256_set1_ps(-0.0f);
   const __m256 p1x = _mm256_set1_ps(p1.x()), p1y = _mm256_set1_ps(p1.y()),
                p1z = _mm256_set1_ps(p1.z());
@@ -129,6 +132,8 @@ __attribute__((target("avx2"))) std::size_t pair_bins_avx2(const Vec3f& p1, cons
     const __m256 abs1 = abs8(angle1), abs2 = abs8(angle2);
     const __m256 swap = _mm256_cmp_ps(abs1, abs2, _CMP_LT_OS);
     const __m256 gap = abs8(_mm256_sub_ps(abs1, abs2));
+    // Not clearly apart (or NaN): the reversed pair may choose the other source.
+    const __m256 tie = _mm256_cmp_ps(gap, _mm256_set1_ps(2e-6f), _CMP_NGT_UQ);
     exact = _mm256_or_ps(exact, _mm256_and_ps(_mm256_cmp_ps(gap, _mm256_set1_ps(2e-6f), _CMP_LE_OS),
                                               _mm256_cmp_ps(abs1, abs2, _CMP_NEQ_UQ)));
     const __m256 ux = select8(swap, m2x, n1x), uy = select8(swap, m2y, n1y),
@@ -181,8 +186,8 @@ __attribute__((target("avx2"))) std::size_t pair_bins_avx2(const Vec3f& p1, cons
     _mm256_store_si256(reinterpret_cast<__m256i*>(alpha_bins), whole);
     cosine_bins8(phi_value, bins, phi_bins);
     cosine_bins8(theta_value, bins, theta_bins);
-    store_lanes(8, _mm256_movemask_ps(exact), alpha_bins, phi_bins, theta_bins, p1, n1, t, j, bins,
-                alpha, phi, theta);
+    store_lanes(8, _mm256_movemask_ps(exact), _mm256_movemask_ps(tie), alpha_bins, phi_bins,
+                theta_bins, p1, n1, t, j, bins, alpha, phi, theta, one_sided);
   }
   return j;
 }
@@ -197,11 +202,21 @@ bool cpu_has_avx2() {
 
 }  // namespace
 
+void pair_bins_exact(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, int bins,
+                     std::uint8_t bins_out[3]) {
+  PairFeatures f;
+  pair_features(p1, n1, p2, n2, f);
+  bins_out[0] = static_cast<std::uint8_t>(angle_bin(f.alpha, bins));
+  bins_out[1] = static_cast<std::uint8_t>(cosine_bin(f.phi, bins));
+  bins_out[2] = static_cast<std::uint8_t>(cosine_bin(f.theta, bins));
+}
+
 void pair_bins_batch(const Vec3f& p1, const Vec3f& n1, const PairTargets& t, std::size_t count,
-                     int bins, std::uint8_t* alpha, std::uint8_t* phi, std::uint8_t* theta) {
+                     int bins, std::uint8_t* alpha, std::uint8_t* phi, std::uint8_t* theta,
+                     std::uint8_t* one_sided) {
   std::size_t j = 0;
 #if defined(PRIMLABEL_PAIR_BINS_AVX2)
-  if (cpu_has_avx2()) j = pair_bins_avx2(p1, n1, t, count, bins, alpha, phi, theta);
+  if (cpu_has_avx2()) j = pair_bins_avx2(p1, n1, t, count, bins, alpha, phi, theta, one_sided);
 #endif
 #if defined(__SSE2__)
   const __m128 p1x = _mm_set1_ps(p1.x()), p1y = _mm_set1_ps(p1.y()), p1z = _mm_set1_ps(p1.z());
@@ -224,6 +239,7 @@ void pair_bins_batch(const Vec3f& p1, const Vec3f& n1, const PairTargets& t, std
     const __m128 abs1 = abs_ps(angle1), abs2 = abs_ps(angle2);
     const __m128 swap = _mm_cmplt_ps(abs1, abs2);
     const __m128 gap = abs_ps(_mm_sub_ps(abs1, abs2));
+    const __m128 tie = _mm_cmpngt_ps(gap, _mm_set1_ps(2e-6f));
     exact = _mm_or_ps(exact,
                       _mm_and_ps(_mm_cmple_ps(gap, _mm_set1_ps(2e-6f)), _mm_cmpneq_ps(abs1, abs2)));
     const __m128 ux = select(swap, m2x, n1x), uy = select(swap, m2y, n1y),
@@ -277,11 +293,14 @@ void pair_bins_batch(const Vec3f& p1, const Vec3f& n1, const PairTargets& t, std
     _mm_store_si128(reinterpret_cast<__m128i*>(alpha_bins), whole);
     cosine_bins(phi_value, bins, phi_bins);
     cosine_bins(theta_value, bins, theta_bins);
-    store_lanes(4, _mm_movemask_ps(exact), alpha_bins, phi_bins, theta_bins, p1, n1, t, j, bins,
-                alpha, phi, theta);
+    store_lanes(4, _mm_movemask_ps(exact), _mm_movemask_ps(tie), alpha_bins, phi_bins, theta_bins,
+                p1, n1, t, j, bins, alpha, phi, theta, one_sided);
   }
 #endif
-  for (; j < count; ++j) exact_bins(p1, n1, t, j, bins, alpha, phi, theta);
+  for (; j < count; ++j) {
+    exact_bins(p1, n1, t, j, bins, alpha, phi, theta);
+    if (one_sided) one_sided[j] = 1;
+  }
 }
 
 }  // namespace primlabel::detail

@@ -29,8 +29,19 @@ struct PairTargets {
 
 // For each of the first `count` targets j, the bins of the pair (p1, n1) -> (target j) with
 // `bins` bins per feature: alpha[j], phi[j], theta[j] in [0, bins).
+//
+// The pair features are symmetric: (target j) -> (p1, n1) gives the same bits, because both
+// directions pick the same source point and frame, except when the two angles to the line tie
+// (then each direction keeps its own first point) or when a zero's sign can pick the bin. With
+// `one_sided`, one_sided[j] is 0 only for pairs where the reversed pair is sure to fall in the
+// same bins; 1 where it has to be computed itself (ties within 2e-6, coincident points,
+// degenerate frames, bins decided near a boundary, and the scalar tail: a cheap superset).
 void pair_bins_batch(const Vec3f& p1, const Vec3f& n1, const PairTargets& targets,
                      std::size_t count, int bins, std::uint8_t* alpha, std::uint8_t* phi,
-                     std::uint8_t* theta);
+                     std::uint8_t* theta, std::uint8_t* one_sided = nullptr);
+
+// The bins of one pair by the exact (scalar) path: {alpha, phi, theta}.
+void pair_bins_exact(const Vec3f& p1, const Vec3f& n1, const Vec3f& p2, const Vec3f& n2, int bins,
+                     std::uint8_t bins_out[3]);
 
 }  // namespace primlabel::detail

@@ -124,6 +124,22 @@ void NeighborLists::find(std::size_t i, const Neighborhood& hood, NeighborList& 
   search_.find(points_[i], hood, out, /*sorted=*/false);
 }
 
+std::span<const std::uint32_t> NeighborLists::view(std::size_t i, const Neighborhood& hood,
+                                                   NeighborList& scratch) const {
+  // The same radius means find()'s filter keeps every entry (the same float comparison), and
+  // within the cap the filtered list is the answer.
+  if (hood.radius == hood_.radius) {
+    const std::uint32_t* indices = nullptr;
+    const float* sq_dists = nullptr;
+    std::size_t count = 0;
+    if (shared(i, scratch, indices, sq_dists, count) &&
+        (hood.max_neighbors == 0 || count < std::size_t(hood.max_neighbors)))
+      return {indices, count};
+  }
+  find(i, hood, scratch);
+  return scratch.indices;
+}
+
 namespace {
 using Entry = std::pair<float, std::uint32_t>;  // (squared distance, index): a total order
 

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "primlabel/geometry/neighbor_search.hpp"
@@ -37,6 +38,12 @@ class NeighborLists {
   // radius or hybrid neighbourhood of radius <= neighborhood().radius. Points whose shared list
   // was not kept are searched again; thread-safe.
   void find(std::size_t i, const Neighborhood& hood, NeighborList& out) const;
+
+  // The indices find(i, hood) gives, in its order, without a copy when the kept shared list is
+  // the answer as it is (a radius neighbourhood of the lists' own radius); otherwise find()
+  // writes them into `scratch`. Valid while this object and `scratch` are. Thread-safe.
+  std::span<const std::uint32_t> view(std::size_t i, const Neighborhood& hood,
+                                      NeighborList& scratch) const;
 
   // The k nearest of point i among the points with allowed[j] != 0 (the point itself included
   // when allowed), sorted by squared distance, ties by index. False when the shared search was
