@@ -258,6 +258,6 @@ int main(int argc, char** argv) {
     return run(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "primlabel-bench-can-radii: error: %s\n", e.what());
-    return primlabel::kExitFile;
+    return primlabel::kExitFailure;
   }
 }
