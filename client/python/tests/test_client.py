@@ -115,6 +115,39 @@ def test_primitives_come_with_their_segments(client, cloud, call):
     assert client.label(cloud).segments is None  # not asked for: none
 
 
+@pytest.mark.parametrize("call", ["label", "label_unary"])
+def test_objects_come_with_their_per_point_ids(client, cloud, call):
+    result = getattr(client, call)(cloud, tabletop_only=True, objects=True, primitives=True)
+    ids = result.object_ids
+    assert ids.shape == (len(cloud),) and ids.dtype == np.uint32
+    table = result.table
+    assert table is not None, result.summary.no_table_reason
+    assert abs(abs(table.normal.z) - 1) < 0.05 and len(table.hull) >= 3
+    assert table.point_count == np.count_nonzero(ids == 0)
+    objects = result.objects
+    assert len(objects) >= 1
+    named = ids[ids != primlabel.NO_OBJECT]
+    assert int(named.max()) <= len(objects)
+    # Labeled exactly where there is a table or an object.
+    np.testing.assert_array_equal(ids == primlabel.NO_OBJECT, result.labels == 0)
+    for k, obj in enumerate(objects, start=1):
+        members = np.flatnonzero(ids == k)
+        assert obj.object_id == k and obj.point_count == len(members)
+        points = np.asarray(cloud.xyz, dtype=np.float64)[members]
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        np.testing.assert_allclose([obj.bounds_min.x, obj.bounds_min.y, obj.bounds_min.z], lo,
+                                   atol=1e-6)
+        np.testing.assert_allclose([obj.bounds_max.x, obj.bounds_max.y, obj.bounds_max.z], hi,
+                                   atol=1e-6)
+        # Its primitives are segments mostly made of its points.
+        for s in obj.primitive_ids:
+            in_segment = result.segments == s
+            assert np.count_nonzero(in_segment & (ids == k)) * 2 > np.count_nonzero(in_segment)
+    assert client.label(cloud, tabletop_only=True).object_ids is None  # not asked for: none
+    with pytest.raises(primlabel.InvalidInput):
+        client.label(cloud, objects=True)
+
+
 def test_normals_sent_are_used(client):
     bunny = primlabel.pcd.read(TEST_DATA / "samples/bun0.pcd")
     with_normals = client.label(bunny.xyz, normals=bunny.normals)
