@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "png_decode.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/pipeline/training.hpp"
