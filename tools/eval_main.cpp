@@ -38,14 +38,15 @@
 #include "primlabel/research/mosd_report.hpp"
 #include "primlabel/research/table1.hpp"
 #include "primlabel/research/truth_check.hpp"
+#include "primlabel/tabletop/objects_json.hpp"
 
 namespace {
 
 using namespace primlabel;
 
 struct Arguments {
-  std::string model, classes, out, primitives_json, confusion_png, fig4_dir, mosd_dir, truth_dir,
-      calibrate_dir, calibration_json;
+  std::string model, classes, out, primitives_json, objects_json, confusion_png, fig4_dir, mosd_dir,
+      truth_dir, calibrate_dir, calibration_json;
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
   bool table1 = false, no_pfh = false, no_svm = false, object_truth = false, fit_simulation = false;
@@ -130,6 +131,7 @@ int evaluate_files(const Arguments& args) {
     pipeline::LabelingOptions options;
     options.tabletop_only = args.tabletop_only;
     options.want_primitives = !args.primitives_json.empty();
+    options.want_objects = !args.objects_json.empty();
     const pipeline::LabelingResult result =
         pipeline::label_cloud(model, cloud, options, RunContext{args.threads});
     if (result.primitives) {
@@ -138,6 +140,12 @@ int evaluate_files(const Arguments& args) {
       if (!args.quiet)
         std::fprintf(stderr, "%s: %zu primitives in %.3f s, wrote %s\n", path.c_str(),
                      instances.size(), result.primitive_seconds, args.primitives_json.c_str());
+    }
+    if (result.objects) {
+      atomic_write_file(args.objects_json, tabletop::objects_json(*result.objects));
+      if (!args.quiet)
+        std::fprintf(stderr, "%s: %zu table-top objects, wrote %s\n", path.c_str(),
+                     result.objects->objects.size(), args.objects_json.c_str());
     }
     if (!args.quiet)
       std::fprintf(stderr, "%s: %zu points, features %.2f s, inference %.2f s\n", path.c_str(),
@@ -368,6 +376,10 @@ int main(int argc, char** argv) {
       "--primitives", args.primitives_json,
       "group the predicted labels into connected segments, fit each with its class's primitive "
       "(plane, cylinder, sphere, torus, edge line) and write them as JSON (one input file)");
+  auto* objects_out = app.add_option(
+      "--objects", args.objects_json,
+      "with --tabletop-only: write the table and its objects (plane, hull; per object points, "
+      "centroid, bounds, height, primitive ids with --primitives) as JSON (one input file)");
   auto* mosd =
       app.add_option("--mosd-report", args.mosd_dir,
                      "mOSD scenes (label 1-9 table): share of table points labeled plane, and a "
@@ -375,7 +387,8 @@ int main(int argc, char** argv) {
           ->needs(model)
           ->excludes(no_truth)
           ->excludes(out)
-          ->excludes(primitives_out);
+          ->excludes(primitives_out)
+          ->excludes(objects_out);
   auto* object_truth =
       app.add_flag("--object-truth", args.object_truth,
                    "--mosd-report: also fit box / cylinder models to the object segments, label "
@@ -485,6 +498,12 @@ int main(int argc, char** argv) {
   if (!args.primitives_json.empty() && args.files.size() != 1) {
     std::fprintf(stderr,
                  "primlabel-eval: usage error: --primitives takes exactly one input file\n");
+    return cli::kExitUsage;
+  }
+  if (!args.objects_json.empty() && (args.files.size() != 1 || !args.tabletop_only)) {
+    std::fprintf(stderr,
+                 "primlabel-eval: usage error: --objects takes exactly one input file "
+                 "and needs --tabletop-only\n");
     return cli::kExitUsage;
   }
   try {

@@ -4,6 +4,7 @@
 //   primlabel-render learn0.pcd -o learn0.png --field label --palette segments --view sensor
 //   primlabel-render features.pcd -o curvature.png --field curvature --view top
 //   primlabel-render labeled.pcd -o fits.png --primitives primitives.json   # fitted outlines
+//   primlabel-render labeled.pcd -o objects.png --objects objects.json      # table-top boxes
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -22,6 +23,7 @@
 #include "primlabel/render/colorize.hpp"
 #include "primlabel/render/primitive_outlines.hpp"
 #include "primlabel/render/render.hpp"
+#include "primlabel/tabletop/objects_json.hpp"
 
 namespace {
 
@@ -30,6 +32,7 @@ using namespace primlabel;
 struct Arguments {
   std::string input, output, field, palette = "classes", classes, view = "oblique", title;
   std::string primitives;  // JSON of primlabel label / primlabel-eval --primitives
+  std::string objects;     // JSON of primlabel label / primlabel-eval --objects
   double min_confidence = 0;
   int width = 1024, height = 768, point_size = 1;
   bool no_legend = false, no_title = false;
@@ -101,6 +104,38 @@ std::vector<Overlay> outlines_from(const std::string& path, double min_confidenc
   }
 }
 
+// The table's hull and every table-top object's axis-aligned box in `path` (objects_json.hpp),
+// in one colour each: hull grey, boxes black.
+std::vector<Overlay> object_boxes_from(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw RunError("cannot read objects file '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  tabletop::TabletopObjects objects;
+  try {
+    objects = tabletop::parse_objects_json(text.str());
+  } catch (const std::invalid_argument& e) {
+    throw RunError(path + ": " + e.what());
+  }
+  std::vector<Overlay> out;
+  if (objects.table && objects.table->hull.size() >= 2)
+    out.push_back({objects.table->hull, 0x808080, true});
+  for (const tabletop::TabletopObject& o : objects.objects) {
+    if (o.points == 0) continue;
+    const auto corner = [&](int x, int y, int z) {
+      return Vec3f(float(x ? o.bounds_max.x() : o.bounds_min.x()),
+                   float(y ? o.bounds_max.y() : o.bounds_min.y()),
+                   float(z ? o.bounds_max.z() : o.bounds_min.z()));
+    };
+    for (int z = 0; z <= 1; ++z)  // bottom and top rectangles, then the four vertical edges
+      out.push_back(
+          {{corner(0, 0, z), corner(1, 0, z), corner(1, 1, z), corner(0, 1, z)}, 0x000000, true});
+    for (int x = 0; x <= 1; ++x)
+      for (int y = 0; y <= 1; ++y) out.push_back({{corner(x, y, 0), corner(x, y, 1)}, 0x000000});
+  }
+  return out;
+}
+
 int run(const Arguments& args) {
   const PointCloud cloud = read_cloud(args.input);
   if (count_finite(cloud) == 0) throw RunError(args.input + ": no point has finite coordinates");
@@ -122,6 +157,8 @@ int run(const Arguments& args) {
   if (!args.no_legend) options.legend = std::move(coloring.legend);
   if (!args.primitives.empty())
     options.overlays = outlines_from(args.primitives, args.min_confidence);
+  if (!args.objects.empty())
+    for (Overlay& box : object_boxes_from(args.objects)) options.overlays.push_back(std::move(box));
   render_png(cloud, coloring.rgb, options, args.output);
   return cli::kExitOk;
 }
@@ -170,6 +207,9 @@ int main(int argc, char** argv) {
                  "draw the fitted primitives of this JSON file (primlabel label / primlabel-eval "
                  "--primitives): plane rectangles, cylinder and torus outlines with axes, sphere "
                  "circles, edge segments");
+  app.add_option("--objects", args.objects,
+                 "draw the table-top objects of this JSON file (primlabel label / primlabel-eval "
+                 "--objects): the table's hull and each object's axis-aligned box");
   app.add_option("--min-confidence", args.min_confidence,
                  "with --primitives: leave out fits below this confidence")
       ->check(CLI::Range(0.0, 1.0));

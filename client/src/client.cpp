@@ -39,6 +39,7 @@ v1::LabelRequest header_request(const PointCloud& cloud, const LabelOptions& o) 
   options.set_return_probabilities(o.probabilities);
   options.set_return_primitives(o.primitives);
   options.set_tabletop_only(o.tabletop_only);
+  options.set_return_objects(o.objects);
   options.set_voxel_size(o.voxel_size);
   options.set_normal_radius(o.normal_radius);
   options.set_feature_radius(o.feature_radius);
@@ -168,7 +169,8 @@ struct Client::Impl {
     const std::size_t chunk_points = std::max<std::size_t>(1, o.chunk_points);
     LabelResult result;
     result.attempts = with_retries(timeout_of(o), control, [&](grpc::ClientContext& context) {
-      LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities, o.primitives);
+      LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities, o.primitives,
+                               o.objects);
       auto stream = labeler->Label(&context);
       // Writes stop at the first failure: the server has ended the call, Finish says why.
       bool writing = stream->Write(header_request(cloud, o));
@@ -217,7 +219,8 @@ struct Client::Impl {
       v1::LabelCloudResponse response;
       grpc::Status status = labeler->LabelCloud(&context, request, &response);
       if (!status.ok()) return status;
-      LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities, o.primitives);
+      LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities, o.primitives,
+                               o.objects);
       assembler.add(response.result());
       result = assembler.finish(response.summary());
       return status;

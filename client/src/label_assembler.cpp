@@ -9,15 +9,17 @@ namespace primlabel::client {
 
 namespace {
 constexpr std::uint32_t kNoSegment = 0xFFFFFFFFu;  // LabelChunk.segments: in no segment
+constexpr std::uint32_t kNoObject = 0xFFFFFFFFu;   // LabelChunk.objects: neither table nor object
 std::string at(std::uint64_t first) { return "chunk at point " + std::to_string(first); }
 }  // namespace
 
 LabelAssembler::LabelAssembler(std::size_t points, bool want_descriptors, bool want_probabilities,
-                               bool want_segments)
+                               bool want_segments, bool want_objects)
     : points_(points),
       want_descriptors_(want_descriptors),
       want_probabilities_(want_probabilities),
       want_segments_(want_segments),
+      want_objects_(want_objects),
       covered_(points, 0) {
   result_.labels.assign(points, 0);
 }
@@ -29,6 +31,20 @@ int LabelAssembler::columns(std::size_t bytes, std::uint32_t count, const char* 
     throw ProtocolError(at(first) + ": " + std::to_string(bytes) + " bytes of " + what +
                         " do not divide into " + std::to_string(count) + " points");
   return static_cast<int>(bytes / (4ull * count));
+}
+
+void LabelAssembler::add_ids(const std::string& bytes, std::uint32_t count, std::uint64_t first,
+                             bool wanted, const char* what, std::vector<std::uint32_t>& out) {
+  const int id_columns = columns(bytes.size(), count, what, first);
+  if (wanted && count > 0 && id_columns < 0)
+    throw ProtocolError(at(first) + ": " + what + " were asked for but are missing");
+  if (id_columns > 1)
+    throw ProtocolError(at(first) + ": " + std::to_string(id_columns) + " " + what +
+                        " a point, not 1");
+  if (id_columns == 1) {
+    if (out.empty()) out.assign(points_, kNoSegment);
+    wire::unpack_u32(bytes, out.data() + first);
+  }
 }
 
 void LabelAssembler::add(const v1::LabelChunk& chunk) {
@@ -72,16 +88,8 @@ void LabelAssembler::add(const v1::LabelChunk& chunk) {
     wire::unpack_f32(chunk.probabilities(), result_.probabilities.data() + first * classes);
   }
 
-  const int segment_columns = columns(chunk.segments().size(), count, "segments", first);
-  if (want_segments_ && count > 0 && segment_columns < 0)
-    throw ProtocolError(at(first) + ": primitives were asked for but the segment ids are missing");
-  if (segment_columns > 1)
-    throw ProtocolError(at(first) + ": " + std::to_string(segment_columns) +
-                        " segment ids a point, not 1");
-  if (segment_columns == 1) {
-    if (result_.segments.empty()) result_.segments.assign(points_, kNoSegment);
-    wire::unpack_u32(chunk.segments(), result_.segments.data() + first);
-  }
+  add_ids(chunk.segments(), count, first, want_segments_, "segment ids", result_.segments);
+  add_ids(chunk.objects(), count, first, want_objects_, "object ids", result_.object_ids);
 
   wire::unpack_u32(chunk.labels(), result_.labels.data() + first);
   for (std::uint64_t i = first; i < first + count; ++i) covered_[i] = 1;
@@ -117,6 +125,15 @@ LabelResult LabelAssembler::finish(const v1::LabelSummary& summary) {
       throw ProtocolError("point " + std::to_string(i) + " is in segment " +
                           std::to_string(result_.segments[i]) + ", the summary has " +
                           std::to_string(primitive_count) + " primitives");
+  // Every object id names the table or one of the summary's objects.
+  const auto object_count = std::uint32_t(summary.objects_size());
+  for (std::size_t i = 0; i < result_.object_ids.size(); ++i) {
+    const std::uint32_t id = result_.object_ids[i];
+    if (id != kNoObject && (id > object_count || (id == 0 && !summary.has_table())))
+      throw ProtocolError("point " + std::to_string(i) + " is in object " + std::to_string(id) +
+                          ", the summary has " + std::to_string(object_count) + " objects" +
+                          (summary.has_table() ? "" : " and no table"));
+  }
   for (const auto& c : summary.classes()) {
     result_.class_ids.push_back(c.id());
     result_.class_names.push_back(c.name());

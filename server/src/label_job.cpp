@@ -1,8 +1,10 @@
 #include "label_job.hpp"
 
+#include <algorithm>
 #include <new>
 #include <stdexcept>
 
+#include "primlabel/tabletop/tabletop.hpp"
 #include "registry_error.hpp"
 
 namespace primlabel::server {
@@ -23,6 +25,10 @@ std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelReg
     return ServiceError{
         ErrorCode::kInvalidArgument,
         which + " does not allow radius overrides (options.normal_radius / feature_radius)"};
+  if (options.return_objects() && !options.tabletop_only())
+    return ServiceError{ErrorCode::kInvalidArgument,
+                        "options.return_objects needs options.tabletop_only (the objects are "
+                        "those of the table-top stage)"};
   plan.options.want_descriptors = options.return_descriptors();
   plan.options.want_probabilities = options.return_probabilities();
   plan.options.tabletop_only = options.tabletop_only();
@@ -31,6 +37,7 @@ std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelReg
   plan.options.feature_radius = options.feature_radius();
   plan.options.use_cloud_normals = header.layout().normals();
   plan.options.want_primitives = options.return_primitives();
+  plan.options.want_objects = options.return_objects();
   return std::nullopt;
 }
 
@@ -41,12 +48,25 @@ std::uint64_t answer_bytes_per_point(const LabelPlan& plan) {
     bytes += sizeof(float) * std::uint64_t(model.features.descriptor_dim());
   if (plan.options.want_probabilities) bytes += sizeof(float) * model.class_ids().size();
   if (plan.options.want_primitives) bytes += sizeof(std::uint32_t);  // LabelChunk.segments
+  if (plan.options.want_objects) {
+    bytes += sizeof(std::uint32_t);  // LabelChunk.objects
+    // Every object holds at least min_size points of the cloud (clusters smaller are dropped
+    // and the refinements only split off parts at least as large).
+    const std::uint64_t min_points =
+        std::max<std::size_t>(1, tabletop::TabletopOptions{}.clusters.min_size);
+    bytes += (kMaxObjectMessageBytes + min_points - 1) / min_points;
+  }
   return bytes;
 }
 
 std::uint64_t answer_summary_bytes(const LabelPlan& plan) {
-  if (!plan.options.want_primitives) return 0;
-  return std::uint64_t(plan.options.primitives.segments.max_segments) * kMaxPrimitiveMessageBytes;
+  std::uint64_t bytes = 0;
+  const std::uint64_t segments = plan.options.primitives.segments.max_segments;
+  if (plan.options.want_primitives) bytes += segments * kMaxPrimitiveMessageBytes;
+  // The table, and each segment's id listed by at most one object (5 bytes a varint).
+  if (plan.options.want_objects)
+    bytes += kMaxTableMessageBytes + (plan.options.want_primitives ? 5 * segments : 0);
+  return bytes;
 }
 
 std::optional<ServiceError> run_label_job(const LabelPlan& plan, PointCloud& cloud,

@@ -27,14 +27,21 @@ std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelReg
                                           LabelPlan& plan);
 
 // Bytes per point of the answer the plan asks for (labels, descriptors, probabilities, segment
-// ids), known before labeling.
+// ids, object ids and the objects' messages), known before labeling.
 std::uint64_t answer_bytes_per_point(const LabelPlan& plan);
 
 // A bound on one encoded v1::Primitive (a plane, the largest: 16 doubles and 4 scalars with their
 // tags, about 300 bytes); test_server_service checks real messages against it.
 inline constexpr std::uint64_t kMaxPrimitiveMessageBytes = 400;
+// A bound on one encoded v1::TabletopObject without its primitive ids (an id, a count, three
+// Vec3d and a double with their tags: about 110 bytes).
+inline constexpr std::uint64_t kMaxObjectMessageBytes = 160;
+// An estimate of the encoded v1::TabletopTable: the plane and up to 1024 hull vertices at 31 bytes
+// each (the hull of the table's grid cells has far fewer).
+inline constexpr std::uint64_t kMaxTableMessageBytes = 64 + 1024 * 31;
 // Bytes the summary may carry on top of its fixed part, whatever the cloud size: the primitives
-// (at most PrimitiveOptions::segments.max_segments of them).
+// (at most PrimitiveOptions::segments.max_segments of them) and the table with the objects'
+// primitive ids (the objects themselves are counted per point in answer_bytes_per_point).
 std::uint64_t answer_summary_bytes(const LabelPlan& plan);
 
 // Runs label_cloud; never throws. CANCELLED when context.stop was requested.

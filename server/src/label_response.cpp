@@ -5,6 +5,7 @@
 #include <map>
 #include <vector>
 
+#include "object_messages.hpp"
 #include "primitive_messages.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/wire/packing.hpp"
@@ -20,7 +21,8 @@ LabelResponder::LabelResponder(const pipeline::LabelingResult& result,
   bytes_per_point_ =
       wire::kLabelBytesPerPoint +
       sizeof(float) * std::uint64_t(result.descriptors.dim) * (result.descriptors.empty() ? 0 : 1) +
-      sizeof(float) * classes_ + (result.primitives ? sizeof(std::uint32_t) : 0);
+      sizeof(float) * classes_ + (result.primitives ? sizeof(std::uint32_t) : 0) +
+      (result.objects ? sizeof(std::uint32_t) : 0);
   const std::uint64_t fitting = std::max<std::uint64_t>(1, max_bytes / bytes_per_point_);
   chunk_points_ =
       requested_points > 0 ? std::min<std::uint64_t>(requested_points, fitting) : fitting;
@@ -58,6 +60,10 @@ void LabelResponder::fill_range(std::uint64_t first, std::uint64_t count,
     wire::append_le(
         *chunk.mutable_segments(),
         std::span<const std::uint32_t>(result_.primitives->point_segment.data() + first, count));
+  if (result_.objects)
+    wire::append_le(
+        *chunk.mutable_objects(),
+        std::span<const std::uint32_t>(result_.objects->point_object.data() + first, count));
 }
 
 namespace {
@@ -120,6 +126,7 @@ void fill_summary(const RequestRecord& record, const ModelEntry& entry,
   summary.set_domain_warning(result.domain_warning);
   *summary.mutable_classes() = entry.metadata.classes();
   if (result.primitives) add_primitives(result.primitives->primitives, summary);
+  if (result.objects) add_objects(*result.objects, summary);
 }
 
 }  // namespace primlabel::server

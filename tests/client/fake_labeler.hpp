@@ -221,11 +221,42 @@ class FakeLabeler final : public v1::Labeler::Service {
     line.set_length(0.5);
   }
 
+  // Known table-top objects: the table z = 0.3 (normal +z, offset -0.3) with a square hull and
+  // two objects, id 1 (label 2) and id 2 (label 3), each with primitive 1 resp. 2 in it.
+  static std::uint32_t fake_object_of(std::uint32_t label) {
+    return label == 1 ? 0u : label == 2 ? 1u : label == 3 ? 2u : 0xFFFFFFFFu;
+  }
+  static void fake_objects(std::size_t table_points, v1::LabelSummary& summary) {
+    const auto set = [](v1::Vec3d* v, double x, double y, double z) {
+      v->set_x(x), v->set_y(y), v->set_z(z);
+    };
+    v1::TabletopTable& table = *summary.mutable_table();
+    set(table.mutable_normal(), 0, 0, 1);
+    table.set_offset(-0.3);
+    for (const auto& [x, y] : {std::pair{0, 0}, {4, 0}, {4, 3}, {0, 3}})
+      set(table.add_hull(), x, y, 0.3);
+    table.set_point_count(table_points);
+    table.add_primitive_ids(0);
+    for (std::uint32_t id = 1; id <= 2; ++id) {
+      v1::TabletopObject& o = *summary.add_objects();
+      o.set_object_id(id);
+      o.set_point_count(60);
+      set(o.mutable_centroid(), id + 1, 1.5, 0.35);
+      set(o.mutable_bounds_min(), id + 0.5, 0.0, 0.3);
+      set(o.mutable_bounds_max(), id + 1.5, 3.0, 0.4);
+      o.set_height(0.1 * id);
+      o.add_primitive_ids(id);
+    }
+  }
+
   grpc::Status answer(const v1::ScanHeader& header, const std::vector<Vec3f>& points,
                       std::vector<v1::LabelResponse>& responses, v1::LabelSummary& summary) {
     if (!header.model().empty() && header.model() != "fake")
       return {grpc::StatusCode::NOT_FOUND, "no model '" + header.model() + "'"};
     if (points.empty()) return {grpc::StatusCode::INVALID_ARGUMENT, "zero points"};
+    if (header.options().return_objects() && !header.options().tabletop_only())
+      return {grpc::StatusCode::INVALID_ARGUMENT, "options.return_objects needs tabletop_only"};
+    std::size_t table_points = 0;
     {
       std::lock_guard lock(mutex);
       scan_ids.push_back(header.scan_id());
@@ -264,7 +295,16 @@ class FakeLabeler final : public v1::Labeler::Service {
           segments[i] = labels[i] == 0 ? 0xFFFFFFFFu : labels[i] - 1;
         c.set_segments(wire::pack_u32(segments.data(), count));
       }
+      if (header.options().return_objects()) {
+        std::vector<std::uint32_t> objects(count);
+        for (std::size_t i = 0; i < count; ++i) {
+          objects[i] = fake_object_of(labels[i]);
+          table_points += objects[i] == 0;
+        }
+        c.set_objects(wire::pack_u32(objects.data(), count));
+      }
     }
+    if (header.options().return_objects()) fake_objects(table_points, summary);
     if (header.options().return_primitives()) fake_primitives(summary);
     summary.set_scan_id(header.scan_id());
     summary.set_model("fake");

@@ -16,6 +16,7 @@
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/primitives/primitives_json.hpp"
+#include "primlabel/tabletop/objects_json.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -130,6 +131,51 @@ TEST(ClientCli, PrimitivesGoToTheirJsonFile) {
   EXPECT_DOUBLE_EQ(line->length, 0.5);
   EXPECT_EQ(line->direction, primitives::Vec3d(0, 1, 0));
   EXPECT_DOUBLE_EQ(instances[3].rms, 0.004);
+}
+
+// --objects (with --tabletop) writes the summary's table and objects as the core's JSON (read
+// back with its parser) and every point's object id as the `object` field; without --tabletop it
+// is a usage error.
+TEST(ClientCli, ObjectsGoToTheirJsonFileAndTheObjectField) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  const std::string base = cli() + " --server " + server.address() + " label " +
+                           dir.file("scan.pcd") + " -o " + dir.file("out.pcd") + " --objects " +
+                           dir.file("objects.json");
+  const auto refused = test::run_command(base);
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("--tabletop"), std::string::npos) << refused.output;
+
+  const auto r = test::run_command(base + " --tabletop --chunk-points 64");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const tabletop::TabletopObjects objects =
+      tabletop::parse_objects_json(read_text(dir.file("objects.json")));
+  ASSERT_TRUE(objects.table);
+  EXPECT_EQ(objects.table->plane, Eigen::Vector4f(0, 0, 1, -0.3f));
+  EXPECT_EQ(objects.table->hull.size(), 4u);
+  EXPECT_EQ(objects.table->points, 60u);  // x = 1: every fifth of 300 points
+  EXPECT_EQ(objects.table->primitive_ids, std::vector<std::uint32_t>{0});
+  ASSERT_EQ(objects.objects.size(), 2u);
+  for (std::uint32_t id = 1; id <= 2; ++id) {
+    const tabletop::TabletopObject& o = objects.objects[id - 1];
+    EXPECT_EQ(o.id, id);
+    EXPECT_EQ(o.points, 60u);
+    EXPECT_EQ(o.centroid, Eigen::Vector3d(id + 1, 1.5, 0.35));
+    EXPECT_EQ(o.bounds_min, Eigen::Vector3d(id + 0.5, 0.0, 0.3));
+    EXPECT_EQ(o.bounds_max, Eigen::Vector3d(id + 1.5, 3.0, 0.4));
+    EXPECT_DOUBLE_EQ(o.height, 0.1 * id);
+    EXPECT_EQ(o.primitive_ids, std::vector<std::uint32_t>{id});
+  }
+  const PointCloud out = read_cloud(dir.file("out.pcd"));
+  const FloatField* field = out.find_field("object");
+  ASSERT_NE(field, nullptr);
+  ASSERT_EQ(field->values.size(), out.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {  // label i % 5: 1 table, 2, 3 objects, else -1
+    const int label = int(i % 5);
+    const float want = label == 1 ? 0.0f : label == 2 ? 1.0f : label == 3 ? 2.0f : -1.0f;
+    ASSERT_EQ(field->values[i], want) << i;
+  }
 }
 
 TEST(ClientCli, LabeledFilesDescribeThemselvesInTheirHeader) {

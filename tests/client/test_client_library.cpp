@@ -196,8 +196,76 @@ TEST(ClientAssembler, RejectsASummaryThatCountedOtherPoints) {
   EXPECT_THROW(assembler.finish(summary_for(4)), client::ProtocolError);
 }
 
+// Object ids: one a point, asked for means present, and each names the table or an object of
+// the summary.
+TEST(ClientAssembler, ChecksObjectIdsAgainstTheSummary) {
+  const auto with_objects = [](std::uint64_t first, std::vector<std::uint32_t> ids) {
+    v1::LabelChunk c = chunk(first, std::uint32_t(ids.size()));
+    c.set_objects(wire::pack_u32(ids.data(), ids.size()));
+    return c;
+  };
+  v1::LabelSummary s = summary_for(4);
+  s.mutable_table();
+  s.add_objects()->set_object_id(1);
+  {
+    client::LabelAssembler assembler(4, false, false, false, true);
+    assembler.add(with_objects(0, {0, 1}));
+    EXPECT_THROW(assembler.add(chunk(2, 2)), client::ProtocolError);  // asked for, missing
+    assembler.add(with_objects(2, {0xFFFFFFFFu, 1}));
+    const auto result = assembler.finish(s);
+    EXPECT_EQ(result.object_ids, (std::vector<std::uint32_t>{0, 1, 0xFFFFFFFFu, 1}));
+    EXPECT_EQ(result.objects().size(), 1);
+    EXPECT_TRUE(result.has_table());
+  }
+  {
+    client::LabelAssembler assembler(4, false, false, false, true);
+    assembler.add(with_objects(0, {0, 1, 2, 1}));  // object 2 is not in the summary
+    EXPECT_THROW(assembler.finish(s), client::ProtocolError);
+  }
+  {
+    client::LabelAssembler assembler(2, false, false, false, true);
+    assembler.add(with_objects(0, {0, 1}));  // the table, but the summary has none
+    v1::LabelSummary no_table = summary_for(2);
+    no_table.add_objects()->set_object_id(1);
+    EXPECT_THROW(assembler.finish(no_table), client::ProtocolError);
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Calls against the fake server
+
+TEST(ClientCalls, ObjectsComeWithTheirPerPointIds) {
+  FakeServer server;
+  Client client(fast_options(server.address()));
+  for (const bool unary : {false, true}) {
+    const LabelOptions options = label_options([](auto& o) {
+      o.tabletop_only = true;
+      o.objects = true;
+      o.response_chunk_points = 256;
+    });
+    const auto result = unary ? client.label_unary(labeled_line(1000), options)
+                              : client.label(labeled_line(1000), options);
+    ASSERT_EQ(result.object_ids.size(), 1000u);
+    for (std::size_t i = 0; i < 1000; ++i) {  // label i % 7: 1 table, 2 and 3 objects
+      const std::uint32_t label = std::uint32_t(i % 7);
+      const std::uint32_t want = label == 1 ? 0u : label == 2 ? 1u : label == 3 ? 2u : 0xFFFFFFFFu;
+      ASSERT_EQ(result.object_ids[i], want) << i;
+    }
+    ASSERT_TRUE(result.has_table());
+    EXPECT_DOUBLE_EQ(result.table().offset(), -0.3);
+    ASSERT_EQ(result.objects().size(), 2);
+    EXPECT_EQ(result.objects().Get(1).object_id(), 2u);
+    EXPECT_DOUBLE_EQ(result.objects().Get(1).height(), 0.2);
+  }
+  // Without tabletop_only the (fake) server refuses, as the real one does.
+  const LabelOptions refused = label_options([](auto& o) { o.objects = true; });
+  try {
+    client.label(labeled_line(10), refused);
+    FAIL() << "objects without tabletop_only were accepted";
+  } catch (const ClientError& e) {
+    EXPECT_EQ(e.code(), grpc::StatusCode::INVALID_ARGUMENT);
+  }
+}
 
 TEST(ClientCalls, StreamsInChunksAndReassemblesLabelsDescriptorsProbabilities) {
   FakeServer server;

@@ -5,16 +5,20 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "png_decode.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/primitives/primitives_json.hpp"
 #include "primlabel/synth/generate.hpp"
+#include "primlabel/tabletop/objects_json.hpp"
+#include "tabletop_objects_scene.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -121,6 +125,34 @@ TEST_F(PipelineCli, WritesPrimitivesAsJson) {
   // Usage: one input file only.
   EXPECT_EQ(run(eval() + " --model " + zero_model_path() + " -q --primitives " + out + " " +
                 scene_path() + " " + scene_path())
+                .exit_code,
+            2);
+}
+
+// --objects with --tabletop-only: the table and the two boxes and the can of the synthetic
+// table, as the JSON the CLI writes too (read back by the core's parser).
+TEST_F(PipelineCli, WritesTableTopObjectsAsJson) {
+  const std::string scene = (*dir_ / "objects_scene.pcd").string();
+  write_cloud(scene, testing::objects_scene(0.005f).cloud);
+  const std::string out = (*dir_ / "objects.json").string();
+  const Result r = run(
+      eval() + " --model " + zero_model_path() + " --no-truth -q --tabletop-only --primitives " +
+      (*dir_ / "objects_primitives.json").string() + " --objects " + out + " " + scene);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const tabletop::TabletopObjects read = tabletop::parse_objects_json(text);
+  ASSERT_TRUE(read.table) << text.substr(0, 400);
+  EXPECT_GT(std::abs(read.table->plane[2]), 0.999f);
+  ASSERT_EQ(read.objects.size(), 3u) << text.substr(0, 400);
+  std::vector<double> heights;
+  for (const tabletop::TabletopObject& o : read.objects) heights.push_back(o.height);
+  std::sort(heights.begin(), heights.end());
+  EXPECT_NEAR(heights[0], 0.06, 0.002);  // box B, box A, the can
+  EXPECT_NEAR(heights[1], 0.10, 0.002);
+  EXPECT_NEAR(heights[2], 0.12, 0.002);
+  // Usage: only with --tabletop-only.
+  EXPECT_EQ(run(eval() + " --model " + zero_model_path() + " -q --objects " + out + " " + scene)
                 .exit_code,
             2);
 }

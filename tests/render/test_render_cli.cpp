@@ -13,6 +13,7 @@
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/primitives/primitives_json.hpp"
+#include "primlabel/tabletop/objects_json.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -158,6 +159,37 @@ TEST_F(RenderCli, DrawsTheFittedPrimitivesOfAJsonFile) {
     EXPECT_EQ(lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find(bad), std::string::npos) << r.output;
   }
+}
+
+TEST_F(RenderCli, DrawsTheTableTopObjectsOfAJsonFile) {
+  // One box around the scene's middle, as primlabel label --objects writes it.
+  const PointCloud cloud = read_cloud(scene());
+  Vec3f lo = Vec3f::Constant(INFINITY), hi = -lo;
+  for (const Vec3f& p : cloud.xyz)
+    if (is_finite(p)) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  tabletop::TabletopObjects objects;
+  objects.table = tabletop::TabletopTable{};
+  tabletop::TabletopObject box;
+  box.id = 1;
+  box.points = 100;
+  box.bounds_min = (0.75f * lo + 0.25f * hi).cast<double>();
+  box.bounds_max = (0.25f * lo + 0.75f * hi).cast<double>();
+  objects.objects.push_back(box);
+  const std::string json = dir_->file("objects.json");
+  { std::ofstream(json) << tabletop::objects_json(objects); }
+  const std::string base =
+      render_tool() + " " + scene() + " --no-legend --width 320 --height 240 -o ";
+  ASSERT_EQ(run(base + dir_->file("plain_objects.png")).exit_code, 0);
+  Result r = run(base + dir_->file("boxes.png") + " --objects " + json);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test::Decoded plain = test::decode_png(dir_->file("plain_objects.png"));
+  const test::Decoded boxes = test::decode_png(dir_->file("boxes.png"));
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < plain.rgb.size(); ++i) changed += plain.rgb[i] != boxes.rgb[i];
+  EXPECT_GT(changed, 300u) << changed;  // twelve edges
+  r = run(base + dir_->file("bad.png") + " --objects " + scene());
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find(scene()), std::string::npos) << r.output;
 }
 
 TEST(RenderCliShared, MosdSegmentsFromTheSensor) {

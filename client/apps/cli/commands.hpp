@@ -20,6 +20,7 @@ struct LabelCommand {
   bool descriptors = false;
   bool probabilities = false;
   std::string primitives;  // --primitives: JSON file (one input) or directory (several)
+  std::string objects;     // --objects (needs --tabletop): likewise, and an `object` field
   bool unary = false;
   bool quiet = false;
   LabelOptions options;

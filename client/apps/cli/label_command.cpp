@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "common/labeled_output.hpp"
+#include "common/object_json.hpp"
 #include "common/primitive_json.hpp"
 #include "exit_codes.hpp"
 #include "primlabel/cli/cli_common.hpp"
@@ -31,12 +32,25 @@ std::string output_path(const LabelCommand& command, const fs::path& input) {
   return out.string();
 }
 
-// Where the primitives of `input` go: --primitives itself, or inside it for several inputs.
-std::string primitives_path(const LabelCommand& command, const fs::path& input) {
-  const fs::path out(command.primitives);
+// Where the JSON `what` ("primitives", "objects") of `input` goes: `target` itself, or inside it
+// for several inputs.
+std::string json_path(const LabelCommand& command, const std::string& target, const fs::path& input,
+                      const char* what) {
+  const fs::path out(target);
   if (command.inputs.size() > 1 || fs::is_directory(out))
-    return (out / (input.stem().string() + "_primitives.json")).string();
+    return (out / (input.stem().string() + "_" + what + ".json")).string();
   return out.string();
+}
+
+// For several inputs the JSON goes into a directory: false (and said) when it cannot be made.
+bool make_json_directory(const LabelCommand& command, const std::string& target, const char* what) {
+  if (command.inputs.size() <= 1 || target.empty()) return true;
+  std::error_code ec;
+  fs::create_directories(target, ec);
+  if (!ec) return true;
+  std::fprintf(stderr, "primlabel: %s: cannot create the %s directory: %s\n", target.c_str(), what,
+               ec.message().c_str());
+  return false;
 }
 
 }  // namespace
@@ -54,15 +68,16 @@ int run_label(Client& client, LabelCommand command) {
   command.options.descriptors = command.descriptors;
   command.options.probabilities = command.probabilities;
   command.options.primitives = !command.primitives.empty();
-  if (command.inputs.size() > 1 && !command.primitives.empty()) {
-    std::error_code ec;
-    fs::create_directories(command.primitives, ec);
-    if (ec) {
-      std::fprintf(stderr, "primlabel: %s: cannot create the primitives directory: %s\n",
-                   command.primitives.c_str(), ec.message().c_str());
-      return kExitFile;
-    }
+  command.options.objects = !command.objects.empty();
+  if (command.options.objects && !command.options.tabletop_only) {
+    std::fprintf(stderr,
+                 "primlabel: --objects needs --tabletop (the objects are the table-top "
+                 "stage's)\n");
+    return kExitUsage;
   }
+  if (!make_json_directory(command, command.primitives, "primitives") ||
+      !make_json_directory(command, command.objects, "objects"))
+    return kExitFile;
   cli::ProgressPrinter progress(command.quiet);
   int exit_code = kExitOk;
   for (const std::string& input : command.inputs) {
@@ -96,14 +111,20 @@ int run_label(Client& client, LabelCommand command) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const std::string out = output_path(command, input);
     try {
-      const PointCloud labeled = labeled_cloud(std::move(cloud), result);
+      PointCloud labeled = labeled_cloud(std::move(cloud), result);
+      if (!result.object_ids.empty())
+        labeled.set_field("object", 1).values = object_field(result.object_ids);
       write_tagged_cloud(out, labeled, labeled_cloud_tags(result));
       if (command.png)
         write_label_png(labeled, fs::path(out).replace_extension(".png").string(),
                         fs::path(input).filename().string() + " - " + result.summary.model() + " " +
                             result.summary.model_version());
       if (!command.primitives.empty())
-        atomic_write_file(primitives_path(command, input), summary_primitives_json(result.summary));
+        atomic_write_file(json_path(command, command.primitives, input, "primitives"),
+                          summary_primitives_json(result.summary));
+      if (!command.objects.empty())
+        atomic_write_file(json_path(command, command.objects, input, "objects"),
+                          summary_objects_json(result.summary));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "primlabel: %s\n", e.what());
       if (exit_code == kExitOk) exit_code = kExitFile;

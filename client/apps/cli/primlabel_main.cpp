@@ -58,6 +58,12 @@ int main(int argc, char** argv) {
                     "Also fit primitive instances and write them as JSON (as primlabel-eval "
                     "--primitives): a file (one input) or directory (several, "
                     "<input>_primitives.json)");
+  label->add_option("--objects", label_args.objects,
+                    "With --tabletop: also write the table and its objects as JSON (table "
+                    "plane, hull; per object id, points, centroid, bounds, height, primitive "
+                    "ids) to a file (one input) or directory (several, <input>_objects.json), "
+                    "and each point's object id as the field `object` (0 table, k object, -1 "
+                    "neither)");
   label->add_option("--model", label_args.options.model, "Model (default: the server's)");
   label->add_option("--model-version", label_args.options.model_version, "Model version");
   label->add_flag("--tabletop", label_args.options.tabletop_only,

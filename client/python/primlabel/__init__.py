@@ -13,7 +13,7 @@ from ._version import __version__
 from .backoff import Backoff, BackoffPolicy
 from .client import ClassInfo, Client, HealthStatus, Result, Tls
 from .errors import InvalidInput, PrimlabelError
-from .wire import NO_SEGMENT
+from .wire import NO_OBJECT, NO_SEGMENT
 
 __all__ = [
     "Backoff",
@@ -22,6 +22,7 @@ __all__ = [
     "Client",
     "HealthStatus",
     "InvalidInput",
+    "NO_OBJECT",
     "NO_SEGMENT",
     "PrimlabelError",
     "Result",

@@ -70,12 +70,26 @@ class Result:
     summary: labeling_pb2.LabelSummary  # model, version, counts, timings, domain warning
     # With primitives=True: (N,) uint32, the point's index into primitives, NO_SEGMENT if none.
     segments: np.ndarray | None = None
+    # With objects=True: (N,) uint32, the point's table-top object: 0 the table, k objects[k - 1],
+    # NO_OBJECT neither.
+    object_ids: np.ndarray | None = None
     attempts: int = 1  # calls made, including retries
 
     @property
     def primitives(self) -> list:
         """The fitted instances (labeling_pb2.Primitive), primitives[s] for segment id s."""
         return list(self.summary.primitives)
+
+    @property
+    def objects(self) -> list:
+        """The table-top objects (labeling_pb2.TabletopObject), objects[k - 1] for object id k."""
+        return list(self.summary.objects)
+
+    @property
+    def table(self):
+        """The table the objects stand on (labeling_pb2.TabletopTable), None when none was found
+        (summary.no_table_reason says why)."""
+        return self.summary.table if self.summary.HasField("table") else None
 
     @property
     def class_ids(self) -> np.ndarray:
@@ -120,6 +134,7 @@ class _Call:
     want_descriptors: bool
     want_probabilities: bool
     want_segments: bool
+    want_objects: bool = False
 
     def chunk(self, first: int, end: int | None) -> labeling_pb2.PointChunk:
         chunk = labeling_pb2.PointChunk(xyz=self.xyz[first:end].tobytes())
@@ -135,12 +150,12 @@ class _Call:
 
     def assembler(self) -> LabelAssembler:
         return LabelAssembler(len(self.xyz), self.want_descriptors, self.want_probabilities,
-                              self.want_segments)
+                              self.want_segments, self.want_objects)
 
 
 def _result(assembled_and_summary, attempts: int) -> Result:
     assembled, summary = assembled_and_summary
-    labels, descriptor_rows, probability_rows, classes, segments = assembled
+    labels, descriptor_rows, probability_rows, classes, segments, objects = assembled
     return Result(
         labels=labels,
         probabilities=probability_rows,
@@ -148,6 +163,7 @@ def _result(assembled_and_summary, attempts: int) -> Result:
         classes=[ClassInfo(int(i), name) for i, name in classes],
         summary=summary,
         segments=segments,
+        object_ids=objects,
         attempts=attempts,
     )
 
@@ -272,7 +288,9 @@ class Client:
         scan's); normal_radius, feature_radius (> 0: override, where the model allows);
         non_finite, "drop" (NaN/Inf points get label 0) or "reject" (the call fails with
         INVALID_ARGUMENT); primitives, True to group the labels into same-class segments fitted
-        with their class's model (Result.segments, Result.primitives); chunk_points,
+        with their class's model (Result.segments, Result.primitives); objects, True (with
+        tabletop_only) for the table and its objects as instances (Result.table,
+        Result.objects, per point Result.object_ids); chunk_points,
         response_chunk_points; deadline (seconds).
         """
         call, timeout = self._prepare(xyz, normals, model, voxel_size, probabilities, descriptors,
@@ -349,6 +367,7 @@ class Client:
         feature_radius: float | None = None,
         non_finite: str = "drop",
         primitives: bool = False,
+        objects: bool = False,
         chunk_points: int = DEFAULT_CHUNK_POINTS,
         response_chunk_points: int = 0,
         deadline: float | None = None,
@@ -385,12 +404,15 @@ class Client:
                 non_finite=_NON_FINITE[non_finite],
                 response_chunk_points=int(response_chunk_points),
                 return_primitives=bool(primitives),
+                return_objects=bool(objects),
             ),
             layout=labeling_pb2.PointLayout(normals=sent_normals is not None),
             expected_points=len(points),
         )
+        if objects and not tabletop_only:
+            raise InvalidInput("objects=True needs tabletop_only=True (the table-top stage's)")
         call = _Call(header, points, sent_normals, int(chunk_points), bool(descriptors),
-                     bool(probabilities), bool(primitives))
+                     bool(probabilities), bool(primitives), bool(objects))
         timeout = self.deadline if deadline is None else _positive_or_zero(deadline, "deadline")
         return call, timeout
 

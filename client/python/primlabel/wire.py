@@ -11,6 +11,7 @@ from .errors import InvalidInput, ProtocolError
 FLOAT32_LE = np.dtype("<f4")
 UINT32_LE = np.dtype("<u4")
 NO_SEGMENT = 0xFFFFFFFF  # LabelChunk.segments: the point is in no fitted segment
+NO_OBJECT = 0xFFFFFFFF  # LabelChunk.objects: neither the table (0) nor an object (k >= 1)
 
 
 def as_points(values, what: str, points: int | None = None) -> np.ndarray:
@@ -43,17 +44,19 @@ class LabelAssembler:
     once with consistent column counts; any violation is a ProtocolError, never patched over."""
 
     def __init__(self, points: int, want_descriptors: bool, want_probabilities: bool,
-                 want_segments: bool = False):
+                 want_segments: bool = False, want_objects: bool = False):
         self._points = points
         self._want_descriptors = want_descriptors
         self._want_probabilities = want_probabilities
         self._want_segments = want_segments
+        self._want_objects = want_objects
         self._covered = np.zeros(points, dtype=bool)
         self._covered_count = 0
         self.labels = np.zeros(points, dtype=np.uint32)
         self.descriptors: np.ndarray | None = None
         self.probabilities: np.ndarray | None = None
         self.segments: np.ndarray | None = None
+        self.objects: np.ndarray | None = None
 
     def add(self, chunk) -> None:
         first, count = chunk.first_point, chunk.point_count
@@ -81,19 +84,28 @@ class LabelAssembler:
             self.probabilities = self._place(self.probabilities, chunk.probabilities, classes,
                                              first, end, 0.0, "probabilities", at)
 
-        segment_columns = _columns(len(chunk.segments), count, "segments", first)
-        if self._want_segments and count > 0 and segment_columns < 0:
-            raise ProtocolError(f"{at}: primitives were asked for but the segment ids are missing")
-        if segment_columns > 1:
-            raise ProtocolError(f"{at}: {segment_columns} segment ids a point, not 1")
-        if segment_columns == 1:
-            if self.segments is None:
-                self.segments = np.full(self._points, NO_SEGMENT, dtype=np.uint32)
-            self.segments[first:end] = np.frombuffer(chunk.segments, dtype=UINT32_LE)
+        self.segments = self._place_ids(self.segments, chunk.segments, self._want_segments,
+                                        "segment ids", first, end, at)
+        self.objects = self._place_ids(self.objects, chunk.objects, self._want_objects,
+                                       "object ids", first, end, at)
 
         self.labels[first:end] = np.frombuffer(chunk.labels, dtype=UINT32_LE)
         self._covered[first:end] = True
         self._covered_count += count
+
+    def _place_ids(self, target, payload, wanted, what, first, end, at):
+        """One uint32 a point (segment or object ids), all 0xFFFFFFFF until a chunk fills it."""
+        count = end - first
+        columns = _columns(len(payload), count, what, first)
+        if wanted and count > 0 and columns < 0:
+            raise ProtocolError(f"{at}: {what} were asked for but are missing")
+        if columns > 1:
+            raise ProtocolError(f"{at}: {columns} {what} a point, not 1")
+        if columns == 1:
+            if target is None:
+                target = np.full(self._points, 0xFFFFFFFF, dtype=np.uint32)
+            target[first:end] = np.frombuffer(payload, dtype=UINT32_LE)
+        return target
 
     def _place(self, target, payload, columns, first, end, fill, what, at):
         if target is None:
@@ -107,7 +119,7 @@ class LabelAssembler:
 
     def finish(self, summary):
         """Checks coverage, column counts and segment ids against the summary; returns
-        (labels, descriptors, probabilities, classes as (id, name) pairs, segments)."""
+        (labels, descriptors, probabilities, classes as (id, name) pairs, segments, objects)."""
         if self._covered_count != self._points:
             missing = int(np.argmin(self._covered))
             raise ProtocolError(
@@ -148,7 +160,19 @@ class LabelAssembler:
                 )
         elif self._want_segments:
             segments = np.zeros(0, dtype=np.uint32)
-        return self.labels, descriptors, probabilities, classes, segments
+        objects = self.objects
+        if objects is not None:
+            named = objects[objects != NO_OBJECT]
+            bad = (named > len(summary.objects)) | ((named == 0) & (not summary.HasField("table")))
+            if bad.any():
+                value = int(named[np.argmax(bad)])
+                raise ProtocolError(
+                    f"a point is in object {value}, the summary has {len(summary.objects)} "
+                    f"objects{'' if summary.HasField('table') else ' and no table'}"
+                )
+        elif self._want_objects:
+            objects = np.zeros(0, dtype=np.uint32)
+        return self.labels, descriptors, probabilities, classes, segments, objects
 
 
 # grpc.health.v1 by hand (as client/src/health_wire.cpp): two one-field messages do not justify a

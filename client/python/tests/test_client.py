@@ -115,6 +115,46 @@ def test_primitives_come_with_their_segments(client, cloud, call):
     assert client.label(cloud).segments is None  # not asked for: none
 
 
+@pytest.mark.parametrize("call", ["label", "label_unary"])
+def test_objects_come_with_their_per_point_ids(client, cloud, call):
+    # The scene is z-up; the service takes "up" from a camera (-y, no orientation is sent): the
+    # scene as a camera sees it, rotated +90 degrees about x (x, y, z) -> (x, -z, y).
+    rotation = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], dtype=np.float64)
+    xyz = np.asarray(cloud.xyz, dtype=np.float64) @ rotation.T
+    viewpoint = rotation @ np.asarray(cloud.viewpoint[:3], dtype=np.float64)
+    result = getattr(client, call)(xyz, viewpoint=viewpoint, tabletop_only=True, objects=True,
+                                   primitives=True)
+    ids = result.object_ids
+    assert ids.shape == (len(cloud),) and ids.dtype == np.uint32
+    table = result.table
+    assert table is not None, result.summary.no_table_reason
+    assert abs(abs(table.normal.y) - 1) < 0.05 and len(table.hull) >= 3
+    assert table.point_count == np.count_nonzero(ids == 0)
+    objects = result.objects
+    assert len(objects) >= 1
+    named = ids[ids != primlabel.NO_OBJECT]
+    assert int(named.max()) <= len(objects)
+    # Only the table and the objects are labeled (a few of their points may lack a descriptor).
+    assert not np.any((ids == primlabel.NO_OBJECT) & (result.labels != 0))
+    assert np.count_nonzero((ids != primlabel.NO_OBJECT) & (result.labels == 0)) < 0.01 * len(ids)
+    for k, obj in enumerate(objects, start=1):
+        members = np.flatnonzero(ids == k)
+        assert obj.object_id == k and obj.point_count == len(members)
+        points = xyz.astype(np.float32).astype(np.float64)[members]
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        np.testing.assert_allclose([obj.bounds_min.x, obj.bounds_min.y, obj.bounds_min.z], lo,
+                                   atol=1e-6)
+        np.testing.assert_allclose([obj.bounds_max.x, obj.bounds_max.y, obj.bounds_max.z], hi,
+                                   atol=1e-6)
+        # Its primitives are segments mostly made of its points.
+        for s in obj.primitive_ids:
+            in_segment = result.segments == s
+            assert np.count_nonzero(in_segment & (ids == k)) * 2 > np.count_nonzero(in_segment)
+    assert client.label(xyz, tabletop_only=True).object_ids is None  # not asked for: none
+    with pytest.raises(primlabel.InvalidInput):
+        client.label(xyz, objects=True)
+
+
 def test_normals_sent_are_used(client):
     bunny = primlabel.pcd.read(TEST_DATA / "samples/bun0.pcd")
     with_normals = client.label(bunny.xyz, normals=bunny.normals)

@@ -148,10 +148,15 @@ LabelingResult fan_out(const LabelingResult& partial, const PointCloud& part,
     cloud.curvature.assign(cloud.size(), kNaN);
   }
   const std::uint32_t unknown = class_id(PrimitiveClass::kUnknown);
+  if (partial.objects) {  // the ids go with the labels; counts and shapes come at the end
+    result.objects = partial.objects;
+    result.objects->point_object.assign(cloud.size(), tabletop::kNoObject);
+  }
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const std::uint32_t j = slot_of[i];
     if (j == tabletop::kNoVoxel) continue;
     copy_point(partial, j, result, i);
+    if (partial.objects) result.objects->point_object[i] = partial.objects->point_object[j];
     if (partial.labels[j] != unknown) ++result.labeled_points;
     if (!options.use_cloud_normals) {
       cloud.normals[i] = part.normals[j];
@@ -214,6 +219,7 @@ LabelingResult label_tabletop(const LabelModel& model, const FeatureSettings& fe
   // One point per slot: the sub-cloud's own count stands (fan_out counts copies).
   result.labeled_points = partial.labeled_points;
   result.prefilter_seconds = prefilter_seconds;
+  if (options.want_objects) result.objects = tabletop::object_ids(segmented, cloud.size());
   return result;
 }
 
@@ -273,6 +279,8 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
   if (!(options.voxel_size >= 0.0f) || !std::isfinite(options.voxel_size))
     throw std::invalid_argument("voxel size must be finite and >= 0");
   if (options.want_primitives) options.primitives.validate();  // before the costly part
+  if (options.want_objects && !options.tabletop_only)
+    throw std::invalid_argument("objects need the table-top stage (tabletop_only)");
   const FeatureSettings features = effective_features(model, options);
   const float voxel_size =
       options.voxel_size > 0.0f ? options.voxel_size : model.features.voxel_size;
@@ -287,6 +295,16 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
     result.primitives = primitives::fit_primitives(cloud.xyz, cloud.normals, result.labels,
                                                    options.primitives, context);
     result.primitive_seconds = seconds_since(start);
+  }
+  if (result.objects) {
+    tabletop::describe_objects(cloud.xyz, *result.objects);
+    if (result.primitives) {
+      std::vector<std::size_t> segment_points;
+      for (const primitives::Primitive& p : result.primitives->primitives)
+        segment_points.push_back(p.points);
+      tabletop::assign_primitives(result.primitives->point_segment, segment_points,
+                                  *result.objects);
+    }
   }
   return result;
 }

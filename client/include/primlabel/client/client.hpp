@@ -62,6 +62,9 @@ struct LabelOptions {
   bool probabilities = false;
   bool primitives = false;  // fitted primitive instances (summary.primitives) and segment ids
   bool tabletop_only = false;
+  // With tabletop_only: the table and its objects as instances (LabelResult::objects(), table())
+  // and every point's object id (LabelResult::object_ids).
+  bool objects = false;
   float voxel_size = 0;  // > 0: downsample before features
   float normal_radius = 0;
   float feature_radius = 0;
@@ -88,6 +91,9 @@ struct LabelResult {
   std::vector<float> probabilities;  // point-major
   // With LabelOptions::primitives: each point's index into primitives(), 0xFFFFFFFF for none.
   std::vector<std::uint32_t> segments;
+  // With LabelOptions::objects: each point's table-top object, 0 the table, k objects()[k - 1],
+  // 0xFFFFFFFF neither.
+  std::vector<std::uint32_t> object_ids;
   v1::LabelSummary summary;
   int attempts = 1;  // calls made, including retries
 
@@ -99,6 +105,13 @@ struct LabelResult {
   const google::protobuf::RepeatedPtrField<v1::Primitive>& primitives() const {
     return summary.primitives();
   }
+  // The table-top objects (with LabelOptions::objects), objects()[k - 1] for object id k, and the
+  // table they stand on (has_table() false when none was found: summary.no_table_reason()).
+  const google::protobuf::RepeatedPtrField<v1::TabletopObject>& objects() const {
+    return summary.objects();
+  }
+  bool has_table() const { return summary.has_table(); }
+  const v1::TabletopTable& table() const { return summary.table(); }
 };
 
 // A failed call: the gRPC status of the last attempt (or DATA_LOSS when the server's answer did

@@ -20,6 +20,7 @@
 #include "primlabel/geometry/run_context.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/primitives/fit_primitives.hpp"
+#include "primlabel/tabletop/tabletop_objects.hpp"
 
 namespace primlabel::pipeline {
 
@@ -95,6 +96,9 @@ struct LabelingOptions {
   // (LabelingResult::primitives), from the labels and the normals label_cloud leaves in the cloud.
   bool want_primitives = false;
   primitives::PrimitiveOptions primitives;
+  // With tabletop_only: the table and its objects as instances, every input point's object id
+  // and, with want_primitives, the primitives of each (LabelingResult::objects).
+  bool want_objects = false;
 };
 
 struct LabelingResult {
@@ -125,6 +129,8 @@ struct LabelingResult {
   // With want_primitives: the fitted instances and every point's segment (primitive) id.
   std::optional<primitives::PrimitiveSet> primitives;
   double primitive_seconds = 0;  // segmentation and fitting (in no stage above)
+  // With want_objects: the table, the objects and every input point's object id.
+  std::optional<tabletop::TabletopObjects> objects;
 };
 
 // Labels every point with the model's own feature, graph and inference settings (and the
@@ -132,10 +138,10 @@ struct LabelingResult {
 // Exact duplicates are described once (duplicates.hpp): every copy gets the labels,
 // probabilities, descriptor and normal of its lowest-index copy.
 // Throws ModelError when an SVM model's libsvm text does not load, std::invalid_argument for
-// overrides the model does not allow or missing normals, and Cancelled when context.stop is
-// requested (checked between stages and per point inside them, the table-top stage, the voxel
-// filter and the index builds included: within milliseconds). The labels (and primitives) do not
-// depend on context.threads.
+// overrides the model does not allow, missing normals or want_objects without tabletop_only, and
+// Cancelled when context.stop is requested (checked between stages and per point inside them, the
+// table-top stage, the voxel filter and the index builds included: within milliseconds). The labels
+// (and primitives) do not depend on context.threads.
 LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
                            const LabelingOptions& options = {}, const RunContext& context = {});
 
