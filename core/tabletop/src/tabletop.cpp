@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -47,6 +48,7 @@ void TabletopOptions::validate() const {
   if (!std::isfinite(hull_margin)) fail("hull margin must be finite");
   plane.validate();
   clusters.validate();
+  table_noise.validate();
   creases.validate();
   split.validate();
   merge.validate();
@@ -258,6 +260,18 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
                               object_grid, options.clusters);
   } else {
     result.clusters = euclidean_clusters(xyz, candidates, options.clusters);
+  }
+  {
+    TableNoiseSplit noise =
+        separate_table_noise(xyz, height, cloud.viewpoint.origin, std::move(result.clusters),
+                             options.table_band, options.table_noise);
+    result.clusters = std::move(noise.objects);
+    if (!noise.table_points.empty()) {
+      std::vector<std::uint32_t> table;
+      std::merge(result.table_inliers.begin(), result.table_inliers.end(),
+                 noise.table_points.begin(), noise.table_points.end(), std::back_inserter(table));
+      result.table_inliers = std::move(table);
+    }
   }
   context.throw_if_stopped(kWhat);
   // 5. Objects as wholes: cut touching objects at their creases and split stacked objects first, so

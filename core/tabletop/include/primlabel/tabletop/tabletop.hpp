@@ -25,6 +25,7 @@
 #include "primlabel/tabletop/occlusion_merge.hpp"
 #include "primlabel/tabletop/plane_fit.hpp"
 #include "primlabel/tabletop/stacked_split.hpp"
+#include "primlabel/tabletop/table_noise.hpp"
 
 namespace primlabel::tabletop {
 
@@ -64,6 +65,7 @@ struct TabletopOptions {
   float max_object_height = 0.5f;
   float hull_margin = 0.0f;  // grow (> 0) or shrink (< 0) the table hull (m)
   ClusterOptions clusters{0.02f, 100, 200000};
+  TableNoiseOptions table_noise;  // flat clusters within the depth noise of the table: table
   ConvexitySplitOptions creases;  // touching objects, cut at concave creases
   StackSplitOptions split;        // objects standing on objects
   OcclusionMergeOptions merge;    // parts of one object cut apart by occlusion (organised clouds)
