@@ -41,13 +41,13 @@ struct MatchedPair {
 };
 
 struct InstanceMatch {
-  std::size_t true_instances = 0;  // visible true primitives: own_points >= min_true_points
-  std::size_t found = 0;           // of those, matched
+  std::size_t true_instances = 0;    // visible true primitives: own_points >= min_true_points
+  std::size_t found = 0;             // of those, matched
   std::size_t listed_instances = 0;  // true primitives with primitive.points >= min_true_points
   std::size_t listed_found = 0;      // of those, matched
-  std::size_t detections = 0;      // plane/cylinder/sphere/torus with >= min_detection_points
-  std::size_t correct = 0;         // detections matched one to one to a true primitive
-  std::vector<MatchedPair> pairs;  // every match (also of true primitives under the threshold)
+  std::size_t detections = 0;        // plane/cylinder/sphere/torus with >= min_detection_points
+  std::size_t correct = 0;           // detections matched one to one to a true primitive
+  std::vector<MatchedPair> pairs;    // every match (also of true primitives under the threshold)
 };
 
 // `object[i]` is point i's object index (the synthetic cloud's `object` field); `detected`'s

@@ -314,10 +314,10 @@ void explain_misses(const char* what, std::uint64_t seed, const primitives::Prim
                   std::string(primitives::kind_name(p.kind())).c_str(), p.class_id, p.points,
                   p.inliers, n);
       if (const auto* pl = std::get_if<primitives::PlaneModel>(&p.model))
-        std::printf(", normal off %.1f deg, %.0fx%.0f mm",
-                    bench::axis_angle_deg(pl->normal,
-                                          std::get<primitives::PlaneModel>(tp.model).normal),
-                    1000 * pl->extent_u, 1000 * pl->extent_v);
+        std::printf(
+            ", normal off %.1f deg, %.0fx%.0f mm",
+            bench::axis_angle_deg(pl->normal, std::get<primitives::PlaneModel>(tp.model).normal),
+            1000 * pl->extent_u, 1000 * pl->extent_v);
       std::printf("\n");
     }
   }
@@ -378,8 +378,7 @@ int run(const Arguments& args) {
     if (args.explain_misses) {
       explain_misses("true labels", options.seed, from_truth, g.cloud.xyz, objects, instances,
                      truth_match, match_options);
-      explain_misses("predicted", options.seed, *result.primitives, g.cloud.xyz, objects,
-                     instances,
+      explain_misses("predicted", options.seed, *result.primitives, g.cloud.xyz, objects, instances,
                      bench::match_instances(*result.primitives, g.cloud.xyz, objects.values,
                                             instances, match_options),
                      match_options);

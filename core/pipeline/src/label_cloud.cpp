@@ -64,8 +64,7 @@ void fit_primitives_of_input(const PointCloud& cloud, const DescribedCloud& desc
 // here, while its neighbour index and lists are alive.
 LabelingResult label_distinct_points(const LabelModel& model, const FeatureSettings& features,
                                      PointCloud& cloud, const LabelingOptions& options,
-                                     const RunContext& context,
-                                     const PointCloud* input = nullptr) {
+                                     const RunContext& context, const PointCloud* input = nullptr) {
   LabelingResult result;
   result.class_ids = model.class_ids();
   DescribeOptions describe_options;

@@ -25,7 +25,7 @@ struct SegmentOptions {
   // pipeline's own cap (pipeline::kDefaultMaxNeighbors), so its shared lists answer the linking
   // neighbourhood without a search of its own (SharedNeighbors).
   int max_neighbors = 1024;
-  std::size_t min_points = 30;  // smaller components get no segment
+  std::size_t min_points = 30;      // smaller components get no segment
   std::size_t max_segments = 4096;  // the largest kept, the rest get no segment
   bool skip_unknown = true;         // label 0 (unknown) forms no segments
 
