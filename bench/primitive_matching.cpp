@@ -39,6 +39,10 @@ MatchedPair errors(const primitives::Model& fitted, const primitives::Model& tru
 
 }  // namespace
 
+bool visible(const synth::TruePrimitive& truth, const MatchOptions& options) {
+  return truth.own_points >= options.min_true_points;
+}
+
 double axis_angle_deg(const Vec3d& a, const Vec3d& b) {
   return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180 / M_PI;
 }
@@ -59,8 +63,10 @@ InstanceMatch match_instances(const primitives::PrimitiveSet& detected,
   for (std::size_t t = 0; t < truth.size(); ++t) truth_of_object[truth[t].object].push_back(t);
 
   InstanceMatch out;
-  for (const auto& t : truth)
-    if (t.primitive.points >= options.min_true_points) ++out.true_instances;
+  for (const auto& t : truth) {
+    if (visible(t, options)) ++out.true_instances;
+    if (t.primitive.points >= options.min_true_points) ++out.listed_instances;
+  }
 
   // best[t]: the detection with most points on true primitive t, and that count.
   std::vector<std::pair<std::size_t, std::size_t>> best(truth.size(), {0, 0});
@@ -93,7 +99,8 @@ InstanceMatch match_instances(const primitives::PrimitiveSet& detected,
     pair.detection = best[t].first;
     out.pairs.push_back(pair);
     ++out.correct;
-    if (truth[t].primitive.points >= options.min_true_points) ++out.found;
+    if (visible(truth[t], options)) ++out.found;
+    if (truth[t].primitive.points >= options.min_true_points) ++out.listed_found;
   }
   return out;
 }

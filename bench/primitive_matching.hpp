@@ -8,8 +8,11 @@
 // gates (5x the targets, so the error figures still show what is matched). Each true
 // primitive is matched by at most one detection (the one with most points on it): a second
 // detection of the same surface, a detection on no true surface and a detection of the wrong
-// kind all count against precision. Recall is over the true primitives with at least
-// `min_true_points` scan points on them (TruePrimitive::primitive.points).
+// kind all count against precision. Recall is over the visible true primitives: those with at
+// least `min_true_points` scan points of their class that are theirs (TruePrimitive::own_points:
+// nearer to them than to another of their object's primitives). The listed count
+// (primitive.points, which also takes the adjacent faces' points within the tolerance of an
+// edge, so a face the scan never sees can reach it) is reported beside it.
 
 #include <cstddef>
 #include <span>
@@ -38,15 +41,20 @@ struct MatchedPair {
 };
 
 struct InstanceMatch {
-  std::size_t true_instances = 0;  // true primitives with >= min_true_points
-  std::size_t found = 0;           // of those, matched
-  std::size_t detections = 0;      // plane/cylinder/sphere/torus with >= min_detection_points
-  std::size_t correct = 0;         // detections matched one to one to a true primitive
-  std::vector<MatchedPair> pairs;  // every match (also of true primitives under the threshold)
+  std::size_t true_instances = 0;    // visible true primitives: own_points >= min_true_points
+  std::size_t found = 0;             // of those, matched
+  std::size_t listed_instances = 0;  // true primitives with primitive.points >= min_true_points
+  std::size_t listed_found = 0;      // of those, matched
+  std::size_t detections = 0;        // plane/cylinder/sphere/torus with >= min_detection_points
+  std::size_t correct = 0;           // detections matched one to one to a true primitive
+  std::vector<MatchedPair> pairs;    // every match (also of true primitives under the threshold)
 };
 
 // `object[i]` is point i's object index (the synthetic cloud's `object` field); `detected`'s
 // point_segment gives each point's detection (primitives::kNoSegment: none).
+// The rule a true primitive is scored by (recall's denominator).
+bool visible(const synth::TruePrimitive& truth, const MatchOptions& options);
+
 InstanceMatch match_instances(const primitives::PrimitiveSet& detected,
                               const std::vector<Vec3f>& xyz, std::span<const float> object,
                               const std::vector<synth::TruePrimitive>& truth,

@@ -50,6 +50,7 @@ struct Arguments {
   // CGAL's search endurance and connectivity, to check the comparison does not hinge on them.
   double cgal_probability = 0.01;
   double cgal_cluster_spacings = 4;  // cluster epsilon in median point spacings
+  bool explain_misses = false;       // print why each true primitive was not matched
 };
 
 // A curved surface the generator placed: its model, class and true parameters (world frame).
@@ -189,6 +190,7 @@ void print(const char* what, const Figures& f, int scenes) {
 // One detector's instance figures over the scenes (primitive_matching.hpp's rule).
 struct InstanceFigures {
   std::size_t true_instances = 0, found = 0, detections = 0, correct = 0;
+  std::size_t listed_instances = 0, listed_found = 0;  // by primitive.points (edge bands too)
   std::map<PrimitiveKind, std::pair<std::size_t, std::size_t>> by_kind;  // found, true
   std::vector<double> cylinder_radius, sphere_radius, torus_radius, axis_deg, plane_normal_deg;
   double seconds = 0;  // the detector's own time (fit or detection)
@@ -198,13 +200,15 @@ void add_match(const bench::InstanceMatch& m, const std::vector<synth::TruePrimi
                const bench::MatchOptions& options, InstanceFigures& f) {
   f.true_instances += m.true_instances;
   f.found += m.found;
+  f.listed_instances += m.listed_instances;
+  f.listed_found += m.listed_found;
   f.detections += m.detections;
   f.correct += m.correct;
   for (const auto& t : truth)
-    if (t.primitive.points >= options.min_true_points) ++f.by_kind[t.primitive.kind()].second;
+    if (bench::visible(t, options)) ++f.by_kind[t.primitive.kind()].second;
   for (const bench::MatchedPair& pair : m.pairs) {
     const primitives::Primitive& t = truth[pair.truth].primitive;
-    if (t.points < options.min_true_points) continue;
+    if (!bench::visible(truth[pair.truth], options)) continue;
     ++f.by_kind[t.kind()].first;
     switch (t.kind()) {
       case PrimitiveKind::kCylinder:
@@ -239,6 +243,9 @@ json::Json instance_json(const InstanceFigures& f, int scenes) {
   return {{"true_instances", f.true_instances},
           {"found", f.found},
           {"recall", json::rounded(ratio(f.found, f.true_instances), "%.4f")},
+          {"listed_instances", f.listed_instances},
+          {"listed_found", f.listed_found},
+          {"listed_recall", json::rounded(ratio(f.listed_found, f.listed_instances), "%.4f")},
           {"detections", f.detections},
           {"correct", f.correct},
           {"precision", json::rounded(ratio(f.correct, f.detections), "%.4f")},
@@ -268,10 +275,52 @@ void print_instances(const char* what, const InstanceFigures& f, int scenes) {
       1000 * median(f.sphere_radius), 1000 * percentile90(f.sphere_radius), f.sphere_radius.size(),
       1000 * median(radius), 1000 * percentile90(radius), median(f.axis_deg),
       median(f.plane_normal_deg), 1000 * f.seconds / scenes);
+  std::printf("%-22s by the listed count (edge-band points too): recall %zu/%zu = %.3f\n", "",
+              f.listed_found, f.listed_instances, ratio(f.listed_found, f.listed_instances));
   std::printf("%-22s found/true by kind:", "");
   for (const auto& [kind, n] : f.by_kind)
     std::printf(" %s %zu/%zu", std::string(primitives::kind_name(kind)).c_str(), n.first, n.second);
   std::printf("\n");
+}
+
+// For each true primitive with enough points that no detection matched: the detections with
+// points on it, how many, how large they are and what they fit (to see why it was missed).
+void explain_misses(const char* what, std::uint64_t seed, const primitives::PrimitiveSet& set,
+                    const std::vector<Vec3f>& xyz, const FloatField& object,
+                    const std::vector<synth::TruePrimitive>& truth, const bench::InstanceMatch& m,
+                    const bench::MatchOptions& options) {
+  std::vector<bool> matched(truth.size(), false);
+  for (const auto& pair : m.pairs) matched[pair.truth] = true;
+  for (std::size_t t = 0; t < truth.size(); ++t) {
+    const primitives::Primitive& tp = truth[t].primitive;
+    if (matched[t] || tp.points < options.min_true_points) continue;
+    std::printf("miss %s seed %llu: true %s of object %d, %zu points (%zu its own%s)", what,
+                static_cast<unsigned long long>(seed),
+                std::string(primitives::kind_name(tp.kind())).c_str(), truth[t].object, tp.points,
+                truth[t].own_points, bench::visible(truth[t], options) ? "" : ": not visible");
+    if (const auto* pl = std::get_if<primitives::PlaneModel>(&tp.model))
+      std::printf(", %.0fx%.0f mm, normal (%.2f %.2f %.2f)", 1000 * pl->extent_u,
+                  1000 * pl->extent_v, pl->normal.x(), pl->normal.y(), pl->normal.z());
+    std::printf("\n");
+    std::map<std::uint32_t, std::size_t> on;
+    for (std::size_t i = 0; i < xyz.size(); ++i) {
+      const std::uint32_t d = set.point_segment[i];
+      if (d == primitives::kNoSegment || int(object.values[i]) != truth[t].object) continue;
+      if (synth::distance_to(tp.model, xyz[i].cast<double>()) <= options.tolerance) ++on[d];
+    }
+    for (const auto& [d, n] : on) {
+      const primitives::Primitive& p = set.primitives[d];
+      std::printf("    detection %u: %s class %u, %zu points (%zu inliers), %zu on it", d,
+                  std::string(primitives::kind_name(p.kind())).c_str(), p.class_id, p.points,
+                  p.inliers, n);
+      if (const auto* pl = std::get_if<primitives::PlaneModel>(&p.model))
+        std::printf(
+            ", normal off %.1f deg, %.0fx%.0f mm",
+            bench::axis_angle_deg(pl->normal, std::get<primitives::PlaneModel>(tp.model).normal),
+            1000 * pl->extent_u, 1000 * pl->extent_v);
+      std::printf("\n");
+    }
+  }
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -323,9 +372,17 @@ int run(const Arguments& args) {
     truth.seconds += seconds_since(start);
     truth_instances.seconds += seconds_since(start);
     score(from_truth, surfaces, true_points, objects, truth);
-    add_match(
-        bench::match_instances(from_truth, g.cloud.xyz, objects.values, instances, match_options),
-        instances, match_options, truth_instances);
+    const bench::InstanceMatch truth_match =
+        bench::match_instances(from_truth, g.cloud.xyz, objects.values, instances, match_options);
+    add_match(truth_match, instances, match_options, truth_instances);
+    if (args.explain_misses) {
+      explain_misses("true labels", options.seed, from_truth, g.cloud.xyz, objects, instances,
+                     truth_match, match_options);
+      explain_misses("predicted", options.seed, *result.primitives, g.cloud.xyz, objects, instances,
+                     bench::match_instances(*result.primitives, g.cloud.xyz, objects.values,
+                                            instances, match_options),
+                     match_options);
+    }
 #ifdef PRIMLABEL_HAVE_CGAL
     // The same points with primlabel's normals (label_cloud left them in the cloud).
     auto cgal_parameters = bench::CgalRansacParameters::for_spacing(result.point_spacing);
@@ -356,8 +413,9 @@ int run(const Arguments& args) {
   }
   print("predicted labels", predicted, args.scenes);
   print("true labels", truth, args.scenes);
-  std::printf("instances (all true primitives with >= %zu points, planes included):\n",
-              match_options.min_true_points);
+  std::printf(
+      "instances (true primitives with >= %zu scan points of their own, planes included):\n",
+      match_options.min_true_points);
   print_instances("primlabel, predicted", predicted_instances, args.scenes);
   print_instances("primlabel, true labels", truth_instances, args.scenes);
   std::printf("%-22s label_cloud end to end %.0f ms/scan (%d threads)\n", "",
@@ -413,6 +471,8 @@ int main(int argc, char** argv) {
                  "CGAL Efficient RANSAC: cluster epsilon in median point spacings")
       ->check(CLI::Range(0.5, 100.0))
       ->capture_default_str();
+  app.add_flag("--explain-misses", args.explain_misses,
+               "print, per unmatched true primitive, the detections with points on it");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

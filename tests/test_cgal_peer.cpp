@@ -62,7 +62,7 @@ std::vector<synth::TruePrimitive> truth() {
   cylinder.class_id = class_id(PrimitiveClass::kCylinderConvex);
   cylinder.model = primitives::CylinderModel{kBase + 0.06 * kAxis, kAxis, kRadius, 0.12};
   cylinder.points = 1000;
-  return {{0, plane}, {1, cylinder}};
+  return {{0, plane, plane.points}, {1, cylinder, cylinder.points}};  // all points their own
 }
 
 TEST(CgalPeer, FindsThePlaneAndTheCylinderWithTheirParameters) {

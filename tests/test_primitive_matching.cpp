@@ -42,7 +42,7 @@ struct Scene {
     inner.class_id = class_id(PrimitiveClass::kCylinderConcave);
     inner.model = CylinderModel{{0.5, 0, 0.05}, Vec3d::UnitZ(), 0.035, 0.1};
     inner.points = 10;  // under min_true_points: not in the recall
-    truth = {{1, plane}, {2, outer}, {2, inner}};
+    truth = {{1, plane, plane.points}, {2, outer, outer.points}, {2, inner, inner.points}};
   }
 
   // n points of `object` as detection `segment` (kNoSegment: none), from `at(k)`.
@@ -110,7 +110,7 @@ TEST(PrimitiveMatching, CountsEachTrueInstanceOnceAndNoWrongDetection) {
 
 TEST(PrimitiveMatching, ADetectionGoesToTheSurfaceMostOfItsPointsAreOn) {
   Scene s;
-  s.truth[2].primitive.points = 100;  // the inner wall counts now
+  s.truth[2].primitive.points = s.truth[2].own_points = 100;  // the inner wall counts now
   const auto d = s.detection(CylinderModel{{0.5, 0, 0.05}, Vec3d::UnitZ(), 0.035, 0.1});
   s.add(40, 2, d, [](double t) { return on_circle(0.04, t); });
   s.add(70, 2, d, [](double t) { return on_circle(0.035, t); });
@@ -120,6 +120,26 @@ TEST(PrimitiveMatching, ADetectionGoesToTheSurfaceMostOfItsPointsAreOn) {
   ASSERT_EQ(m.pairs.size(), 1u);
   EXPECT_EQ(m.pairs[0].truth, 2u);  // inner, not outer
   EXPECT_NEAR(m.pairs[0].radius_error, 0, 1e-12);
+}
+
+// A face the scan never sees still has the adjacent faces' points within the tolerance of its
+// edge in its listed count; it is visible, and in the recall, only by points of its own.
+TEST(PrimitiveMatching, RecallCountsTruePrimitivesVisibleByPointsOfTheirOwn) {
+  Scene s;
+  s.truth[2].primitive.points = 100;  // listed: 100 points within the tolerance
+  s.truth[2].own_points = 49;         // but under 50 of them nearer to it than to the outer wall
+  const auto d = s.detection(CylinderModel{{0.5, 0, 0.05}, Vec3d::UnitZ(), 0.04, 0.1});
+  s.add(100, 2, d, [](double t) { return on_circle(0.04, t); });
+  bench::InstanceMatch m = bench::match_instances(s.detected, s.xyz, s.object, s.truth);
+  EXPECT_EQ(m.true_instances, 2u);  // the plane and the outer wall
+  EXPECT_EQ(m.found, 1u);
+  EXPECT_EQ(m.listed_instances, 3u);
+  EXPECT_EQ(m.listed_found, 1u);
+  EXPECT_TRUE(bench::visible(s.truth[1], {}));
+  EXPECT_FALSE(bench::visible(s.truth[2], {}));
+  s.truth[2].own_points = 50;
+  m = bench::match_instances(s.detected, s.xyz, s.object, s.truth);
+  EXPECT_EQ(m.true_instances, 3u);
 }
 
 TEST(PrimitiveMatching, MismatchedSizesAreRejected) {

@@ -93,6 +93,7 @@ void write_true_primitives(const std::string& path, const Generated& scan, doubl
   for (std::size_t i = 0; i < truth.size(); ++i) {
     json::Json entry = primitives::to_json(truth[i].primitive, i);
     entry["object"] = truth[i].object;
+    entry["own_points"] = truth[i].own_points;  // the visibility rule of bench-primitives
     list.push_back(std::move(entry));
   }
   const json::Json out = {{"source", "primlabel-synth ground truth"},

@@ -13,6 +13,7 @@
 #include "primlabel/geometry/normals.hpp"
 #include "primlabel/pipeline/duplicates.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/primitives/primitives_json.hpp"
 #include "primlabel/tabletop/voxel_grid.hpp"
 #include "random_label_model.hpp"
 
@@ -99,6 +100,28 @@ TEST(PipelineServiceOptions, SharedNeighbourListsChangeNothingButTheSearches) {
   PointCloud again = table_with_box_cloud(0.005f);
   EXPECT_EQ(pipeline::label_cloud(model, again, shared_options, RunContext{2}).labels,
             shared.labels);
+}
+
+// label_cloud fits the primitives with the index, lists and spacing that described the cloud;
+// they are those of fit_primitives on its labels and normals alone, bit for bit, at 1 and 2
+// threads (and the lists were there to share).
+TEST(PipelineServiceOptions, PrimitivesFromTheSharedListsAreThoseOfAStandaloneFit) {
+  const LabelModel model = random_label_model("crf", "1", 7, 0.5f);
+  pipeline::LabelingOptions options;
+  options.want_primitives = true;
+  for (int threads : {1, 2}) {
+    PointCloud cloud = table_with_box_cloud(0.005f);
+    const auto labeled = pipeline::label_cloud(model, cloud, options, RunContext{threads});
+    EXPECT_GT(labeled.lists_seconds, 0.0);
+    ASSERT_TRUE(labeled.primitives);
+    const primitives::PrimitiveSet alone = primitives::fit_primitives(
+        cloud.xyz, cloud.normals, labeled.labels, options.primitives, RunContext{threads});
+    ASSERT_GE(alone.primitives.size(), 1u);
+    EXPECT_EQ(labeled.primitives->segment_radius, alone.segment_radius);
+    EXPECT_EQ(labeled.primitives->point_segment, alone.point_segment);
+    EXPECT_EQ(primitives::primitives_json(labeled.primitives->primitives),
+              primitives::primitives_json(alone.primitives));
+  }
 }
 
 TEST(PipelineServiceOptions, ClientNormalsSkipEstimationAndGiveTheSameLabels) {

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "primitive_samples.hpp"
+#include "primlabel/geometry/point_spacing.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/primitives/fit_primitives.hpp"
 #include "primlabel/primitives/primitives_json.hpp"
@@ -127,6 +128,37 @@ TEST(FitPrimitives, SceneOfKnownShapesAnyThreadCount) {
               primitives_json(std::span(&two.primitives[k], 1)));
     EXPECT_EQ(one.primitives[k].rms, two.primitives[k].rms);
   }
+}
+
+// What the labeling pipeline shares (its index, its radius lists, kept whole or in part, and its
+// point spacing) gives the segments and fits a search of segment_by_label's own gives, at 1 and
+// 2 threads; lists of a smaller radius than the linking one are not used.
+TEST(FitPrimitives, SharedNeighbourListsGiveTheSameSegmentsAndFits) {
+  const Scene scene = make_scene();
+  const std::vector<Vec3f>& xyz = scene.samples.xyz;
+  const PrimitiveOptions options;  // automatic linking radius, the default cap
+  const PrimitiveSet own =
+      fit_primitives(xyz, scene.samples.normals, scene.labels, options, RunContext{1});
+  ASSERT_GE(own.primitives.size(), 3u);
+  const NeighborSearch search(xyz);
+  const float spacing = median_point_spacing(xyz, search);
+  const float linking = own.segment_radius;
+  ASSERT_NEAR(linking, 4 * spacing, 1e-6f);
+  const NeighborLists whole(xyz, search, Neighborhood::Hybrid(2 * linking, 1024), 1u << 30);
+  const NeighborLists part(xyz, search, Neighborhood::Hybrid(2 * linking, 1024), 200000);
+  const NeighborLists narrow(xyz, search, Neighborhood::Hybrid(0.5f * linking, 1024), 1u << 30);
+  ASSERT_EQ(whole.kept_points(), xyz.size());
+  ASSERT_GT(part.kept_points(), 0u);
+  ASSERT_LT(part.kept_points(), xyz.size());
+  for (const NeighborLists* lists : {&whole, &part, &narrow, (const NeighborLists*)nullptr})
+    for (int threads : {1, 2}) {
+      const PrimitiveSet shared = fit_primitives(xyz, scene.samples.normals, scene.labels, options,
+                                                 RunContext{threads}, {&search, lists, spacing});
+      EXPECT_EQ(shared.segment_radius, own.segment_radius);
+      EXPECT_EQ(shared.point_segment, own.point_segment) << threads;
+      ASSERT_EQ(shared.primitives.size(), own.primitives.size());
+      EXPECT_EQ(primitives_json(shared.primitives), primitives_json(own.primitives));
+    }
 }
 
 TEST(FitPrimitives, CornersAndFailedFitsKeepTheirSegment) {

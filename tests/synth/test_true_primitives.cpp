@@ -86,18 +86,27 @@ TEST(TruePrimitives, RandomTablesAreCoveredAndCountsSayWhatWasSeen) {
     // The table's top is the largest seen primitive, its bottom is seen only along the edge it
     // shares with the sides; every object in the scan has seen primitives (its edge and corner
     // points count for none).
-    std::size_t most = 0, table_top = 0, table_bottom = 0;
+    // A point counts as its own for one primitive at most, the nearest: the bottom, seen only
+    // through the sides' points along its edges, has next to none of its own.
+    std::size_t most = 0, table_top = 0, table_bottom = 0, top_own = 0, bottom_own = 0, own = 0;
     std::map<int, std::size_t> seen_per_object;
     for (const TruePrimitive& t : truth) {
       most = std::max(most, t.primitive.points);
       seen_per_object[t.object] += t.primitive.points;
+      EXPECT_LE(t.own_points, t.primitive.points);
+      own += t.own_points;
       const auto* plane = std::get_if<primitives::PlaneModel>(&t.primitive.model);
-      if (t.object == 0 && plane && plane->normal.z() > 0.99) table_top = t.primitive.points;
-      if (t.object == 0 && plane && plane->normal.z() < -0.99) table_bottom = t.primitive.points;
+      if (t.object == 0 && plane && plane->normal.z() > 0.99)
+        table_top = t.primitive.points, top_own = t.own_points;
+      if (t.object == 0 && plane && plane->normal.z() < -0.99)
+        table_bottom = t.primitive.points, bottom_own = t.own_points;
       EXPECT_EQ(t.primitive.confidence, 1.0);
     }
     EXPECT_EQ(table_top, most) << seed;
     EXPECT_LT(table_bottom, table_top / 100) << seed;
+    EXPECT_GT(top_own, table_top * 99 / 100) << seed;
+    EXPECT_LT(bottom_own, 10u) << seed;
+    EXPECT_LE(own, scan.cloud.size()) << seed;
     const FloatField* object = scan.cloud.find_field("object");
     std::map<int, std::size_t> in_scan;
     for (float o : object->values) ++in_scan[int(o)];

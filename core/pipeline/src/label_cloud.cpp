@@ -46,10 +46,25 @@ FeatureSettings effective_features(const LabelModel& model, const LabelingOption
   return settings;
 }
 
+// The primitives of the labeled input cloud, reusing the neighbour index, shared lists and point
+// spacing that described it (the same segments as a search of its own, ~4x faster).
+void fit_primitives_of_input(const PointCloud& cloud, const DescribedCloud& described,
+                             const LabelingOptions& options, const RunContext& context,
+                             LabelingResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  const primitives::SharedNeighbors shared{described.search.get(), described.lists.get(),
+                                           described.point_spacing};
+  result.primitives = primitives::fit_primitives(cloud.xyz, cloud.normals, result.labels,
+                                                 options.primitives, context, shared);
+  result.primitive_seconds = seconds_since(start);
+}
+
 // Every point of `cloud` described and labeled (no duplicates expected, see label_all_points).
+// When `cloud` is the input cloud itself (`input`) and primitives are wanted, they are fitted
+// here, while its neighbour index and lists are alive.
 LabelingResult label_distinct_points(const LabelModel& model, const FeatureSettings& features,
                                      PointCloud& cloud, const LabelingOptions& options,
-                                     const RunContext& context) {
+                                     const RunContext& context, const PointCloud* input = nullptr) {
   LabelingResult result;
   result.class_ids = model.class_ids();
   DescribeOptions describe_options;
@@ -90,6 +105,8 @@ LabelingResult label_distinct_points(const LabelModel& model, const FeatureSetti
     result.descriptors = std::move(described.descriptors);
   }
   result.labeled_points = graph.num_active();
+  if (options.want_primitives && input == &cloud)
+    fit_primitives_of_input(cloud, described, options, context, result);
   return result;
 }
 
@@ -186,9 +203,10 @@ PointCloud gather(const PointCloud& cloud, const std::vector<std::uint32_t>& ind
 // results (as voxels fan out to their members below).
 LabelingResult label_all_points(const LabelModel& model, const FeatureSettings& features,
                                 PointCloud& cloud, const LabelingOptions& options,
-                                const RunContext& context) {
+                                const RunContext& context, const PointCloud* input = nullptr) {
   const DuplicateMap duplicates = find_duplicates(cloud.xyz, context.stop);
-  if (!duplicates.any()) return label_distinct_points(model, features, cloud, options, context);
+  if (!duplicates.any())
+    return label_distinct_points(model, features, cloud, options, context, input);
   PointCloud distinct = gather(cloud, duplicates.representatives, options.use_cloud_normals);
   const LabelingResult partial = label_distinct_points(model, features, distinct, options, context);
   return fan_out(partial, distinct, duplicates.slot_of, cloud, options);
@@ -223,11 +241,12 @@ LabelingResult label_tabletop(const LabelModel& model, const FeatureSettings& fe
   return result;
 }
 
+// `input`: the caller's cloud when `cloud` is it (see label_distinct_points).
 LabelingResult label_points(const LabelModel& model, const FeatureSettings& features,
                             PointCloud& cloud, const LabelingOptions& options,
-                            const RunContext& context) {
+                            const RunContext& context, const PointCloud* input = nullptr) {
   return options.tabletop_only ? label_tabletop(model, features, cloud, options, context)
-                               : label_all_points(model, features, cloud, options, context);
+                               : label_all_points(model, features, cloud, options, context, input);
 }
 
 // Voxel centroids, with the mean of the members' normals (normalised) when the cloud's own
@@ -287,10 +306,10 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
   context.throw_if_stopped("labeling");
   LabelingResult result = voxel_size > 0.0f
                               ? label_voxels(model, features, cloud, voxel_size, options, context)
-                              : label_points(model, features, cloud, options, context);
+                              : label_points(model, features, cloud, options, context, &cloud);
   result.domain_warning =
       domain_warning(model.training, result.point_spacing, result.surface_variation);
-  if (options.want_primitives) {
+  if (options.want_primitives && !result.primitives) {  // not fitted with the labeling's lists
     const auto start = std::chrono::steady_clock::now();
     result.primitives = primitives::fit_primitives(cloud.xyz, cloud.normals, result.labels,
                                                    options.primitives, context);

@@ -47,14 +47,14 @@ void PrimitiveOptions::validate() const {
 
 PrimitiveSet fit_primitives(const std::vector<Vec3f>& xyz, std::span<const Vec3f> normals,
                             std::span<const std::uint32_t> labels, const PrimitiveOptions& options,
-                            const RunContext& context) {
+                            const RunContext& context, const SharedNeighbors& shared) {
   options.validate();
   if (!normals.empty() && normals.size() != xyz.size())
     throw std::invalid_argument("primitives: " + std::to_string(normals.size()) + " normals for " +
                                 std::to_string(xyz.size()) + " points");
   PrimitiveSet out;
   auto start = std::chrono::steady_clock::now();
-  Segmentation segmentation = segment_by_label(xyz, labels, options.segments, context);
+  Segmentation segmentation = segment_by_label(xyz, labels, options.segments, context, shared);
   out.segment_seconds = seconds_since(start);
   out.segment_radius = segmentation.radius;
   start = std::chrono::steady_clock::now();

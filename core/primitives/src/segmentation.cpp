@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -39,9 +40,10 @@ class DisjointSets {
 };
 
 float linking_radius(const std::vector<Vec3f>& xyz, const NeighborSearch& search,
-                     const SegmentOptions& options) {
+                     const SegmentOptions& options, float known_spacing) {
   if (options.radius > 0.0f) return options.radius;
-  const float spacing = median_point_spacing(xyz, search);
+  const float spacing =
+      std::isnan(known_spacing) ? median_point_spacing(xyz, search) : known_spacing;
   return std::isfinite(spacing) ? std::max(4.0f * spacing, 1e-3f) : 1e-3f;
 }
 
@@ -57,7 +59,8 @@ void SegmentOptions::validate() const {
 }
 
 Segmentation segment_by_label(const std::vector<Vec3f>& xyz, std::span<const std::uint32_t> labels,
-                              const SegmentOptions& options, const RunContext& context) {
+                              const SegmentOptions& options, const RunContext& context,
+                              const SharedNeighbors& shared) {
   options.validate();
   if (labels.size() != xyz.size())
     throw std::invalid_argument("segmentation: " + std::to_string(labels.size()) + " labels for " +
@@ -68,9 +71,18 @@ Segmentation segment_by_label(const std::vector<Vec3f>& xyz, std::span<const std
   const std::size_t n = xyz.size();
   out.point_segment.assign(n, kNoSegment);
   if (n == 0) return out;
-  const NeighborSearch search(xyz, context.stop);
-  out.radius = linking_radius(xyz, search, options);
+  std::optional<NeighborSearch> own_search;
+  if (!shared.search) own_search.emplace(xyz, context.stop);
+  const NeighborSearch& search = shared.search ? *shared.search : *own_search;
+  out.radius =
+      linking_radius(xyz, search, options, shared.search ? shared.point_spacing : float(NAN));
   const Neighborhood hood = Neighborhood::Hybrid(out.radius, options.max_neighbors);
+  // The lists hold the same neighbour set as a search (NeighborLists::find) when the linking
+  // radius is within theirs; the order differs, which components do not depend on.
+  const NeighborLists* lists =
+      shared.search && shared.lists && out.radius <= shared.lists->neighborhood().radius
+          ? shared.lists
+          : nullptr;
   auto eligible = [&](std::size_t i) {
     return is_finite(xyz[i]) && !(options.skip_unknown && labels[i] == 0);
   };
@@ -87,7 +99,10 @@ Segmentation segment_by_label(const std::vector<Vec3f>& xyz, std::span<const std
           const std::size_t last = std::min(end, first + kBlockPoints);
           for (std::size_t i = first; i < last; ++i) {
             if (!eligible(i)) continue;
-            search.find(xyz[i], hood, list, false);
+            if (lists)
+              lists->find(i, hood, list);
+            else
+              search.find(xyz[i], hood, list, false);
             for (std::uint32_t j : list.indices)
               if (j > i && labels[j] == labels[i]) edges[block].emplace_back(std::uint32_t(i), j);
           }

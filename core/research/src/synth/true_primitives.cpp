@@ -154,17 +154,23 @@ double distance_to(const primitives::Model& model, const Vec3d& p) {
 }
 
 void count_points_on(std::vector<TruePrimitive>& truth, const PointCloud& cloud, double tolerance) {
-  for (TruePrimitive& t : truth) t.primitive.points = 0;
+  for (TruePrimitive& t : truth) t.primitive.points = t.own_points = 0;
   const FloatField* object = cloud.find_field("object");
   if (!object || !cloud.has_labels()) return;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (!is_finite(cloud.xyz[i])) continue;
     const int owner = int(object->values[i]);
     const Vec3d p = cloud.xyz[i].cast<double>();
-    for (TruePrimitive& t : truth)
-      if (t.object == owner && counts_for(cloud.labels[i], t.primitive.class_id) &&
-          distance_to(t.primitive.model, p) <= tolerance)
-        ++t.primitive.points;
+    TruePrimitive* nearest = nullptr;
+    double nearest_distance = tolerance;
+    for (TruePrimitive& t : truth) {
+      if (t.object != owner || !counts_for(cloud.labels[i], t.primitive.class_id)) continue;
+      const double d = distance_to(t.primitive.model, p);
+      if (d > tolerance) continue;
+      ++t.primitive.points;
+      if (!nearest || d < nearest_distance) nearest = &t, nearest_distance = d;
+    }
+    if (nearest) ++nearest->own_points;
   }
 }
 

@@ -34,9 +34,10 @@ struct PrimitiveSet {
 
 // `normals` may be empty (then only planes and lines are fitted; the curved models need them) or
 // hold one entry per point. Throws std::invalid_argument for mismatched sizes or bad options,
-// Cancelled when context.stop is requested (checked per segment).
+// Cancelled when context.stop is requested (checked per segment). `shared`: what the labeling
+// already built on `xyz` (segment_by_label reuses it; the result is the same).
 PrimitiveSet fit_primitives(const std::vector<Vec3f>& xyz, std::span<const Vec3f> normals,
                             std::span<const std::uint32_t> labels, const PrimitiveOptions& options,
-                            const RunContext& context = {});
+                            const RunContext& context = {}, const SharedNeighbors& shared = {});
 
 }  // namespace primlabel::primitives

@@ -17,6 +17,11 @@ struct TruePrimitive {
   // class_id and model set; points = the scan points on it (see count_points_on), the rest 0;
   // confidence 1.
   primitives::Primitive primitive;
+  // Of primitive.points, those nearer to this primitive than to any other of its object's that
+  // the point's class counts for (ties: the first listed): a point along an edge two faces share
+  // counts for one. A face the scan never sees keeps only the adjacent faces' points within the
+  // tolerance of its edges in `points`, none here (see count_points_on).
+  std::size_t own_points = 0;
 };
 
 std::vector<TruePrimitive> true_primitives(const Scene& scene);
@@ -27,7 +32,7 @@ double distance_to(const primitives::Model& model, const Eigen::Vector3d& p);
 
 // Sets each true primitive's `points` to the points of `cloud` (fields `object` and `label`) of
 // its object and class (for tori either torus class) within `tolerance` of its surface; the same
-// point may count for two faces along their shared edge.
+// point may count for two faces along their shared edge. Sets own_points too.
 void count_points_on(std::vector<TruePrimitive>& truth, const PointCloud& cloud, double tolerance);
 
 }  // namespace primlabel::synth
