@@ -10,6 +10,7 @@
 #include "primlabel/tabletop/segmentation_eval.hpp"
 #include "primlabel/tabletop/stacked_split.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
+#include "table_scan.hpp"
 
 namespace primlabel::tabletop {
 namespace {
@@ -102,66 +103,9 @@ TEST(TabletopStackedSplit, ContainersBoxesAndLowSurfacesStayWhole) {
   EXPECT_THROW(split_stacked(stack, heights(stack), kTable, {}, options), std::invalid_argument);
 }
 
-// Boxes on a 1.2 x 1.3 m table (z = 0), ray-cast into an organised 640 x 480 scan (Kinect-like
-// optics) from a camera above and in front, with mOSD labels (1 table, 10k+ object k) and
-// colours.
-struct Box {
-  Vec3f lo, hi;
-  std::uint32_t label, rgb;
-};
-
-PointCloud scan(const std::vector<Box>& boxes) {
-  const int width = 640, height = 480;
-  const float focal = 525.0f;
-  const Vec3f eye(0.0f, -0.7f, 0.6f), target(0.0f, 0.2f, 0.0f);
-  const Vec3f forward = (target - eye).normalized();
-  const Vec3f right = forward.cross(Vec3f::UnitZ()).normalized();
-  const Vec3f down = forward.cross(right);
-  std::mt19937 rng(3);
-  std::normal_distribution<float> noise(0.0f, 0.0005f);
-  PointCloud cloud;
-  cloud.width = width;
-  cloud.height = height;
-  cloud.viewpoint.origin = eye;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c) {
-      const Vec3f ray =
-          (forward + (c - width / 2.0f) / focal * right + (r - height / 2.0f) / focal * down)
-              .normalized();
-      float nearest = std::numeric_limits<float>::infinity();
-      std::uint32_t label = 0, rgb = 0;
-      if (ray.z() < 0) {  // the table
-        const float t = -eye.z() / ray.z();
-        const Vec3f p = eye + t * ray;
-        if (std::abs(p.x()) < 0.6f && p.y() > -0.3f && p.y() < 1.0f) {
-          nearest = t;
-          label = 1;
-          rgb = 0xC8B496;
-        }
-      }
-      for (const Box& box : boxes) {  // slab test
-        float t0 = 0.0f, t1 = std::numeric_limits<float>::infinity();
-        for (int a = 0; a < 3; ++a) {
-          const float ta = (box.lo[a] - eye[a]) / ray[a], tb = (box.hi[a] - eye[a]) / ray[a];
-          t0 = std::max(t0, std::min(ta, tb));
-          t1 = std::min(t1, std::max(ta, tb));
-        }
-        if (t0 <= t1 && t0 < nearest) {
-          nearest = t0;
-          label = box.label;
-          rgb = box.rgb;
-        }
-      }
-      const bool hit = std::isfinite(nearest);
-      const Vec3f p = hit ? Vec3f(eye + nearest * ray + Vec3f(noise(rng), noise(rng), noise(rng)))
-                          : Vec3f(nan, nan, nan);
-      cloud.xyz.push_back(p);
-      cloud.labels.push_back(hit ? label : 0);
-      cloud.rgba.push_back(0xFF000000u | rgb);
-    }
-  return cloud;
-}
+using test::Box;
+// The refinement tests' scans: boxes only, their own noise seed.
+PointCloud scan(const std::vector<Box>& boxes) { return test::scan(boxes, {}, 3); }
 
 TabletopResult segment(const PointCloud& cloud, bool merge = true) {
   TabletopOptions options;
