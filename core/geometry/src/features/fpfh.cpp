@@ -373,7 +373,8 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
             }
             float* row = &spfh[p * kFpfhSize];
             if (cut[p] || received != expected[p] || neighbor_count[p] > kMaxCountedNeighbors) {
-              const std::span<const std::uint32_t> list = neighbors_of(p, scratch.list);
+              std::span<const std::uint32_t> list;
+              if (!cache.load(p, list)) list = neighbors_of(p, scratch.list);
               compute_spfh(cloud, p, list, usable_or_all, neighbor_count[p], scratch, row);
             } else {
               const float* sum_of = scratch.sums.for_neighbors(neighbor_count[p]);
