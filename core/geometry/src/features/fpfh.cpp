@@ -293,11 +293,6 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
   // Points without a normal are skipped where a list is read; null when every point has one.
   const bool all_usable = std::all_of(usable.begin(), usable.end(), [](char u) { return u != 0; });
   const char* usable_or_all = all_usable ? nullptr : usable.data();
-  const auto taking_part = [&](std::span<const std::uint32_t> list) {
-    if (all_usable) return list.size();
-    return std::size_t(
-        std::count_if(list.begin(), list.end(), [&](std::uint32_t q) { return usable[q] != 0; }));
-  };
 
   std::vector<float> spfh;
   std::vector<double> spfh_sums;              // per sub-histogram, for the normalisation
@@ -308,6 +303,16 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
   // Shared lists are read again in pass 2 at no cost; searched ones are kept for it.
   NeighborCache cache(n, use_lists ? 0 : options.neighbor_cache_bytes);
   detail::ProgressCounter progress(context.progress, 2 * n);
+  // What pass 2 needs of p's list: the list itself (when searched) and how many take part.
+  const auto keep_for_pass_2 = [&](std::size_t p, std::span<const std::uint32_t> list) {
+    cache.store(p, list);
+    const std::size_t taking_part =
+        all_usable ? list.size()
+                   : std::size_t(std::count_if(list.begin(), list.end(),
+                                               [&](std::uint32_t q) { return usable[q] != 0; }));
+    neighbor_count[p] = static_cast<std::uint32_t>(
+        std::min<std::size_t>(taking_part, std::numeric_limits<std::uint32_t>::max()));
+  };
   const auto finish_row = [&](std::size_t p) {
     const float* row = &spfh[p * kFpfhSize];
     for (int b = 0; b < kFpfhSize; ++b) spfh_sums[3 * p + b / kBins] += row[b];
@@ -342,9 +347,7 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
             if (stop.stop_requested()) return;
             if (!usable[p]) continue;
             const std::span<const std::uint32_t> list = neighbors_of(p, scratch.pairs.list);
-            cache.store(p, list);
-            neighbor_count[p] = static_cast<std::uint32_t>(std::min<std::size_t>(
-                taking_part(list), std::numeric_limits<std::uint32_t>::max()));
+            keep_for_pass_2(p, list);
             cut[p] = hood.max_neighbors > 0 && list.size() >= std::size_t(hood.max_neighbors);
             expected[p] =
                 count_upper_pairs(cloud, p, list, usable_or_all, scratch.pairs, *scratch.counts);
@@ -394,9 +397,7 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
             if (stop.stop_requested()) return;
             if (!usable[p]) continue;
             const std::span<const std::uint32_t> list = neighbors_of(p, scratch.list);
-            cache.store(p, list);
-            neighbor_count[p] = static_cast<std::uint32_t>(std::min<std::size_t>(
-                taking_part(list), std::numeric_limits<std::uint32_t>::max()));
+            keep_for_pass_2(p, list);
             if (neighbor_count[p] < 2) continue;
             compute_spfh(cloud, p, list, usable_or_all, neighbor_count[p], scratch,
                          &spfh[p * kFpfhSize]);
