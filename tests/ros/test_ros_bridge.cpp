@@ -197,6 +197,45 @@ TEST(LabeledPointCloud2, RefusesAResultOfAnotherSize) {
                std::invalid_argument);
 }
 
+TEST(LabeledPointCloud2, AppendsObjectAndSegmentIdsAfterTheLabel) {
+  PointCloud cloud = organised_cloud();
+  cloud.labels = {7, 7, 7, 7, 7, 7};
+  const PointCloud2 in = to_pointcloud2(cloud);
+  client::LabelResult r = result_for(6);
+  r.object_ids = {0, 0, 1, 2, 0xFFFFFFFFu, 1};
+  r.segments = {3, 0xFFFFFFFFu, 1, 1, 0, 2};
+  rosnode::LabeledFields fields;
+  fields.object = fields.segment = fields.confidence = true;
+  for (const PointField& f : in.fields)  // an input field of a name the node writes is replaced
+    ASSERT_NE(f.name, "object");
+  PointCloud2 with_old_object = in;
+  with_old_object.fields.push_back(with_old_object.fields.front());
+  with_old_object.fields.back().name = "object";
+  for (const PointCloud2& input : {in, with_old_object}) {
+    const PointCloud2 out = labeled_pointcloud2(input, r, fields);
+    expect_layout_kept(in, out);
+    const std::uint32_t label = field_named(out, "label").offset;
+    EXPECT_EQ(field_named(out, "object").offset, label + 4);
+    EXPECT_EQ(field_named(out, "object").datatype, PointField::UINT32);
+    EXPECT_EQ(field_named(out, "segment").offset, label + 8);
+    EXPECT_EQ(field_named(out, "segment").datatype, PointField::UINT32);
+    EXPECT_EQ(field_named(out, "confidence").offset, label + 12);
+    EXPECT_EQ(std::count_if(out.fields.begin(), out.fields.end(),
+                            [](const PointField& f) { return f.name == "object"; }),
+              1);
+    for (std::size_t i = 0; i < 6; ++i) {
+      EXPECT_EQ(value_of<std::uint32_t>(out, i, "label"), r.labels[i]);
+      EXPECT_EQ(value_of<std::uint32_t>(out, i, "object"), r.object_ids[i]);
+      EXPECT_EQ(value_of<std::uint32_t>(out, i, "segment"), r.segments[i]);
+    }
+  }
+  client::LabelResult no_ids = result_for(6);
+  EXPECT_THROW(labeled_pointcloud2(in, no_ids, rosnode::LabeledFields{false, false, true, false}),
+               std::invalid_argument);
+  EXPECT_THROW(labeled_pointcloud2(in, no_ids, rosnode::LabeledFields{false, false, false, true}),
+               std::invalid_argument);
+}
+
 TEST(LabeledPointCloud2, TheHeaderIsTheEchoedFrameAndStampElseTheInputs) {
   PointCloud2 in = to_pointcloud2(organised_cloud());
   in.header.frame_id = "sent_frame";
@@ -227,6 +266,17 @@ TEST(SummaryJson, CarriesTheProtoFieldNamesFrameAndStamp) {
   EXPECT_EQ(json.at("model"), "tabletop-kinect");
   EXPECT_EQ(json.at("class_counts").at(0).at("name"), "plane");
   EXPECT_EQ(json.at("scan_id"), "");  // every field present
+}
+
+TEST(NodeParameters, ObjectsAndPrimitivesGoIntoTheLabelOptions) {
+  rosnode::NodeParameters parameters;
+  EXPECT_FALSE(rosnode::label_options(parameters).objects);
+  EXPECT_FALSE(rosnode::label_options(parameters).primitives);
+  parameters.tabletop_only = parameters.objects = parameters.primitives = true;
+  const auto options = rosnode::label_options(parameters);
+  EXPECT_TRUE(options.tabletop_only);
+  EXPECT_TRUE(options.objects);
+  EXPECT_TRUE(options.primitives);
 }
 
 TEST(NodeParameters, TheViewpointGoesIntoTheLabelOptionsOnlyWhenSet) {

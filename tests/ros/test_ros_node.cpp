@@ -14,6 +14,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
 
@@ -151,12 +152,14 @@ class RosNode : public ::testing::Test {
     return std::make_unique<NodeUnderTest>(name, all, file(name + ".log"));
   }
 
-  // The CLI's labeled version of `pcd` (same model and voxel size as the node).
-  static PointCloud cli_labels(const std::string& pcd, const std::string& out) {
-    const auto r = test::run_command("timeout 180 " + test::binary("primlabel") + " --server " +
-                                     server_address_ + " --deadline 120 -q label " + pcd + " -o " +
-                                     out + " --model random --voxel-size " +
-                                     std::to_string(kVoxel) + " --probabilities");
+  // The CLI's labeled version of `pcd` (same model and voxel size as the node), with
+  // `options` besides (default: the probabilities).
+  static PointCloud cli_labels(const std::string& pcd, const std::string& out,
+                               const std::string& options = "--probabilities") {
+    const auto r =
+        test::run_command("timeout 180 " + test::binary("primlabel") + " --server " +
+                          server_address_ + " --deadline 120 -q label " + pcd + " -o " + out +
+                          " --model random --voxel-size " + std::to_string(kVoxel) + " " + options);
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return read_cloud(out);
   }
@@ -290,6 +293,74 @@ TEST_F(RosNode, LabelsPointCloud2LikeTheCli) {
   EXPECT_FALSE(node->process.wait_for(0ms)) << node->process.log();  // still running
 }
 
+// A robot's one call for objects and primitives: the table-top objects as a uint32 `object` per
+// point and the fitted instances as a uint32 `segment`, both described in the summary, the same
+// as `primlabel label --tabletop --objects --primitives` on the same file.
+TEST_F(RosNode, PublishesObjectsAndPrimitivesLikeTheCli) {
+  if (!fs::exists(test::shared_data("mosd/learn0.pcd"))) GTEST_SKIP() << "no mOSD learn0";
+  auto node =
+      start_node("objects", {"_tabletop_only:=true", "_objects:=true", "_primitives:=true"});
+  ros::Publisher publisher = node_handle_->advertise<PointCloud2>("/objects/in", 4);
+  Inbox<PointCloud2> clouds(*node_handle_, "/objects/out");
+  Inbox<std_msgs::String> summaries(*node_handle_, "/objects/summary");
+  ASSERT_TRUE(connected(publisher, clouds.subscriber())) << node->process.log();
+  ASSERT_TRUE(test::eventually([&] { return summaries.subscriber().getNumPublishers() > 0; }, 60s));
+
+  // The whole frame: the table-top stage needs the table around the objects.
+  const std::string pcd = test::shared_data("mosd/learn0.pcd");
+  const PointCloud frame = read_cloud(pcd);
+  PointCloud2 sent = to_pointcloud2(frame, layout_of(false, false, 0));
+  sent.header.frame_id = "camera_depth_optical_frame";
+  sent.header.stamp = ros::Time(1'700'000'100, 5);
+  publisher.publish(sent);
+  ASSERT_TRUE(test::eventually([&] { return clouds.size() == 1 && summaries.size() == 1; }, 180s))
+      << node->process.log();
+  const PointCloud2 got = clouds.messages().back();
+  const auto summary = nlohmann::json::parse(summaries.messages().back().data);
+  const PointCloud cli = cli_labels(pcd, file("cli_objects.pcd"),
+                                    "--tabletop --objects " + file("cli_objects.json") +
+                                        " --primitives " + file("cli_primitives.json"));
+  const FloatField* cli_object = cli.find_field("object");
+  ASSERT_NE(cli_object, nullptr);
+  std::ifstream objects_file(file("cli_objects.json"));
+  const auto cli_objects = nlohmann::json::parse(objects_file);
+
+  const std::size_t n = frame.size();
+  ASSERT_EQ(std::size_t(got.width) * got.height, n);
+  ASSERT_EQ(cli.size(), n);
+  const auto& objects = summary.at("objects");
+  const auto& primitives = summary.at("primitives");
+  ASSERT_GE(objects.size(), 1u) << "no object on learn0's table";
+  EXPECT_EQ(objects.size(), cli_objects.at("objects").size());
+  ASSERT_GE(primitives.size(), 1u);
+  std::size_t labels_differ = 0, objects_differ = 0, bad_segments = 0, on_table = 0, on_objects = 0,
+              in_segments = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t label = value_of<std::uint32_t>(got, i, "label");
+    const std::uint32_t object = value_of<std::uint32_t>(got, i, "object");
+    const std::uint32_t segment = value_of<std::uint32_t>(got, i, "segment");
+    labels_differ += label != cli.labels[i];
+    const float cli_id = cli_object->row(i)[0];
+    objects_differ += cli_id < 0 ? object != 0xFFFFFFFFu : object != std::uint32_t(cli_id);
+    on_table += object == 0;
+    on_objects += object != 0 && object != 0xFFFFFFFFu;
+    EXPECT_TRUE(object == 0xFFFFFFFFu || object <= objects.size()) << i;
+    if (segment == 0xFFFFFFFFu) continue;
+    ++in_segments;
+    // A segment's points are of its class.
+    bad_segments +=
+        segment >= primitives.size() || primitives[segment].value("class_id", 0u) != label;
+  }
+  EXPECT_EQ(labels_differ, 0u);
+  EXPECT_EQ(objects_differ, 0u);
+  EXPECT_EQ(bad_segments, 0u);
+  EXPECT_GT(on_table, n / 10);
+  EXPECT_GT(on_objects, 1000u);
+  EXPECT_GT(in_segments, 1000u);
+  EXPECT_TRUE(summary.contains("table"));
+  EXPECT_FALSE(node->process.wait_for(0ms)) << node->process.log();
+}
+
 TEST_F(RosNode, KeepsRunningAfterAnUnreadableCloudAndAFailedRequest) {
   auto node = start_node("survivor");
   auto lost = start_node("lost", {"_model:=no-such-model"});
@@ -351,7 +422,7 @@ TEST_F(RosNode, RefusesBadParametersAtStart) {
   int run = 0;
   for (const std::string& bad :
        {"_voxel_size:=-1", "_deadline:=0", "_server:=host:port", "_probabilities:=maybe",
-        "_viewpoint:=[1.0,2.0]", "_viewpoint:=up"}) {
+        "_viewpoint:=[1.0,2.0]", "_viewpoint:=up", "_objects:=true"}) {
     // A name of its own each time: private parameters stay on the master after the node exits.
     auto node = start_node("bad" + std::to_string(++run), {bad});
     const auto code = node->process.wait_for(60s);

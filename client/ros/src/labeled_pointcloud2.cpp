@@ -19,7 +19,8 @@ using sensor_msgs::PointCloud2;
 using sensor_msgs::PointField;
 
 bool is_replaced(const std::string& name) {
-  return name == "label" || name == "confidence" || name.rfind("prob_", 0) == 0;
+  return name == "label" || name == "object" || name == "segment" || name == "confidence" ||
+         name.rfind("prob_", 0) == 0;
 }
 
 PointField field(const std::string& name, std::uint32_t offset, std::uint8_t datatype) {
@@ -78,6 +79,10 @@ PointCloud2 labeled_pointcloud2(const PointCloud2& input, const client::LabelRes
   const bool with_probabilities = fields.confidence || fields.probabilities;
   if (with_probabilities && result.probabilities.size() != points * classes)
     throw std::invalid_argument("the service sent no probabilities for every point");
+  if (fields.object && result.object_ids.size() != points)
+    throw std::invalid_argument("the service sent no object id for every point");
+  if (fields.segment && result.segments.size() != points)
+    throw std::invalid_argument("the service sent no segment id for every point");
 
   PointCloud2 out;
   out.header = echoed_header(input.header, result.summary);
@@ -91,6 +96,14 @@ PointCloud2 labeled_pointcloud2(const PointCloud2& input, const client::LabelRes
   std::uint32_t offset = base;
   out.fields.push_back(field("label", offset, PointField::UINT32));
   offset += 4;
+  if (fields.object) {
+    out.fields.push_back(field("object", offset, PointField::UINT32));
+    offset += 4;
+  }
+  if (fields.segment) {
+    out.fields.push_back(field("segment", offset, PointField::UINT32));
+    offset += 4;
+  }
   if (fields.confidence) {
     out.fields.push_back(field("confidence", offset, PointField::FLOAT32));
     offset += 4;
@@ -118,6 +131,14 @@ PointCloud2 labeled_pointcloud2(const PointCloud2& input, const client::LabelRes
       std::uint8_t* extra = to + base;
       write_word(extra, result.labels[i], swap);
       extra += 4;
+      if (fields.object) {
+        write_word(extra, result.object_ids[i], swap);
+        extra += 4;
+      }
+      if (fields.segment) {
+        write_word(extra, result.segments[i], swap);
+        extra += 4;
+      }
       if (!with_probabilities) continue;
       const float* p = result.probabilities.data() + i * classes;
       if (fields.confidence) {

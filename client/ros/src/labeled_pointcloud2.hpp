@@ -15,6 +15,8 @@ namespace primlabel::rosnode {
 struct LabeledFields {
   bool confidence = false;     // float32 `confidence`: the highest class probability (or NaN)
   bool probabilities = false;  // float32 `prob_<class>` per class, in the summary's class order
+  bool object = false;         // uint32 `object`: the table-top object id (LabelResult::object_ids)
+  bool segment = false;        // uint32 `segment`: the primitive segment id (LabelResult::segments)
 };
 
 // The field name of a class's probability: "prob_" + the class name with every character other
@@ -25,12 +27,13 @@ std::string probability_field_name(const std::string& class_name, std::uint32_t 
 // input's when the service echoed neither (a server older than the echo).
 std_msgs::Header echoed_header(const std_msgs::Header& input, const v1::LabelSummary& summary);
 
-// `input` with a uint32 `label` (and the asked-for float32 fields) appended after its own bytes,
-// at the next 4-byte boundary; rows are packed (row_step = width * point_step). Input fields of
-// the same names (e.g. a ground-truth `label`) are dropped from the field list, their bytes left
-// as padding. The probabilities come from `result` (LabelOptions::probabilities) and must be
-// there when `fields` asks for them. Throws std::invalid_argument when `result` does not cover
-// the cloud's points.
+// `input` with a uint32 `label` (and the asked-for fields: `object`, `segment`, `confidence`,
+// `prob_<class>`, in that order) appended after its own bytes, at the next 4-byte boundary; rows
+// are packed (row_step = width * point_step). Input fields of the same names (e.g. a
+// ground-truth `label`) are dropped from the field list, their bytes left as padding. The ids
+// and probabilities come from `result` (LabelOptions::objects, primitives, probabilities) and
+// must be there when `fields` asks for them. Throws std::invalid_argument when `result` does not
+// cover the cloud's points.
 sensor_msgs::PointCloud2 labeled_pointcloud2(const sensor_msgs::PointCloud2& input,
                                              const client::LabelResult& result,
                                              const LabeledFields& fields);

@@ -13,7 +13,8 @@ LabelingNode::LabelingNode(ros::NodeHandle& node, const NodeParameters& paramete
     : parameters_(parameters),
       client_(client_options(parameters)),
       label_options_(label_options(parameters)),
-      fields_{parameters.confidence, parameters.probabilities} {
+      fields_{parameters.confidence, parameters.probabilities, parameters.objects,
+              parameters.primitives} {
   cloud_publisher_ = node.advertise<sensor_msgs::PointCloud2>(parameters.output_topic, 1);
   summary_publisher_ = node.advertise<std_msgs::String>(parameters.summary_topic, 1);
   // Queue size 1: roscpp drops the oldest queued cloud when a newer one arrives.

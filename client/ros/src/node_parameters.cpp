@@ -64,6 +64,8 @@ NodeParameters read_parameters(const ros::NodeHandle& node) {
     p.viewpoint = std::array<double, 3>{xyz[0], xyz[1], xyz[2]};
   }
   read(node, "tabletop_only", p.tabletop_only);
+  read(node, "objects", p.objects);
+  read(node, "primitives", p.primitives);
   read(node, "confidence", p.confidence);
   read(node, "probabilities", p.probabilities);
   read(node, "input_topic", p.input_topic);
@@ -79,6 +81,9 @@ NodeParameters read_parameters(const ros::NodeHandle& node) {
     throw std::invalid_argument("~voxel_size must be a finite number >= 0 (metres)");
   if (!std::isfinite(p.deadline) || p.deadline <= 0)
     throw std::invalid_argument("~deadline must be a finite number of seconds > 0");
+  if (p.objects && !p.tabletop_only)
+    throw std::invalid_argument(
+        "~objects needs ~tabletop_only:=true (the objects are the table-top stage's)");
   if (p.retries < 1) throw std::invalid_argument("~retries must be >= 1 (attempts in all)");
   if (p.input_topic.empty() || p.output_topic.empty() || p.summary_topic.empty())
     throw std::invalid_argument("~input_topic, ~output_topic and ~summary_topic must not be empty");
@@ -116,6 +121,8 @@ client::LabelOptions label_options(const NodeParameters& p) {
         Vec3f(static_cast<float>((*p.viewpoint)[0]), static_cast<float>((*p.viewpoint)[1]),
               static_cast<float>((*p.viewpoint)[2]));
   options.tabletop_only = p.tabletop_only;
+  options.objects = p.objects;
+  options.primitives = p.primitives;
   options.probabilities = p.confidence || p.probabilities;
   return options;
 }

@@ -29,6 +29,12 @@ struct NodeParameters {
   // origin (right for a cloud in its camera's own frame, wrong for one in base_link or map).
   std::optional<std::array<double, 3>> viewpoint;
   bool tabletop_only = false;
+  // With tabletop_only: the table and its objects as instances in the summary and a uint32
+  // `object` field per point (0 the table, k the summary's objects[k - 1]).
+  bool objects = false;
+  // Fitted primitive instances in the summary and a uint32 `segment` field per point (its index
+  // into the summary's primitives).
+  bool primitives = false;
   bool confidence = false;     // publish a float32 `confidence` field (the highest probability)
   bool probabilities = false;  // publish float32 `prob_<class>` fields
   // Topics, resolved in the node's namespace.
@@ -40,7 +46,8 @@ struct NodeParameters {
 // Reads the parameters under `private_node` (a NodeHandle on "~"), defaults where unset. Throws
 // std::invalid_argument naming the parameter: a wrong type, a negative or non-finite voxel size,
 // a viewpoint that is not three finite numbers,
-// a deadline <= 0, retries < 1, an empty topic, a malformed server address.
+// a deadline <= 0, retries < 1, an empty topic, a malformed server address, ~objects without
+// ~tabletop_only.
 NodeParameters read_parameters(const ros::NodeHandle& private_node);
 
 // The connection: address, deadline, retries, TLS and the bearer token (read from ~token_file or
