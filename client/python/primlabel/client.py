@@ -1,4 +1,4 @@
-"""The Python client of the primlabel labeling service (api/primlabel/v1/labeling.proto), the
+"""The Python client of the primlabel labeling service (proto/primlabel/v1/labeling.proto), the
 same protocol as the C++ client (client/src/client.cpp):
 
     client = primlabel.Client("127.0.0.1:50051")

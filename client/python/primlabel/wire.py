@@ -1,4 +1,4 @@
-"""The packed arrays of the labeling API (api/include/primlabel/wire/packing.hpp): float32 xyz,
+"""The packed arrays of the labeling API (proto/include/primlabel/wire/packing.hpp): float32 xyz,
 normals, descriptors and probabilities and uint32 labels, little-endian and point-major; and the
 reassembly of an answer's LabelChunks in input order (as client/src/label_assembler.cpp)."""
 

@@ -1,5 +1,5 @@
 #pragma once
-// The C++ client of the primlabel labeling service (api/primlabel/v1/labeling.proto).
+// The C++ client of the primlabel labeling service (proto/primlabel/v1/labeling.proto).
 //
 //   primlabel::client::Client client({.address = "127.0.0.1:50051"});
 //   primlabel::client::LabelResult r = client.label(cloud, {.model = "tabletop-lms400"});

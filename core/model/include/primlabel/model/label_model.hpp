@@ -4,7 +4,7 @@
 // weights, inference settings, and where the model came from and how well it did.
 //
 // File layout: the 16-byte magic "PRIMLABEL-MODEL\n", then a primlabel.v1.ModelEnvelope
-// (api/primlabel/v1/model.proto) holding the format version and a CRC-32 of the serialised
+// (proto/primlabel/v1/model.proto) holding the format version and a CRC-32 of the serialised
 // primlabel.v1.Model. A file that is not a model, truncated, corrupt, from a newer format or
 // inconsistent with itself is rejected with a ModelError naming the file and the reason.
 

@@ -1,5 +1,5 @@
 #pragma once
-// The packed little-endian arrays of the labeling API (api/primlabel/v1/labeling.proto):
+// The packed little-endian arrays of the labeling API (proto/primlabel/v1/labeling.proto):
 // float32 xyz / normals / intensity / descriptors / probabilities and uint32 labels, point-major.
 // Header-only, no dependency but the standard library, so the server and the clients share one
 // layout (primlabel::api).
