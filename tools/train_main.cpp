@@ -16,6 +16,7 @@
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
+#include "primlabel/pipeline/cloud_signature.hpp"
 #include "primlabel/pipeline/labeled_voxels.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/research/curve_plot.hpp"
@@ -38,6 +39,7 @@ struct Arguments {
   float voxel_size = 0.0f;      // > 0: train on voxels of this edge and record it in the model
   float feature_sample = 0.0f;  // > 0: FPFH against one point per voxel of this edge
   std::vector<std::string> train_files, val_files;
+  std::string sensor_name;  // --sensor-name: the sensor of --train files
   std::string classes, output, curve_csv, curve_png, name, augment;
   synth::Augmentation augmentation;  // --augment, parsed
   bool quiet = false;
@@ -59,10 +61,17 @@ std::vector<pipeline::SceneData> load_scenes(const Arguments& args, bool validat
   auto add = [&](PointCloud cloud, const std::string& source) {
     const auto start = std::chrono::steady_clock::now();
     // The density the model is served at: label_cloud downsamples to the model's voxel size.
+    const std::uint32_t width = cloud.organized() ? cloud.width : 0;
+    const std::uint32_t height = cloud.organized() ? cloud.height : 0;
+    const pipeline::CloudSignature acquired =
+        pipeline::measure_signature(cloud.xyz, RunContext{args.threads});
     if (args.voxel_size > 0.0f)
       cloud = pipeline::voxelize_labeled(cloud, args.voxel_size, RunContext{args.threads});
     scenes.push_back(pipeline::prepare_scene(std::move(cloud), source, features, graph, every_class,
                                              RunContext{args.threads}));
+    scenes.back().image_width = width;  // the frame as acquired, not its voxels
+    scenes.back().image_height = height;
+    scenes.back().acquired = acquired;
     const double s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     char line[512];
@@ -161,6 +170,8 @@ int run(const Arguments& args) {
   if (options.kind != ModelKind::kNodeOnly) say(args, model.training.objective);
   if (!args.name.empty()) model.name = args.name;
   model.features.voxel_size = args.voxel_size;  // applied by label_cloud (and so the server)
+  if (args.train_files.empty() || !args.sensor_name.empty())  // part of the model's domain
+    model.training.sensor = args.train_files.empty() ? args.sensor : args.sensor_name;
   save_model(args.output, model);
 
   if (!args.curve_csv.empty()) {
@@ -204,6 +215,9 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   auto* train_files = app.add_option("--train", args.train_files, "labeled PCD/PLY training files")
                           ->excludes(synth_train);
+  app.add_option("--sensor-name", args.sensor_name,
+                 "the sensor that made the --train files (e.g. kinect), recorded in the model")
+      ->needs(train_files);
   app.add_option("--val", args.val_files, "labeled PCD/PLY validation files")
       ->needs(train_files)
       ->excludes(synth_val);

@@ -46,6 +46,10 @@ v1::LabelRequest header_request(const PointCloud& cloud, const LabelOptions& o) 
   options.set_non_finite(o.reject_non_finite ? v1::NON_FINITE_REJECT : v1::NON_FINITE_DROP);
   options.set_response_chunk_points(o.response_chunk_points);
   header.mutable_layout()->set_normals(o.send_normals && cloud.has_normals());
+  if (cloud.organized()) {  // a frame: lets a request naming no model find the camera's model
+    header.mutable_layout()->set_width(cloud.width);
+    header.mutable_layout()->set_height(cloud.height);
+  }
   header.set_expected_points(cloud.size());
   return request;
 }
@@ -64,6 +68,32 @@ void fill_chunk(const PointCloud& cloud, const LabelOptions& o, std::size_t firs
 
 std::string status_code_name(grpc::StatusCode code) {
   return ::primlabel::wire::status_code_name(code);
+}
+
+std::string model_choice_name(v1::ModelChoice choice) {
+  switch (choice) {
+    case v1::MODEL_CHOICE_NAMED:
+      return "named";
+    case v1::MODEL_CHOICE_DOMAIN:
+      return "domain";
+    case v1::MODEL_CHOICE_DEFAULT:
+      return "default";
+    default:
+      return "";
+  }
+}
+
+std::string model_choice_text(const v1::LabelSummary& summary) {
+  switch (summary.model_choice()) {
+    case v1::MODEL_CHOICE_NAMED:
+      return "named by the request";
+    case v1::MODEL_CHOICE_DOMAIN:
+      return "chosen by domain: " + summary.model_choice_reason();
+    case v1::MODEL_CHOICE_DEFAULT:
+      return "the default: " + summary.model_choice_reason();
+    default:
+      return "";
+  }
 }
 
 std::string health_status_name(HealthStatus status) {

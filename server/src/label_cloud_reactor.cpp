@@ -102,7 +102,7 @@ class LabelCloudReactor final : public grpc::ServerUnaryReactor,
       v1::LabelCloudResponse response;
       responder.fill_range(0, session_.result().labels.size(), *response.mutable_result());
       record_.stages.send = 0;
-      fill_summary(record_, *session_.plan().entry, session_.result(), *response.mutable_summary());
+      fill_summary(record_, session_.plan(), session_.result(), *response.mutable_summary());
       session_.free_result();
       *response_ = serialize_message(response);
       record_.stages.send =

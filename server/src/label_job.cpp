@@ -1,30 +1,99 @@
 #include "label_job.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <new>
 #include <stdexcept>
 
+#include "primlabel/pipeline/cloud_signature.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
 #include "registry_error.hpp"
 
 namespace primlabel::server {
 
+std::vector<const ModelEntry*> LabelPlan::possible_models() const {
+  if (entry) return {entry.get()};
+  std::vector<const ModelEntry*> models;
+  for (const auto& candidate : candidates) models.push_back(candidate.get());
+  return models;
+}
+
+namespace {
+
+// Takes the chooser's decision into the plan: the entry it names, or NOT_FOUND.
+std::optional<ServiceError> apply_choice(LabelPlan& plan) {
+  const pipeline::ModelChoice& choice = plan.chooser->choice();
+  if (choice.model.empty())
+    return ServiceError{ErrorCode::kNotFound, "the request names no model and " + choice.why};
+  for (const auto& candidate : plan.candidates)
+    if (candidate->name == choice.model) plan.entry = candidate;
+  if (!plan.entry)  // the chooser only names candidates; a broken invariant, not the client's
+    return ServiceError{ErrorCode::kInternal, "the model chosen is not a candidate"};
+  plan.choice = choice.reason;
+  plan.choice_why = choice.why;
+  plan.candidates.clear();
+  plan.chooser.reset();
+  return std::nullopt;
+}
+
+// Every served model as a candidate of the choice, in the registry's (name) order.
+std::optional<ServiceError> start_choice(const pipeline::CloudShape& shape,
+                                         const ModelRegistry& registry, LabelPlan& plan) {
+  std::vector<pipeline::ModelCandidate> candidates;
+  for (const ServedModel& served : registry.list()) {
+    plan.candidates.push_back(served.served);
+    candidates.push_back({served.name, &served.served->model->training});
+  }
+  if (candidates.empty())
+    return ServiceError{ErrorCode::kNotFound,
+                        "the request names no model and the server has no model loaded"};
+  plan.chooser =
+      std::make_shared<pipeline::ModelChooser>(candidates, registry.default_model(), shape);
+  if (plan.chooser->decided()) return apply_choice(plan);
+  std::vector<std::shared_ptr<const ModelEntry>> open;  // only those the shape left in
+  for (const pipeline::ModelCandidate& remaining : plan.chooser->remaining())
+    for (const auto& candidate : plan.candidates)
+      if (candidate->name == remaining.name) open.push_back(candidate);
+  plan.candidates = std::move(open);
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelRegistry& registry,
                                           LabelPlan& plan) {
+  const pipeline::CloudShape shape{header.layout().width(), header.layout().height()};
   try {
-    plan.entry = registry.resolve(header.model(), header.model_version());
+    if (!header.model().empty() || !header.model_version().empty()) {
+      // A version alone names a version of the default model, as before routing existed.
+      plan.entry = registry.resolve(header.model(), header.model_version());
+      plan.choice = header.model().empty() ? pipeline::ChoiceReason::kDefault
+                                           : pipeline::ChoiceReason::kNamed;
+      plan.choice_why =
+          header.model().empty() ? "a version of the default model" : "named by the request";
+      const pipeline::DomainVerdict verdict =
+          pipeline::judge_shape(plan.entry->model->training, shape);
+      if (verdict.fit == pipeline::DomainFit::kOutside)
+        plan.shape_warning = "the cloud is an organised " + std::to_string(shape.width) + "x" +
+                             std::to_string(shape.height) + " frame and this model was " +
+                             verdict.why + ": labels are unreliable; use a model for this sensor";
+    } else if (auto refused = start_choice(shape, registry, plan)) {
+      return refused;
+    }
   } catch (const RegistryError& error) {
     return registry_error(error);
   }
-  const LabelModel& model = *plan.entry->model;
-  const std::string which =
-      "model '" + plan.entry->name + "' version '" + plan.entry->version + "'";
   const v1::LabelOptions& options = header.options();
-  if ((options.normal_radius() > 0.0f || options.feature_radius() > 0.0f) &&
-      !model.features.radii_overridable)
-    return ServiceError{
-        ErrorCode::kInvalidArgument,
-        which + " does not allow radius overrides (options.normal_radius / feature_radius)"};
+  for (const ModelEntry* entry : plan.possible_models()) {
+    const std::string which = "model '" + entry->name + "' version '" + entry->version + "'";
+    if ((options.normal_radius() > 0.0f || options.feature_radius() > 0.0f) &&
+        !entry->model->features.radii_overridable)
+      return ServiceError{ErrorCode::kInvalidArgument,
+                          which +
+                              " does not allow radius overrides (options.normal_radius / "
+                              "feature_radius)" +
+                              (plan.entry ? "" : "; name a model that does")};
+  }
   if (options.return_objects() && !options.tabletop_only())
     return ServiceError{ErrorCode::kInvalidArgument,
                         "options.return_objects needs options.tabletop_only (the objects are "
@@ -41,12 +110,28 @@ std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelReg
   return std::nullopt;
 }
 
+std::optional<ServiceError> finish_model_choice(LabelPlan& plan, const PointCloud& cloud,
+                                                const RunContext& context) {
+  if (plan.entry) return std::nullopt;
+  const auto start = std::chrono::steady_clock::now();
+  plan.chooser->consider(pipeline::measure_signature(cloud.xyz, context));
+  plan.choice_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return apply_choice(plan);
+}
+
 std::uint64_t answer_bytes_per_point(const LabelPlan& plan) {
-  const LabelModel& model = *plan.entry->model;
-  std::uint64_t bytes = sizeof(std::uint32_t);
-  if (plan.options.want_descriptors)
-    bytes += sizeof(float) * std::uint64_t(model.features.descriptor_dim());
-  if (plan.options.want_probabilities) bytes += sizeof(float) * model.class_ids().size();
+  // Until the choice is made, the largest answer any candidate would give.
+  std::uint64_t model_bytes = 0;
+  for (const ModelEntry* entry : plan.possible_models()) {
+    const LabelModel& model = *entry->model;
+    std::uint64_t bytes = 0;
+    if (plan.options.want_descriptors)
+      bytes += sizeof(float) * std::uint64_t(model.features.descriptor_dim());
+    if (plan.options.want_probabilities) bytes += sizeof(float) * model.class_ids().size();
+    model_bytes = std::max(model_bytes, bytes);
+  }
+  std::uint64_t bytes = sizeof(std::uint32_t) + model_bytes;
   if (plan.options.want_primitives) bytes += sizeof(std::uint32_t);  // LabelChunk.segments
   if (plan.options.want_objects) {
     bytes += sizeof(std::uint32_t);  // LabelChunk.objects
@@ -69,11 +154,16 @@ std::uint64_t answer_summary_bytes(const LabelPlan& plan) {
   return bytes;
 }
 
-std::optional<ServiceError> run_label_job(const LabelPlan& plan, PointCloud& cloud,
+std::optional<ServiceError> run_label_job(LabelPlan& plan, PointCloud& cloud,
                                           const RunContext& context,
                                           pipeline::LabelingResult& result) {
   try {
+    if (auto refused = finish_model_choice(plan, cloud, context)) return refused;
     result = pipeline::label_cloud(*plan.entry->model, cloud, plan.options, context);
+    if (!plan.shape_warning.empty())
+      result.domain_warning = result.domain_warning.empty()
+                                  ? plan.shape_warning
+                                  : plan.shape_warning + "; " + result.domain_warning;
     return std::nullopt;
   } catch (const pipeline::Cancelled&) {
     return ServiceError{ErrorCode::kCancelled, "labeling was cancelled"};

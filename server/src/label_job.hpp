@@ -12,19 +12,41 @@
 #include "admission.hpp"
 #include "model_registry.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/pipeline/model_choice.hpp"
 #include "primlabel/v1/labeling.pb.h"
 #include "service_error.hpp"
 
 namespace primlabel::server {
 
 struct LabelPlan {
-  std::shared_ptr<const ModelEntry> entry;  // held for the whole request: reloads cannot touch it
-  pipeline::LabelingOptions options;        // without stop token and thread count
+  // The model, held for the whole request: reloads cannot touch it. Empty until the job when
+  // the request names no model and the header leaves the choice to the cloud's signature.
+  std::shared_ptr<const ModelEntry> entry;
+  // A request naming no model: the models it may still go to (held, like entry) and the
+  // choice in progress (pipeline/model_choice.hpp); how it was decided, once it is.
+  std::vector<std::shared_ptr<const ModelEntry>> candidates;
+  std::shared_ptr<pipeline::ModelChooser> chooser;
+  pipeline::ChoiceReason choice = pipeline::ChoiceReason::kNamed;
+  std::string choice_why;
+  double choice_seconds = 0;  // measuring the cloud's signature, when the choice needed it
+  // A named model's shape mismatch (an organised frame sent to a model of unorganised scans),
+  // prefixed to label_cloud's own domain warning.
+  std::string shape_warning;
+  pipeline::LabelingOptions options;  // without stop token and thread count
+
+  // The models the answer may come from: the chosen one, or every candidate still open.
+  std::vector<const ModelEntry*> possible_models() const;
 };
 
-// Resolves the model and checks the options (NOT_FOUND, INVALID_ARGUMENT, FAILED_PRECONDITION).
+// Resolves the model (or as much of the choice as the header allows) and checks the options
+// (NOT_FOUND, INVALID_ARGUMENT, FAILED_PRECONDITION).
 std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelRegistry& registry,
                                           LabelPlan& plan);
+
+// Finishes a choice the header left open, from the cloud's signature (a neighbour index over
+// it); NOT_FOUND when no model fits and the server has no default. Runs inside the job.
+std::optional<ServiceError> finish_model_choice(LabelPlan& plan, const PointCloud& cloud,
+                                                const RunContext& context);
 
 // Bytes per point of the answer the plan asks for (labels, descriptors, probabilities, segment
 // ids, object ids and the objects' messages), known before labeling.
@@ -44,8 +66,9 @@ inline constexpr std::uint64_t kMaxTableMessageBytes = 64 + 1024 * 31;
 // primitive ids (the objects themselves are counted per point in answer_bytes_per_point).
 std::uint64_t answer_summary_bytes(const LabelPlan& plan);
 
-// Runs label_cloud; never throws. CANCELLED when context.stop was requested.
-std::optional<ServiceError> run_label_job(const LabelPlan& plan, PointCloud& cloud,
+// Finishes the model choice if it is open, then runs label_cloud; never throws. CANCELLED when
+// context.stop was requested.
+std::optional<ServiceError> run_label_job(LabelPlan& plan, PointCloud& cloud,
                                           const RunContext& context,
                                           pipeline::LabelingResult& result);
 

@@ -194,7 +194,7 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
     } else {
       // From the job's end: the hand-over to this thread, packing and writing the chunks.
       record_.stages.send = seconds_between(session_.job_ended(), Clock::now());
-      fill_summary(record_, *session_.plan().entry, session_.result(), *response.mutable_summary());
+      fill_summary(record_, session_.plan(), session_.result(), *response.mutable_summary());
       summary_sent_ = true;
     }
     write_buffer_ = serialize_message(response);

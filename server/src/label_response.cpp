@@ -76,10 +76,25 @@ std::string class_name_of(const ModelEntry& entry, std::uint32_t id) {
   return taxonomy_class ? std::string(name(*taxonomy_class)) : std::string();
 }
 
+v1::ModelChoice choice_message(pipeline::ChoiceReason reason) {
+  switch (reason) {
+    case pipeline::ChoiceReason::kNamed:
+      return v1::MODEL_CHOICE_NAMED;
+    case pipeline::ChoiceReason::kDomain:
+      return v1::MODEL_CHOICE_DOMAIN;
+    case pipeline::ChoiceReason::kDefault:
+      return v1::MODEL_CHOICE_DEFAULT;
+  }
+  return v1::MODEL_CHOICE_UNSPECIFIED;
+}
+
 }  // namespace
 
-void fill_summary(const RequestRecord& record, const ModelEntry& entry,
+void fill_summary(const RequestRecord& record, const LabelPlan& plan,
                   const pipeline::LabelingResult& result, v1::LabelSummary& summary) {
+  const ModelEntry& entry = *plan.entry;
+  summary.set_model_choice(choice_message(plan.choice));
+  summary.set_model_choice_reason(plan.choice_why);
   summary.set_request_id(record.id());
   summary.set_scan_id(record.scan_id);
   summary.set_frame_id(record.frame_id);

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "label_job.hpp"
 #include "model_registry.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/v1/labeling.pb.h"
@@ -33,7 +34,8 @@ class LabelResponder {
   std::uint64_t chunk_points_;
 };
 
-void fill_summary(const RequestRecord& record, const ModelEntry& entry,
+// `plan.entry` is the model that labeled the cloud.
+void fill_summary(const RequestRecord& record, const LabelPlan& plan,
                   const pipeline::LabelingResult& result, v1::LabelSummary& summary);
 
 }  // namespace primlabel::server

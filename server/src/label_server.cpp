@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "logging.hpp"
+#include "user_text.hpp"
 
 namespace primlabel::server {
 
@@ -65,6 +66,18 @@ LabelServer::LabelServer(ServerConfig config)
   // requests (or a silently different version) in production.
   if (std::string problem = registry_.configuration_problem(); !problem.empty())
     throw ConfigError{std::move(problem), kExitUsage};
+  // Requests naming no model go by their cloud's domain; this one takes those no domain decides.
+  if (const std::string fallback = registry_.default_model(); fallback.empty())
+    log_info("default_model").kv("model", "").kv("source", "none");
+  else
+    log_info("default_model")
+        .kv("model", user_text(fallback))
+        .kv("source", registry_.default_source())
+        .kv("loaded", [&] {
+          for (const ServedModel& served : registry_.list())
+            if (served.name == fallback) return "yes";
+          return "no";
+        }());
   if (auth_.admin_open())
     log_warn("insecure_admin")
         .kv("message",

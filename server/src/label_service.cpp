@@ -50,9 +50,7 @@ std::optional<ServiceError> LabelSession::start(const v1::ScanHeader& header, bo
   const ScanLimits limits = limits_of(*env_.config);
   if (auto invalid = check_header(header, limits)) return invalid;
   if (auto refused = plan_labeling(header, *env_.registry, plan_)) return refused;
-  record_.model = plan_.entry->name;
-  record_.model_resolved = true;
-  record_.version = plan_.entry->version;
+  if (plan_.entry) note_model();
   if (streamed) {
     receiving_ = env_.receiving->try_take();
     if (!receiving_) return receiving_busy(*env_.receiving);
@@ -101,10 +99,20 @@ bool LabelSession::stop() {
   return true;
 }
 
+void LabelSession::note_model() {
+  record_.model = plan_.entry->name;
+  record_.model_resolved = true;
+  record_.version = plan_.entry->version;
+  record_.model_choice = pipeline::choice_reason_name(plan_.choice);
+}
+
 std::optional<ServiceError> LabelSession::outcome() {
+  if (plan_.entry && !record_.model_resolved) note_model();  // chosen in the job
   if (job_error_) return job_error_;
   StageTimes& stages = record_.stages;
-  stages.prefilter = seconds_between(scan_complete_, job_start_) + result_.prefilter_seconds;
+  // The model choice, when it measured the cloud, counts with the work before the description.
+  stages.prefilter = seconds_between(scan_complete_, job_start_) + plan_.choice_seconds +
+                     result_.prefilter_seconds;
   // The neighbour index and shared search go to the first stage that searches: the normals, or
   // the features when the client sent its own normals (normals then stay 0).
   const double search = result_.index_seconds + result_.lists_seconds;
@@ -112,11 +120,12 @@ std::optional<ServiceError> LabelSession::outcome() {
   stages.normals = result_.normal_seconds + (own_normals ? 0.0 : search);
   stages.features = result_.descriptor_seconds + (own_normals ? search : 0.0);
   const double primitives = result_.primitives ? result_.primitive_seconds : 0.0;
+  const double before_labeling = plan_.choice_seconds;
   if (result_.primitives) stages.primitives = primitives;
   // The rest of the job: graph, BP, duplicates and the fan-out (never below 0 by rounding).
   stages.inference =
-      std::max(0.0, seconds_between(job_start_, job_end_) - result_.prefilter_seconds -
-                        stages.normals - stages.features - primitives);
+      std::max(0.0, seconds_between(job_start_, job_end_) - before_labeling -
+                        result_.prefilter_seconds - stages.normals - stages.features - primitives);
   return std::nullopt;
 }
 

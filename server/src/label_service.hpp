@@ -58,6 +58,8 @@ class LabelSession {
   void free_result();
 
  private:
+  void note_model();  // the plan's model into the record
+
   const ServiceEnvironment& env_;
   RequestGauge* const requests_;  // copied: the session may outlive the environment's owner
   IdleMemoryTrimmer* const trimmer_;

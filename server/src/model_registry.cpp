@@ -118,6 +118,39 @@ bool version_less(const std::string& a, const std::string& b) {
 ModelRegistry::ModelRegistry(Options options) : options_(std::move(options)) {
   options_.missing_scans_before_unload = std::max(1u, options_.missing_scans_before_unload);
   default_ = options_.default_model;
+  if (!default_.empty()) default_source_ = "flag";
+}
+
+void ModelRegistry::read_declared_default() {
+  const fs::path file = options_.root / kDefaultModelFile;
+  std::error_code error;
+  std::string declared;
+  // A plain file only: a link could point anywhere, a FIFO would block the scan.
+  if (fs::is_regular_file(fs::symlink_status(file, error))) {
+    std::ifstream in(file, std::ios::binary);
+    char text[kMaxDefaultModelFileBytes + 1] = {};
+    in.read(text, sizeof text);
+    const std::size_t size = static_cast<std::size_t>(in.gcount());
+    declared.assign(text, size);
+    declared = declared.substr(0, declared.find_first_of("\r\n"));
+    while (!declared.empty() && std::isspace(static_cast<unsigned char>(declared.back())))
+      declared.pop_back();
+    const bool plain = std::all_of(declared.begin(), declared.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.';
+    });
+    if (size > kMaxDefaultModelFileBytes || !plain || declared.empty() || declared[0] == '.') {
+      const std::string raw(text, size);
+      if (raw != ignored_default_text_)  // once per content, not at every scan
+        log_warn("default_model_file_ignored")
+            .kv("path", user_text(file.string()))
+            .kv("reason", "not one line naming a model (letters, digits, - _ .; at most " +
+                              std::to_string(kMaxDefaultModelFileBytes) + " bytes)");
+      ignored_default_text_ = raw;
+      declared.clear();
+    }
+  }
+  std::lock_guard lock(mutex_);
+  declared_default_ = declared;
 }
 
 std::map<ModelRegistry::Key, ModelRegistry::Found> ModelRegistry::discover(
@@ -229,6 +262,7 @@ ReloadReport ModelRegistry::reload() {
 ReloadReport ModelRegistry::scan_locked() {
   std::vector<Refused> refused;
   const std::map<Key, Found> found = discover(refused);
+  read_declared_default();
   ReloadReport report;
   note_refused(refused, report);
   bool changed = false;
@@ -403,10 +437,16 @@ std::shared_ptr<const ModelEntry> ModelRegistry::served_locked(const std::string
 
 void ModelRegistry::settle_default_locked() {
   if (!options_.default_model.empty()) return;  // named by the operator: never moves
+  if (!declared_default_.empty()) {             // the repository's own word, followed as it changes
+    default_ = declared_default_;
+    default_source_ = "repository";
+    return;
+  }
+  if (default_source_ == "repository") default_.clear(), default_source_.clear();
   // The only model becomes the default and stays it when others appear, so requests naming no
   // model keep working. When it is gone and several remain, there is no safe guess: requests
   // naming no model are refused, naming the default, until it returns or only one is left.
-  if (models_.size() == 1) default_ = models_.begin()->first;
+  if (models_.size() == 1) default_ = models_.begin()->first, default_source_ = "only model";
 }
 
 std::string ModelRegistry::describe_loaded_locked() const {
@@ -435,7 +475,7 @@ std::shared_ptr<const ModelEntry> ModelRegistry::resolve(const std::string& mode
   if (model.empty() && default_.empty())
     throw RegistryError(RegistryError::Kind::kNotFound,
                         "the request names no model and the server has no default model "
-                        "(--default-model); " +
+                        "(--default-model, or the repository's default_model file); " +
                             describe_loaded_locked());
   const std::string& name = model.empty() ? default_ : model;
   auto found = models_.find(name);
@@ -476,6 +516,11 @@ std::size_t ModelRegistry::loaded_versions() const {
 std::string ModelRegistry::default_model() const {
   std::lock_guard lock(mutex_);
   return default_;
+}
+
+std::string ModelRegistry::default_source() const {
+  std::lock_guard lock(mutex_);
+  return default_.empty() ? std::string() : default_source_;
 }
 
 std::string ModelRegistry::configuration_problem() const {

@@ -13,8 +13,10 @@
 // or a repository being synced, must not take the model down), or until unload().
 // Paths are resolved: a model directory, version directory or model file that resolves outside
 // the repository (a symlink to elsewhere) is refused and logged, never read.
-// The default model is sticky: Options::default_model if given; else the only model, which
-// stays the default when other models appear.
+// The default model, for requests whose cloud no model's domain decides: Options::default_model
+// (--default-model) if given; else the model the repository declares in the file
+// <root>/default_model (one line, read at every scan); else the only model, which stays the
+// default when other models appear.
 
 #include <cstdint>
 #include <filesystem>
@@ -76,6 +78,10 @@ struct ServedModel {
   bool is_default = false;
 };
 
+// The file at a repository's root that names its default model (one line), and its size bound.
+inline constexpr const char* kDefaultModelFile = "default_model";
+inline constexpr std::size_t kMaxDefaultModelFileBytes = 256;
+
 // "2" < "10" < "10a"; otherwise byte order.
 bool version_less(const std::string& a, const std::string& b);
 struct VersionLess {
@@ -125,6 +131,9 @@ class ModelRegistry {
   std::vector<ServedModel> list() const;
   std::size_t loaded_versions() const;
   std::string default_model() const;  // empty: none
+  // Where the default comes from: "flag", "repository" (<root>/default_model), "only model" or
+  // "" when there is none.
+  std::string default_source() const;
   const std::filesystem::path& root() const { return options_.root; }
 
   // What is wrong with Options::default_model and pins given what is loaded now (a model or
@@ -152,6 +161,9 @@ class ModelRegistry {
   std::shared_ptr<const ModelEntry> served_locked(const std::string& model,
                                                   const Versions& versions) const;
   void settle_default_locked();
+  // Reads <root>/default_model into declared_default_ (a missing file declares none; a file that
+  // is unreadable, too long or not a model name is logged and declares none).
+  void read_declared_default();
   std::string describe_loaded_locked() const;
   void notify() const;
 
@@ -161,6 +173,9 @@ class ModelRegistry {
   mutable std::mutex mutex_;  // guards models_ and default_ (held only to look up or swap)
   std::map<std::string, Versions> models_;
   std::string default_;                  // the sticky default model; empty: none
+  std::string default_source_;           // see default_source()
+  std::string declared_default_;         // <root>/default_model at the last scan; empty: none
+  std::string ignored_default_text_;     // the last default_model content refused (logged once)
   std::map<Key, FileSignature> failed_;  // files that failed to load, until they change
   std::set<Key> unloaded_;               // (model, "") = every version of the model
   std::map<Key, unsigned> missing_;      // loaded versions missing from disk: consecutive scans

@@ -37,6 +37,7 @@ grpc::Status RequestRecord::finish(const grpc::Status& status) {
   const std::string metric_model = model_resolved ? user_text(model) : std::string();
   metrics_.request_finished(method_, metric_model, code, seconds);
   if (status.ok() && points > 0) metrics_.points_labeled(metric_model, double(points));
+  if (status.ok() && !model_choice.empty()) metrics_.model_chosen(metric_model, model_choice);
   if (dropped_non_finite > 0) metrics_.points_dropped("non_finite", double(dropped_non_finite));
   LogLine line(status.ok() ? LogLevel::kInfo : LogLevel::kWarn, "request");
   line.kv("method", method_)
@@ -44,6 +45,7 @@ grpc::Status RequestRecord::finish(const grpc::Status& status) {
       .kv("scan_id", user_text(scan_id))
       .kv("model", user_text(model))
       .kv("version", user_text(version))
+      .kv("model_choice", model_choice)
       .kv("points", points)
       .kv("dropped_non_finite", dropped_non_finite)
       .kv("duration_ms", seconds * 1e3)

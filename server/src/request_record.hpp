@@ -31,6 +31,8 @@ class RequestRecord {
   // Set once `model` names a loaded model: only then is it a metric label, so clients that send
   // made-up names cannot grow the metrics without bound (they count as model="").
   bool model_resolved = false;
+  // How the model was chosen ("named", "domain", "default"); empty until it is.
+  std::string model_choice;
   std::uint64_t points = 0, dropped_non_finite = 0;
   StageTimes stages;
 

@@ -49,6 +49,22 @@ std::optional<ServiceError> check_header(const v1::ScanHeader& header, const Sca
     return invalid("the viewpoint must be finite");
   if (options.non_finite() != v1::NON_FINITE_DROP && options.non_finite() != v1::NON_FINITE_REJECT)
     return invalid("unknown options.non_finite policy " + std::to_string(options.non_finite()));
+  const v1::PointLayout& layout = header.layout();
+  if (layout.height() > 1 || layout.width() > 0) {
+    const std::uint64_t pixels = std::uint64_t(layout.width()) * layout.height();
+    const std::string frame = "layout.width x layout.height (" + std::to_string(layout.width()) +
+                              "x" + std::to_string(layout.height()) + ")";
+    if (layout.width() == 0 || layout.height() == 0)
+      return invalid(frame +
+                     ": an organised frame needs both; leave both 0 for an unorganised "
+                     "cloud");
+    if (pixels > limits.max_points)
+      return invalid(frame + " is " + std::to_string(pixels) +
+                     " points; this server takes at most " + std::to_string(limits.max_points));
+    if (header.expected_points() > 0 && header.expected_points() != pixels)
+      return invalid(frame + " is " + std::to_string(pixels) + " points but expected_points is " +
+                     std::to_string(header.expected_points()));
+  }
   return std::nullopt;
 }
 
@@ -57,6 +73,7 @@ ScanAssembler::ScanAssembler(const v1::ScanHeader& header, const ScanLimits& lim
       intensity_(header.layout().intensity()),
       reject_non_finite_(header.options().non_finite() == v1::NON_FINITE_REJECT),
       expected_points_(header.expected_points()),
+      frame_points_(std::uint64_t(header.layout().width()) * header.layout().height()),
       limits_(limits) {
   cloud_.viewpoint.origin =
       Vec3f(header.viewpoint().x(), header.viewpoint().y(), header.viewpoint().z());
@@ -140,6 +157,9 @@ std::optional<ServiceError> ScanAssembler::finish() const {
   if (expected_points_ > 0 && cloud_.size() != expected_points_)
     return invalid("the scan has " + std::to_string(cloud_.size()) + " points but the header " +
                    "announced " + std::to_string(expected_points_));
+  if (frame_points_ > 0 && cloud_.size() != frame_points_)
+    return invalid("the scan has " + std::to_string(cloud_.size()) +
+                   " points but layout.width x layout.height is " + std::to_string(frame_points_));
   return std::nullopt;
 }
 

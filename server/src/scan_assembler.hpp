@@ -39,6 +39,7 @@ class ScanAssembler {
   const bool intensity_;
   const bool reject_non_finite_;
   const std::uint64_t expected_points_;
+  const std::uint64_t frame_points_;  // layout.width x height; 0: unorganised
   const ScanLimits limits_;
   PointCloud cloud_;
   std::uint64_t bytes_ = 0;

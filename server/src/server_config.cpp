@@ -115,7 +115,8 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
       ->envname("PRIMLABEL_METRICS_LISTEN")
       ->capture_default_str();
   app.add_option("--default-model", config.default_model,
-                 "model served when a request names none (default: the only model)")
+                 "model for requests that name none and whose cloud no model's domain decides "
+                 "(default: the repository's default_model file, else the only model)")
       ->envname("PRIMLABEL_DEFAULT_MODEL");
   std::vector<std::string> pins;
   app.add_option("--pin", pins, "MODEL=VERSION: serve this version by default, not the latest")

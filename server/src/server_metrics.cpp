@@ -35,6 +35,11 @@ ServerMetrics::ServerMetrics()
                   .Name("primlabel_points_total")
                   .Help("Points labeled, by model")
                   .Register(*registry_)),
+      choices_(BuildCounter()
+                   .Name("primlabel_model_choices_total")
+                   .Help("Labeling requests by the model that labeled them and how it was chosen "
+                         "(named by the request, by the domain its cloud fits, the default)")
+                   .Register(*registry_)),
       dropped_(BuildCounter()
                    .Name("primlabel_points_dropped_total")
                    .Help("Points not labeled because of bad input, by reason")
@@ -96,6 +101,10 @@ std::string ServerMetrics::serialize() const {
   std::vector<prometheus::MetricFamily> process = process_->Collect();
   families.insert(families.end(), process.begin(), process.end());
   return prometheus::TextSerializer().Serialize(families);
+}
+
+void ServerMetrics::model_chosen(const std::string& model, const std::string& reason) {
+  choices_.Add({{"model", model_label(model)}, {"reason", reason}}).Increment();
 }
 
 std::string ServerMetrics::model_label(const std::string& model) const {

@@ -2,6 +2,8 @@
 // The service's Prometheus metrics (names are a contract: the deployment's alerts use them).
 //   primlabel_requests_total{method,model,status}     counter
 //   primlabel_points_total{model}                      counter, points labeled
+//   primlabel_model_choices_total{model,reason}        counter, how each labeled request's
+//                                                      model was chosen: named, domain, default
 //   primlabel_points_dropped_total{reason}             counter, e.g. reason="non_finite"
 //   primlabel_inflight_requests                        gauge, admitted requests
 //   primlabel_queue_depth                              gauge, requests waiting for a worker
@@ -48,6 +50,8 @@ class ServerMetrics {
   void request_finished(const std::string& method, const std::string& model,
                         const std::string& status, double seconds);
   void points_labeled(const std::string& model, double points);
+  // `reason` is one of pipeline::choice_reason_name's three values.
+  void model_chosen(const std::string& model, const std::string& reason);
   void points_dropped(const std::string& reason, double points);
   void stage(const std::string& stage, double seconds);
   void set_admission(int admitted, int queued);
@@ -65,6 +69,7 @@ class ServerMetrics {
   std::shared_ptr<prometheus::Collectable> process_;
   prometheus::Family<prometheus::Counter>& requests_;
   prometheus::Family<prometheus::Counter>& points_;
+  prometheus::Family<prometheus::Counter>& choices_;
   prometheus::Family<prometheus::Counter>& dropped_;
   prometheus::Gauge& inflight_;
   prometheus::Gauge& queue_depth_;

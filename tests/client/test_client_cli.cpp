@@ -98,6 +98,34 @@ TEST(ClientCli, LabelWritesLabelsDescriptorsProbabilitiesAndPng) {
   EXPECT_NE(r.output.find("300 points"), std::string::npos) << r.output;
 }
 
+// The CLI sends an organised file's width and height (so a server can pick the camera's model)
+// and prints how the model was chosen.
+TEST(ClientCli, LabelSendsTheFramesShapeAndPrintsHowTheModelWasChosen) {
+  FakeServer server;
+  test::TempDir dir;
+  PointCloud frame;
+  frame.resize_unorganized(300);
+  for (std::size_t i = 0; i < 300; ++i) frame.xyz[i] = Vec3f(float(i % 5), 0.01f * i, 0.3f);
+  frame.width = 20, frame.height = 15;
+  write_cloud(dir.file("frame.pcd"), frame);
+  write_scan(dir.file("scan.pcd"));
+  const auto unnamed = test::run_command(cli() + " --server " + server.address() + " label " +
+                                         dir.file("frame.pcd") + " -o " + dir.file("f.pcd"));
+  ASSERT_EQ(unnamed.exit_code, 0) << unnamed.output;
+  EXPECT_NE(unnamed.output.find("the default: the only model served"), std::string::npos)
+      << unnamed.output;
+  const auto named =
+      test::run_command(cli() + " --server " + server.address() + " label " + dir.file("scan.pcd") +
+                        " -o " + dir.file("s.pcd") + " --model fake");
+  ASSERT_EQ(named.exit_code, 0) << named.output;
+  EXPECT_NE(named.output.find("named by the request"), std::string::npos) << named.output;
+  std::lock_guard lock(server.service.mutex);
+  ASSERT_EQ(server.service.layouts.size(), 2u);
+  EXPECT_EQ(server.service.layouts[0].width(), 20u);
+  EXPECT_EQ(server.service.layouts[0].height(), 15u);
+  EXPECT_EQ(server.service.layouts[1].height(), 0u);  // unorganised: no shape sent
+}
+
 // --primitives writes primlabel-eval's JSON from the summary's primitives (the fake's known
 // instances, read back with the core's parser).
 TEST(ClientCli, PrimitivesGoToTheirJsonFile) {

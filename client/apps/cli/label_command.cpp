@@ -135,9 +135,11 @@ int run_label(Client& client, LabelCommand command) {
       std::fprintf(stderr, "primlabel: warning: %s: %s\n", input.c_str(),
                    result.summary.domain_warning().c_str());
     if (!command.quiet)
-      std::fprintf(stderr, "%s: %zu points -> %s in %.2f s, model %s %s (%s)\n", input.c_str(),
+      std::fprintf(stderr, "%s: %zu points -> %s in %.2f s, model %s %s %s (%s)\n", input.c_str(),
                    result.size(), out.c_str(), seconds, result.summary.model().c_str(),
-                   result.summary.model_version().c_str(), label_histogram(result.labels).c_str());
+                   result.summary.model_version().c_str(),
+                   model_choice_text(result.summary).c_str(),
+                   label_histogram(result.labels).c_str());
   }
   return exit_code;
 }

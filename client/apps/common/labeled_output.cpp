@@ -20,6 +20,7 @@ CloudTags labeled_cloud_tags(const LabelResult& result) {
   CloudTags tags;
   tags["model"] = result.summary.model();
   tags["model_version"] = result.summary.model_version();
+  tags["model_choice"] = model_choice_name(result.summary.model_choice());
   tags["classes"] = class_map_tag(ClassMap::taxonomy());  // what the label field holds
   if (result.descriptor_dim > 0) tags["descriptor"] = descriptor_field(result);
   if (!result.probabilities.empty()) {

@@ -12,13 +12,14 @@ from . import pcd
 from ._version import __version__
 from .backoff import Backoff, BackoffPolicy
 from .client import ClassInfo, Client, HealthStatus, Result, Tls
-from .errors import InvalidInput, PrimlabelError
+from .errors import DomainWarning, InvalidInput, PrimlabelError
 from .wire import NO_OBJECT, NO_SEGMENT
 
 __all__ = [
     "Backoff",
     "BackoffPolicy",
     "ClassInfo",
+    "DomainWarning",
     "Client",
     "HealthStatus",
     "InvalidInput",

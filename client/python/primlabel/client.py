@@ -16,13 +16,14 @@ from __future__ import annotations
 import enum
 import math
 import time
+import warnings
 from dataclasses import dataclass
 
 import grpc
 import numpy as np
 
 from .backoff import Backoff, BackoffPolicy
-from .errors import InvalidInput, PrimlabelError, ProtocolError
+from .errors import DomainWarning, InvalidInput, PrimlabelError, ProtocolError
 from .pcd import PointCloud
 from .v1 import labeling_pb2, labeling_pb2_grpc
 from .wire import (
@@ -95,6 +96,17 @@ class Result:
     def class_ids(self) -> np.ndarray:
         return np.array([c.id for c in self.classes], dtype=np.uint32)
 
+    @property
+    def model_choice(self) -> str:
+        """How the server chose the model: "named" (by the call), "domain" (the model whose
+        training domain fits the cloud) or "default" (the repository's default, when no domain
+        decided); model_choice_reason says what decided."""
+        return _MODEL_CHOICES.get(self.summary.model_choice, "")
+
+    @property
+    def model_choice_reason(self) -> str:
+        return self.summary.model_choice_reason
+
 
 class HealthStatus(enum.IntEnum):
     UNKNOWN = 0
@@ -153,9 +165,19 @@ class _Call:
                               self.want_segments, self.want_objects)
 
 
+_MODEL_CHOICES = {
+    labeling_pb2.MODEL_CHOICE_NAMED: "named",
+    labeling_pb2.MODEL_CHOICE_DOMAIN: "domain",
+    labeling_pb2.MODEL_CHOICE_DEFAULT: "default",
+}
+
+
 def _result(assembled_and_summary, attempts: int) -> Result:
     assembled, summary = assembled_and_summary
     labels, descriptor_rows, probability_rows, classes, segments, objects = assembled
+    if summary.domain_warning:  # plausible-looking labels from a model of another sensor
+        warnings.warn(f"model {summary.model}: {summary.domain_warning}", DomainWarning,
+                      stacklevel=3)
     return Result(
         labels=labels,
         probabilities=probability_rows,
@@ -278,9 +300,12 @@ class Client:
         """Streams the points (Labeler.Label) in messages of chunk_points and returns their
         labels in input order.
 
-        xyz: (N, 3) array, float32 or float64 (sent as float32), or a pcd.PointCloud (its xyz,
-        and its VIEWPOINT unless viewpoint is given). normals: (N, 3), sent so the server skips
-        normal estimation. model: None = the server's default. voxel_size: > 0
+        xyz: (N, 3) array, float32 or float64 (sent as float32), an (H, W, 3) organised frame, or
+        a pcd.PointCloud (its xyz, its VIEWPOINT unless viewpoint is given, and its WIDTH x
+        HEIGHT when organised). normals: (N, 3), sent so the server skips normal estimation.
+        model: None = the model whose training domain fits the cloud (the sensor and image size,
+        then spacing and noise), else the repository's default (Result.model_choice says which);
+        a named model used outside its domain warns (DomainWarning). voxel_size: > 0
         downsamples before features (labels still cover every input point); None = the model's.
 
         Keyword-only options: model_version; viewpoint, the sensor origin (x, y, z) the normals
@@ -373,10 +398,16 @@ class Client:
         deadline: float | None = None,
     ) -> tuple[_Call, float]:
         """The checked request of one labeling call, and its deadline in seconds."""
+        frame = (0, 0)  # width, height of an organised frame: it lets the server pick the model
         if isinstance(xyz, PointCloud):  # its points, seen from its VIEWPOINT as the CLI does
             if viewpoint is None:
                 viewpoint = xyz.viewpoint[:3]
+            if xyz.organized:
+                frame = (xyz.width or len(xyz) // xyz.height, xyz.height)
             xyz = xyz.xyz
+        elif np.ndim(xyz) == 3 and np.shape(xyz)[2] == 3:  # an (H, W, 3) image of points
+            frame = (np.shape(xyz)[1], np.shape(xyz)[0])
+            xyz = np.reshape(xyz, (-1, 3))
         points = as_points(xyz, "xyz")
         sent_normals = None if normals is None else as_points(normals, "normals", len(points))
         if non_finite not in _NON_FINITE:
@@ -406,7 +437,9 @@ class Client:
                 return_primitives=bool(primitives),
                 return_objects=bool(objects),
             ),
-            layout=labeling_pb2.PointLayout(normals=sent_normals is not None),
+            layout=labeling_pb2.PointLayout(normals=sent_normals is not None,
+                                            width=frame[0] if frame[1] > 1 else 0,
+                                            height=frame[1] if frame[1] > 1 else 0),
             expected_points=len(points),
         )
         if objects and not tabletop_only:

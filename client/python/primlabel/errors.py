@@ -30,3 +30,9 @@ class InvalidInput(PrimlabelError, ValueError):
 class ProtocolError(Exception):
     """An answer that breaks the protocol (chunks overlapping, missing or of the wrong size); the
     client turns it into PrimlabelError(DATA_LOSS)."""
+
+
+class DomainWarning(UserWarning):
+    """The server labeled the cloud with a model trained for another kind of cloud (sensor, image
+    size, point spacing or noise): the labels look plausible and are unreliable. The message is
+    the summary's domain_warning."""

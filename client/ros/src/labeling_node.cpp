@@ -23,7 +23,8 @@ LabelingNode::LabelingNode(ros::NodeHandle& node, const NodeParameters& paramete
   ROS_INFO("primlabel-ros: labeling %s -> %s (summary %s) through %s, model %s",
            subscriber_.getTopic().c_str(), cloud_publisher_.getTopic().c_str(),
            summary_publisher_.getTopic().c_str(), parameters.server.c_str(),
-           parameters.model.empty() ? "(the server's default)" : parameters.model.c_str());
+           parameters.model.empty() ? "(the one whose domain fits each cloud)"
+                                    : parameters.model.c_str());
 }
 
 void LabelingNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& cloud) {
@@ -37,6 +38,13 @@ void LabelingNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& cloud) {
     const client::LabelResult result = client_.label(points, options);
     if (!result.summary.domain_warning().empty())
       ROS_WARN_THROTTLE(60, "primlabel-ros: %s", result.summary.domain_warning().c_str());
+    // Which model labels the clouds, and why, each time it changes (not every frame).
+    const std::string model = result.summary.model() + " " + result.summary.model_version();
+    if (model != last_model_) {
+      last_model_ = model;
+      ROS_INFO("primlabel-ros: model %s labels frame '%s' (%s)", model.c_str(), frame.c_str(),
+               client::model_choice_text(result.summary).c_str());
+    }
     cloud_publisher_.publish(labeled_pointcloud2(*cloud, result, fields_));
     std_msgs::String summary;
     summary.data = summary_json(result.summary);

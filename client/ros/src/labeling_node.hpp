@@ -36,6 +36,7 @@ class LabelingNode {
   ros::Publisher summary_publisher_;
   ros::Subscriber subscriber_;
   std::uint64_t labeled_ = 0, failed_ = 0;
+  std::string last_model_;  // "name version" of the last answer, to log its choice once
 };
 
 }  // namespace primlabel::rosnode

@@ -141,6 +141,12 @@ v1::Model to_proto(const LabelModel& m) {
   t->set_point_spacing_min(m.training.point_spacing_min);
   t->set_point_spacing_max(m.training.point_spacing_max);
   t->set_surface_variation_max(m.training.surface_variation_max);
+  t->set_surface_variation_min(m.training.surface_variation_min);
+  t->set_sensor(m.training.sensor);
+  t->set_image_width(m.training.image_width), t->set_image_height(m.training.image_height);
+  t->set_acquired_spacing_min(m.training.acquired_spacing_min);
+  t->set_acquired_spacing_max(m.training.acquired_spacing_max);
+  t->set_roughness_min(m.training.roughness_min), t->set_roughness_max(m.training.roughness_max);
   t->set_class_balance(m.training.class_balance);
   for (double w : m.training.class_weights) t->add_class_weights(w);
 
@@ -246,6 +252,12 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
   m.training.point_spacing_min = t.point_spacing_min();
   m.training.point_spacing_max = t.point_spacing_max();
   m.training.surface_variation_max = t.surface_variation_max();
+  m.training.surface_variation_min = t.surface_variation_min();
+  m.training.sensor = t.sensor();
+  m.training.image_width = t.image_width(), m.training.image_height = t.image_height();
+  m.training.acquired_spacing_min = t.acquired_spacing_min();
+  m.training.acquired_spacing_max = t.acquired_spacing_max();
+  m.training.roughness_min = t.roughness_min(), m.training.roughness_max = t.roughness_max();
   m.training.class_balance = t.class_balance();
   m.training.class_weights.assign(t.class_weights().begin(), t.class_weights().end());
 

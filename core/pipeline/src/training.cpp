@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <set>
 #include <stdexcept>
@@ -87,6 +88,7 @@ SceneData prepare_scene(PointCloud cloud, std::string source, const FeatureSetti
                         const std::vector<std::uint32_t>& class_ids, const RunContext& context) {
   SceneData scene;
   scene.source = std::move(source);
+  if (cloud.organized()) scene.image_width = cloud.width, scene.image_height = cloud.height;
   DescribedCloud described = describe_cloud(cloud, features, context);
   scene.normal_seconds = described.normal_seconds;
   scene.feature_seconds = described.feature_seconds;
@@ -165,8 +167,32 @@ TrainingSummary summarize_training(std::span<const SceneData> training, std::siz
     summary.point_spacing_max = std::max(summary.point_spacing_max, s.point_spacing);
   }
   for (const SceneData& s : training)
-    if (s.surface_variation > 0.0f)
+    if (s.surface_variation > 0.0f) {
       summary.surface_variation_max = std::max(summary.surface_variation_max, s.surface_variation);
+      summary.surface_variation_min =
+          summary.surface_variation_min > 0.0f
+              ? std::min(summary.surface_variation_min, s.surface_variation)
+              : s.surface_variation;
+    }
+  // The least and greatest of a positive figure over the scenes (NaN and 0: not measured).
+  const auto widen = [](float value, float& low, float& high) {
+    if (!(value > 0.0f) || !std::isfinite(value)) return;
+    low = low > 0.0f ? std::min(low, value) : value;
+    high = std::max(high, value);
+  };
+  for (const SceneData& s : training) {
+    widen(s.acquired.point_spacing, summary.acquired_spacing_min, summary.acquired_spacing_max);
+    widen(s.acquired.roughness, summary.roughness_min, summary.roughness_max);
+  }
+  // An image size only when every scene was a frame of that one size.
+  if (!training.empty() && training.front().image_height > 1 &&
+      std::all_of(training.begin(), training.end(), [&](const SceneData& s) {
+        return s.image_width == training.front().image_width &&
+               s.image_height == training.front().image_height;
+      })) {
+    summary.image_width = training.front().image_width;
+    summary.image_height = training.front().image_height;
+  }
   summary.class_points.assign(num_classes, 0);
   for (const SceneData& s : training)
     for (int label : s.graph.labels)

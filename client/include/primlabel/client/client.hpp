@@ -129,6 +129,11 @@ class ClientError : public std::runtime_error {
 
 // "UNAVAILABLE", "DEADLINE_EXCEEDED", ...
 std::string status_code_name(grpc::StatusCode code);
+// How the server chose the model: "named", "domain", "default" ("" when the server did not say).
+std::string model_choice_name(v1::ModelChoice choice);
+// The same for people: "named by the request", "chosen by domain: <reason>", "the default:
+// <reason>".
+std::string model_choice_text(const v1::LabelSummary& summary);
 
 // How a call ended, for callbacks and counters.
 struct CallStatus {

@@ -68,6 +68,15 @@ struct TrainingSummary {
   // The greatest median surface variation of the training scenes' normals (a measure of their
   // range noise at the model's normal radius); 0 when not recorded.
   float surface_variation_max = 0;
+  float surface_variation_min = 0;  // the least of the same; 0 when not recorded
+  // The sensor of the training scans ("lms400", "kinect"; empty: not recorded) and, when every
+  // training cloud was an organised frame of one size, that size (0 x 0 otherwise).
+  std::string sensor;
+  std::uint32_t image_width = 0, image_height = 0;
+  // The ranges of the training scans' signatures as acquired (pipeline/cloud_signature.hpp: the
+  // median point spacing and the roughness of small patches, m); 0 when not recorded.
+  float acquired_spacing_min = 0, acquired_spacing_max = 0;
+  float roughness_min = 0, roughness_max = 0;
   // The class balance alpha of the objective (crf::class_balance_weights; 0 = unweighted, as in
   // older files) and the resulting weight per model class (empty when unweighted).
   double class_balance = 0;

@@ -13,6 +13,7 @@
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/model/svm_baseline.hpp"
+#include "primlabel/pipeline/cloud_signature.hpp"
 
 namespace primlabel::pipeline {
 
@@ -25,6 +26,10 @@ struct SceneData {
   double feature_seconds = 0;   // descriptors only
   float point_spacing = 0;      // median point spacing as described (m; NaN: none)
   float surface_variation = 0;  // median surface variation of its normals (NaN: none)
+  // The cloud's image size as acquired, before any voxel filter (0 x 0: unorganised).
+  std::uint32_t image_width = 0, image_height = 0;
+  // Its signature as acquired (cloud_signature.hpp); zeros when not measured.
+  CloudSignature acquired;
 };
 
 // Describes a labeled cloud and builds its graph (labels are assigned with `class_ids`).

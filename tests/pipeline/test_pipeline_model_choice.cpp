@@ -1,0 +1,210 @@
+// Which model labels a request that names none (pipeline/model_choice.hpp), and the signature
+// it reads off a cloud (pipeline/cloud_signature.hpp).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "primlabel/pipeline/cloud_signature.hpp"
+#include "primlabel/pipeline/model_choice.hpp"
+
+namespace primlabel::pipeline {
+namespace {
+
+// A camera model: trained on 640x480 frames, rough and ~2 mm apart.
+TrainingSummary camera() {
+  TrainingSummary t;
+  t.sensor = "kinect";
+  t.image_width = 640, t.image_height = 480;
+  t.acquired_spacing_min = 0.0015f, t.acquired_spacing_max = 0.003f;
+  t.roughness_min = 0.0015f, t.roughness_max = 0.004f;
+  return t;
+}
+
+// A laser scanner: unorganised, smooth, ~1 mm apart.
+TrainingSummary scanner() {
+  TrainingSummary t;
+  t.sensor = "lms400";
+  t.acquired_spacing_min = 0.0008f, t.acquired_spacing_max = 0.0012f;
+  t.roughness_min = 0.0001f, t.roughness_max = 0.0003f;
+  return t;
+}
+
+TrainingSummary unrecorded() { return {}; }  // a model file from before the domain was recorded
+
+struct Models {
+  TrainingSummary cam = camera(), laser = scanner(), old = unrecorded();
+  std::vector<ModelCandidate> both() const { return {{"cam", &cam}, {"laser", &laser}}; }
+};
+
+TEST(ModelChoice, AFrameGoesToTheModelTrainedOnFramesOfItsSize) {
+  const Models m;
+  const ModelChooser chooser(m.both(), "laser", CloudShape{640, 480});
+  ASSERT_TRUE(chooser.decided());  // no signature needed: the header decides
+  EXPECT_EQ(chooser.choice().model, "cam");
+  EXPECT_EQ(chooser.choice().reason, ChoiceReason::kDomain);
+  EXPECT_NE(chooser.choice().why.find("640x480"), std::string::npos) << chooser.choice().why;
+}
+
+TEST(ModelChoice, AFrameOfAnotherSizeIsLeftToTheSignatureAmongCameraModels) {
+  const Models m;
+  ModelChooser chooser(m.both(), "laser", CloudShape{320, 240});
+  ASSERT_TRUE(chooser.needs_signature());
+  ASSERT_EQ(chooser.remaining().size(), 1u);  // the scanner model cannot read a frame
+  EXPECT_EQ(chooser.remaining().front().name, "cam");
+  chooser.consider(CloudSignature{0.004f, 0.003f});  // a coarser camera
+  EXPECT_EQ(chooser.choice().model, "cam");
+  EXPECT_EQ(chooser.choice().reason, ChoiceReason::kDomain);
+}
+
+TEST(ModelChoice, AnUnorganisedCloudIsChosenBySpacingAndRoughness) {
+  const Models m;
+  ModelChooser laser_scan(m.both(), "cam", CloudShape{});
+  ASSERT_TRUE(laser_scan.needs_signature());
+  laser_scan.consider(CloudSignature{0.001f, 0.0002f});
+  EXPECT_EQ(laser_scan.choice().model, "laser");
+  EXPECT_EQ(laser_scan.choice().reason, ChoiceReason::kDomain);
+
+  ModelChooser camera_cloud(m.both(), "laser", CloudShape{});  // a frame sent unorganised
+  camera_cloud.consider(CloudSignature{0.002f, 0.0025f});
+  EXPECT_EQ(camera_cloud.choice().model, "cam");
+  EXPECT_EQ(camera_cloud.choice().reason, ChoiceReason::kDomain);
+}
+
+TEST(ModelChoice, SeveralOrNoneFittingFallBackToTheDefault) {
+  Models m;
+  m.laser.roughness_max = 0.003f;  // a scanner trained with heavy noise: both fit a rough cloud
+  ModelChooser several(m.both(), "laser", CloudShape{});
+  several.consider(CloudSignature{0.0015f, 0.002f});
+  EXPECT_EQ(several.choice().model, "laser");
+  EXPECT_EQ(several.choice().reason, ChoiceReason::kDefault);
+  EXPECT_NE(several.choice().why.find("several"), std::string::npos) << several.choice().why;
+
+  ModelChooser none(m.both(), "cam", CloudShape{});
+  none.consider(CloudSignature{0.05f, 0.02f});  // 5 cm apart: neither sensor
+  EXPECT_EQ(none.choice().model, "cam");
+  EXPECT_EQ(none.choice().reason, ChoiceReason::kDefault);
+  EXPECT_NE(none.choice().why.find("no model fits"), std::string::npos) << none.choice().why;
+  EXPECT_NE(none.choice().why.find("spacing 50.00 mm"), std::string::npos) << none.choice().why;
+}
+
+TEST(ModelChoice, WithoutADefaultTheRefusalNamesTheCandidates) {
+  const Models m;
+  ModelChooser chooser(m.both(), "", CloudShape{});
+  chooser.consider(CloudSignature{0.05f, 0.02f});
+  EXPECT_TRUE(chooser.choice().model.empty());
+  EXPECT_NE(chooser.choice().why.find("cam, laser"), std::string::npos) << chooser.choice().why;
+  EXPECT_NE(chooser.choice().why.find("no default model"), std::string::npos);
+}
+
+TEST(ModelChoice, ADefaultThatIsNotServedIsNoDefault) {
+  const Models m;
+  ModelChooser chooser(m.both(), "gone", CloudShape{});
+  chooser.consider(CloudSignature{0.05f, 0.02f});
+  EXPECT_TRUE(chooser.choice().model.empty()) << chooser.choice().model;
+}
+
+TEST(ModelChoice, ModelsThatRecordNoDomainAreNeverChosenByIt) {
+  const Models m;
+  // Only old files: nothing to measure the cloud against, so no index is built.
+  const ModelChooser old_only({{"old", &m.old}, {"older", &m.old}}, "older", CloudShape{});
+  ASSERT_TRUE(old_only.decided());
+  EXPECT_EQ(old_only.choice().model, "older");
+  EXPECT_EQ(old_only.choice().reason, ChoiceReason::kDefault);
+  // An old file beside a recorded one: the recorded one is chosen only where it fits.
+  ModelChooser mixed({{"cam", &m.cam}, {"old", &m.old}}, "old", CloudShape{});
+  mixed.consider(CloudSignature{0.002f, 0.0025f});
+  EXPECT_EQ(mixed.choice().model, "cam");
+  EXPECT_EQ(mixed.choice().reason, ChoiceReason::kDomain);
+}
+
+TEST(ModelChoice, TheOnlyModelServedNeedsNoSignature) {
+  const Models m;
+  const ModelChooser chooser({{"laser", &m.laser}}, "laser", CloudShape{});
+  ASSERT_TRUE(chooser.decided());
+  EXPECT_EQ(chooser.choice().model, "laser");
+  EXPECT_EQ(chooser.choice().reason, ChoiceReason::kDefault);
+}
+
+TEST(ModelChoice, AFrameNoModelCanReadFallsBackWithTheReasons) {
+  const Models m;
+  const ModelChooser chooser({{"laser", &m.laser}, {"laser2", &m.laser}}, "laser2",
+                             CloudShape{640, 480});
+  ASSERT_TRUE(chooser.decided());
+  EXPECT_EQ(chooser.choice().model, "laser2");
+  EXPECT_EQ(chooser.choice().reason, ChoiceReason::kDefault);
+  EXPECT_NE(chooser.choice().why.find("unorganised lms400 scans"), std::string::npos)
+      << chooser.choice().why;
+}
+
+TEST(ModelChoice, TheShapeVerdictsAreThreeWay) {
+  EXPECT_EQ(judge_shape(camera(), CloudShape{640, 480}).fit, DomainFit::kFits);
+  EXPECT_EQ(judge_shape(camera(), CloudShape{320, 240}).fit, DomainFit::kUnknown);
+  EXPECT_EQ(judge_shape(camera(), CloudShape{}).fit, DomainFit::kUnknown);
+  EXPECT_EQ(judge_shape(scanner(), CloudShape{640, 480}).fit, DomainFit::kOutside);
+  EXPECT_EQ(judge_shape(unrecorded(), CloudShape{640, 480}).fit, DomainFit::kUnknown);
+  EXPECT_EQ(judge_shape(camera(), CloudShape{640, 1}).fit, DomainFit::kUnknown);  // one row
+}
+
+TEST(ModelChoice, TheSignatureToleranceIsTwoEachWay) {
+  const TrainingSummary t = scanner();  // spacing 0.8-1.2 mm, roughness 0.1-0.3 mm
+  EXPECT_EQ(judge_signature(t, CloudSignature{0.0024f, 0.0006f}).fit, DomainFit::kFits);
+  EXPECT_EQ(judge_signature(t, CloudSignature{0.0026f, 0.0002f}).fit, DomainFit::kOutside);
+  EXPECT_EQ(judge_signature(t, CloudSignature{0.001f, 0.00004f}).fit, DomainFit::kOutside);
+  const float nan = std::nanf("");
+  EXPECT_EQ(judge_signature(t, CloudSignature{nan, nan}).fit, DomainFit::kUnknown);
+  EXPECT_EQ(judge_signature(unrecorded(), CloudSignature{0.001f, 0.0002f}).fit,
+            DomainFit::kUnknown);
+}
+
+// A 20 cm square grid of `spacing` with Gaussian depth noise `sigma`.
+std::vector<Vec3f> noisy_plane(float spacing, float sigma, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0f, sigma);
+  std::vector<Vec3f> points;
+  const int n = int(std::lround(0.2f / spacing));
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      points.emplace_back(i * spacing, j * spacing, 1.0f + (sigma > 0 ? noise(rng) : 0.0f));
+  return points;
+}
+
+TEST(CloudSignature, ReadsTheSpacingAndTheNoiseOfAPlane) {
+  const CloudSignature clean = measure_signature(noisy_plane(0.002f, 0.0f, 1));
+  EXPECT_NEAR(clean.point_spacing, 0.002f, 1e-5f);
+  EXPECT_LT(clean.roughness, 1e-5f);
+  const CloudSignature rough = measure_signature(noisy_plane(0.002f, 0.001f, 2));
+  EXPECT_NEAR(rough.roughness, 0.001f, 0.0002f);  // the RMS to the plane is the noise
+  EXPECT_GT(rough.point_spacing, 0.0015f);
+  EXPECT_LT(rough.point_spacing, 0.0025f);
+}
+
+TEST(CloudSignature, InvalidPixelsAndThreadsDoNotChangeIt) {
+  std::vector<Vec3f> points = noisy_plane(0.002f, 0.001f, 3);
+  const CloudSignature one = measure_signature(points, RunContext{1});
+  const CloudSignature two = measure_signature(points, RunContext{2});
+  EXPECT_EQ(one.point_spacing, two.point_spacing);
+  EXPECT_EQ(one.roughness, two.roughness);
+  const float nan = std::nanf("");
+  std::vector<Vec3f> with_holes;  // every other pixel invalid, as a frame's shadows
+  for (const Vec3f& p : points) {
+    with_holes.push_back(p);
+    with_holes.emplace_back(nan, nan, nan);
+  }
+  const CloudSignature holed = measure_signature(with_holes);
+  EXPECT_EQ(holed.point_spacing, one.point_spacing);
+  EXPECT_EQ(holed.roughness, one.roughness);
+}
+
+TEST(CloudSignature, AnEmptyOrSinglePointCloudHasNone) {
+  const CloudSignature empty = measure_signature({});
+  EXPECT_TRUE(std::isnan(empty.point_spacing));
+  EXPECT_TRUE(std::isnan(empty.roughness));
+  const CloudSignature single = measure_signature({Vec3f(1, 2, 3), Vec3f(1, 2, 3)});
+  EXPECT_TRUE(std::isnan(single.point_spacing));  // coincident copies are no spacing
+  EXPECT_TRUE(std::isnan(single.roughness));
+}
+
+}  // namespace
+}  // namespace primlabel::pipeline
