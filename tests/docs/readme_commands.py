@@ -1,10 +1,15 @@
 #!/usr/bin/env python3
 """The README's commands, run as a user would (the doc test docs.ReadmeCommands).
 
-Extracts the ```sh blocks of README.md and client/README.md, keeps the commands that can run
-on this machine (the server, the `primlabel` CLI, the uploader on files, the load generator),
-and runs them from a scratch directory laid out like a checkout (build/bin, build/models,
-scan.pcd, scans/) against a primlabel-server on 127.0.0.1. Each must exit 0.
+First checks that every relative markdown link of the pages below names an existing file (and,
+for a link into a markdown page, an existing heading); a broken link fails the test, naming the
+page and the link.
+
+Then extracts the ```sh blocks of README.md, client/README.md and every docs/*.md page (sorted),
+keeps the commands that can run on this machine (the server, the `primlabel` CLI, the uploader
+on files, the load generator), and runs them from a scratch directory laid out like a checkout
+(build/bin, build/models, scan.pcd, scans/) against a primlabel-server on 127.0.0.1. Each must
+exit 0.
 
 Rewritten only where the machine differs from the example: `labeler:50051` and `HOST:PORT` name
 the server started here, `HOST:METRICS_PORT` its /metrics, and the ports 50051 / 9464 become
@@ -13,15 +18,18 @@ generator's examples get two of its own flags so the whole run stays bounded (< 
 --max-duration 2 per step and --max-points 5000 per cloud (a full 85k-point scan takes ~2 s to
 label on two cores, and a sweep to 7 callers would queue for tens of seconds).
 Commands that cannot end by themselves (--watch) or need another machine (ssh) are listed as
-skipped. The commands the issue's user tried must be among those run: the server start,
-`info`, `label`, the load generator sweep; a README that no longer has them fails the test.
+skipped. The commands the issue's user tried must be among those run, in any of the pages: the
+server start (exactly one across them all), `info`, `label`, the load generator sweep; pages that
+no longer have them fail the test.
 
 usage: readme_commands.py SOURCE_DIR BUILD_DIR
 Model repository: BUILD_DIR/models when it holds tabletop-lms400 (after `deploy/setup.sh run`),
 else a small node-only model is trained for the run (~5 s) and served under both default names,
-tabletop-lms400 and tabletop-kinect, so the server sees two models as it does after setup.sh.
+tabletop-lms400 and tabletop-kinect, with `default_model` naming tabletop-lms400, so the server
+sees two models and a declared default as it does after setup.sh.
 """
 
+import glob
 import os
 import re
 import shlex
@@ -33,7 +41,8 @@ import sys
 import tempfile
 import time
 
-DOCS = ["README.md", "client/README.md"]
+FIXED_DOCS = ["README.md", "client/README.md"]
+DOCS_GLOB = "docs/*.md"
 TOOLS = ["primlabel-server", "primlabel-loadgen", "primlabel-upload", "primlabel"]
 SKIP = [("--watch", "runs until a signal"), ("ssh ", "needs another machine"),
         ("--frame", "pipes to another machine")]
@@ -46,6 +55,57 @@ REQUIRED = {  # what the user tried: (description, pattern over the command)
 LOADGEN_CAPS = " --max-duration 2 --max-points 5000"
 COMMAND_TIMEOUT_S = 45
 BUDGET_S = 100        # the whole run, including training and the server start
+
+
+def doc_pages(source):
+    """README.md, client/README.md and every docs/*.md page, as paths relative to SOURCE."""
+    pages = sorted(os.path.relpath(p, source) for p in glob.glob(os.path.join(source, DOCS_GLOB)))
+    return FIXED_DOCS + pages
+
+
+def without_code_blocks(text):
+    """The text without its fenced code blocks (their lines are neither headings nor links)."""
+    return re.sub(r"^(```|~~~).*?^\1[^\n]*$", "", text, flags=re.S | re.M)
+
+
+def without_code(text):
+    """The text without code blocks and inline code spans (their brackets are no links)."""
+    return re.sub(r"(`+)(?:(?!\1).)+?\1", "", without_code_blocks(text))
+
+
+def heading_anchors(text):
+    """GitHub's anchors of a page's headings: lower case, punctuation dropped, spaces as '-'."""
+    anchors, seen = set(), {}
+    for title in re.findall(r"^#{1,6}[ \t]+(.+?)[ \t#]*$", without_code_blocks(text), re.M):
+        title = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", title)  # a link's text
+        slug = re.sub(r"[^\w\- ]", "", title.replace("`", "").lower()).replace(" ", "-")
+        count = seen.get(slug, 0)
+        seen[slug] = count + 1
+        anchors.add(slug if count == 0 else f"{slug}-{count}")
+    return anchors
+
+
+def broken_links(source, pages):
+    """(page, link, why) for every relative link of PAGES whose file or heading does not exist."""
+    broken = []
+    for page in pages:
+        with open(os.path.join(source, page)) as f:
+            text = f.read()
+        for target in re.findall(r"!?\[[^\]]*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)",
+                                 without_code(text)):
+            if re.match(r"^[a-z][a-z0-9+.-]*:", target, re.I):  # http:, https:, mailto:
+                continue
+            path, _, anchor = target.partition("#")
+            resolved = os.path.normpath(os.path.join(source, os.path.dirname(page), path)) \
+                if path else os.path.join(source, page)
+            if not os.path.exists(resolved):
+                broken.append((page, target, "no such file"))
+            elif anchor and resolved.endswith(".md"):
+                with open(resolved) as f:
+                    if anchor not in heading_anchors(f.read()):
+                        broken.append((page, target, f"no heading #{anchor} in "
+                                       + os.path.relpath(resolved, source)))
+    return broken
 
 
 def free_port():
@@ -118,6 +178,9 @@ def model_repository(build_dir, work, bin_dir):
     # The server names a model by its directory.
     os.makedirs(os.path.join(models, "tabletop-kinect", "1"))
     shutil.copy(trained, os.path.join(models, "tabletop-kinect", "1", "model.plm"))
+    # A declared default (the file `deploy/setup.sh default-model` writes); older servers skip it.
+    with open(os.path.join(models, "default_model"), "w") as f:
+        f.write("tabletop-lms400\n")
     return models, "a small node-only model trained for this run"
 
 
@@ -127,15 +190,23 @@ def main():
     source, build_dir = (os.path.abspath(a) for a in sys.argv[1:])
     bin_dir = os.path.join(build_dir, "bin")
     began = time.monotonic()
+    docs = doc_pages(source)
+    print("pages: " + ", ".join(docs))
+    broken = broken_links(source, docs)
+    for page, link, why in broken:
+        print(f"FAIL broken link in {page}: ({link}): {why}")
+    if broken:
+        return 1
+
     commands = []
-    for doc in DOCS:
+    for doc in docs:
         with open(os.path.join(source, doc)) as f:
             commands += [(doc, c) for c in sh_commands(f.read()) if tool_of(c)]
 
     missing = [what for what, pattern in REQUIRED.items()
                if not any(re.search(pattern, c) for _, c in commands)]
     if missing:
-        print("README commands not found: " + ", ".join(missing))
+        print("commands not found in the pages: " + ", ".join(missing))
         return 1
 
     work = tempfile.mkdtemp(prefix="primlabel-readme-")
@@ -158,7 +229,7 @@ def main():
         log = open(os.path.join(work, "commands.log"), "w")
         starts = [c for _, c in commands if tool_of(c) == "primlabel-server"]
         if len(starts) != 1:
-            print(f"expected one server command in the READMEs, found {len(starts)}")
+            print(f"expected one server command in the pages, found {len(starts)}")
             return 1
         server_log = open(os.path.join(work, "server.log"), "w")
         server_command = rewrite(starts[0], port, metrics_port)
