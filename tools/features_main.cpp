@@ -1,6 +1,7 @@
 // primlabel-features: normals and FPFH/PFH descriptors for a point cloud file, offline.
 //
 //   primlabel-features scan.pcd -o scan_features.pcd --normal-radius 0.015 --feature-radius 0.03
+//   primlabel-features scan.pcd --signature   # what a server routes a model-less request by
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -10,7 +11,9 @@
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/cloud_signature.hpp"
 #include "primlabel/geometry/features.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/normals.hpp"
 
@@ -23,8 +26,27 @@ struct Arguments {
   int normal_k = 0, feature_k = 0, max_neighbors = 0, threads = 0;
   float normal_radius = 0, feature_radius = 0;
   std::string descriptor = "fpfh", variant = "pcl", viewpoint;
-  bool use_input_normals = false, quiet = false;
+  bool use_input_normals = false, quiet = false, signature = false;
 };
+
+// One JSON line: the cloud's shape and its signature as acquired (geometry/cloud_signature.hpp),
+// which a server compares with each model's training domain for a request naming no model.
+int print_signature(const Arguments& args) {
+  const PointCloud cloud = read_cloud(args.input);
+  const Vec3f viewpoint =
+      args.viewpoint.empty() ? cloud.viewpoint.origin : cli::parse_vec3(args.viewpoint);
+  const CloudSignature s = measure_signature(cloud.xyz, viewpoint, RunContext{args.threads});
+  json::Json out;
+  out["file"] = args.input;
+  out["points"] = cloud.size();
+  out["width"] = cloud.organized() ? cloud.width : 0;
+  out["height"] = cloud.organized() ? cloud.height : 0;
+  out["point_spacing_m"] = json::rounded(s.point_spacing, "%.6f");
+  out["roughness_m"] = json::rounded(s.roughness, "%.6f");
+  out["noise_growth"] = json::rounded(s.noise_growth, "%.3f");
+  std::printf("%s\n", json::dump(out).c_str());
+  return cli::kExitOk;
+}
 
 Neighborhood neighborhood_of(int k, float radius, int max_neighbors, int default_k) {
   if (radius > 0)
@@ -38,6 +60,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 int run(const Arguments& args) {
+  if (args.signature) return print_signature(args);
   cli::ProgressPrinter progress(args.quiet);
   PointCloud cloud = read_cloud(args.input);
   const std::size_t finite = count_finite(cloud);
@@ -107,7 +130,11 @@ int main(int argc, char** argv) {
   app.name("primlabel-features");
   Arguments args;
   app.add_option("input", args.input, "input cloud (.pcd or .ply)")->required();
-  app.add_option("-o,--output", args.output, "output cloud (.pcd or .ply)")->required();
+  auto* output = app.add_option("-o,--output", args.output, "output cloud (.pcd or .ply)");
+  app.add_flag("--signature", args.signature,
+               "print the cloud's signature (point spacing, roughness, noise growth with range: "
+               "what a server picks a model by) as one JSON line instead")
+      ->excludes(output);
   // 0 stands for "not given"; --help shows what is used then.
   auto* nk = app.add_option("--normal-k", args.normal_k, "normals from the K nearest points")
                  ->check(CLI::PositiveNumber)
@@ -146,6 +173,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
     std::fprintf(stderr, "primlabel-features: usage error: %s (see --help)\n", e.what());
+    return cli::kExitUsage;
+  }
+  if (args.output.empty() && !args.signature) {
+    std::fprintf(stderr, "primlabel-features: usage error: --output is required (see --help)\n");
     return cli::kExitUsage;
   }
   if (args.use_input_normals && (args.normal_k > 0 || args.normal_radius > 0)) {

@@ -16,7 +16,7 @@
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
-#include "primlabel/pipeline/cloud_signature.hpp"
+#include "primlabel/geometry/cloud_signature.hpp"
 #include "primlabel/pipeline/labeled_voxels.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/research/curve_plot.hpp"
@@ -63,8 +63,8 @@ std::vector<pipeline::SceneData> load_scenes(const Arguments& args, bool validat
     // The density the model is served at: label_cloud downsamples to the model's voxel size.
     const std::uint32_t width = cloud.organized() ? cloud.width : 0;
     const std::uint32_t height = cloud.organized() ? cloud.height : 0;
-    const pipeline::CloudSignature acquired =
-        pipeline::measure_signature(cloud.xyz, RunContext{args.threads});
+    const CloudSignature acquired =
+        measure_signature(cloud.xyz, cloud.viewpoint.origin, RunContext{args.threads});
     if (args.voxel_size > 0.0f)
       cloud = pipeline::voxelize_labeled(cloud, args.voxel_size, RunContext{args.threads});
     scenes.push_back(pipeline::prepare_scene(std::move(cloud), source, features, graph, every_class,

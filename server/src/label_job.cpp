@@ -5,7 +5,7 @@
 #include <new>
 #include <stdexcept>
 
-#include "primlabel/pipeline/cloud_signature.hpp"
+#include "primlabel/geometry/cloud_signature.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
 #include "registry_error.hpp"
 
@@ -114,7 +114,7 @@ std::optional<ServiceError> finish_model_choice(LabelPlan& plan, const PointClou
                                                 const RunContext& context) {
   if (plan.entry) return std::nullopt;
   const auto start = std::chrono::steady_clock::now();
-  plan.chooser->consider(pipeline::measure_signature(cloud.xyz, context));
+  plan.chooser->consider(measure_signature(cloud.xyz, cloud.viewpoint.origin, context));
   plan.choice_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return apply_choice(plan);

@@ -45,11 +45,11 @@ grpc::Status RequestRecord::finish(const grpc::Status& status) {
       .kv("scan_id", user_text(scan_id))
       .kv("model", user_text(model))
       .kv("version", user_text(version))
-      .kv("model_choice", model_choice)
       .kv("points", points)
       .kv("dropped_non_finite", dropped_non_finite)
       .kv("duration_ms", seconds * 1e3)
       .kv("status", code);
+  if (!model_choice.empty()) line.kv("model_choice", model_choice);
   for (const auto& [name, field] : kStages) {
     const double value = stages.*field;
     if (value < 0) continue;

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "primlabel/pipeline/cloud_signature.hpp"
+#include "primlabel/geometry/cloud_signature.hpp"
 #include "primlabel/pipeline/model_choice.hpp"
 
 namespace primlabel::pipeline {
@@ -171,10 +171,10 @@ std::vector<Vec3f> noisy_plane(float spacing, float sigma, unsigned seed) {
 }
 
 TEST(CloudSignature, ReadsTheSpacingAndTheNoiseOfAPlane) {
-  const CloudSignature clean = measure_signature(noisy_plane(0.002f, 0.0f, 1));
+  const CloudSignature clean = measure_signature(noisy_plane(0.002f, 0.0f, 1), Vec3f::Zero());
   EXPECT_NEAR(clean.point_spacing, 0.002f, 1e-5f);
   EXPECT_LT(clean.roughness, 1e-5f);
-  const CloudSignature rough = measure_signature(noisy_plane(0.002f, 0.001f, 2));
+  const CloudSignature rough = measure_signature(noisy_plane(0.002f, 0.001f, 2), Vec3f::Zero());
   EXPECT_NEAR(rough.roughness, 0.001f, 0.0002f);  // the RMS to the plane is the noise
   EXPECT_GT(rough.point_spacing, 0.0015f);
   EXPECT_LT(rough.point_spacing, 0.0025f);
@@ -182,8 +182,8 @@ TEST(CloudSignature, ReadsTheSpacingAndTheNoiseOfAPlane) {
 
 TEST(CloudSignature, InvalidPixelsAndThreadsDoNotChangeIt) {
   std::vector<Vec3f> points = noisy_plane(0.002f, 0.001f, 3);
-  const CloudSignature one = measure_signature(points, RunContext{1});
-  const CloudSignature two = measure_signature(points, RunContext{2});
+  const CloudSignature one = measure_signature(points, Vec3f::Zero(), RunContext{1});
+  const CloudSignature two = measure_signature(points, Vec3f::Zero(), RunContext{2});
   EXPECT_EQ(one.point_spacing, two.point_spacing);
   EXPECT_EQ(one.roughness, two.roughness);
   const float nan = std::nanf("");
@@ -192,18 +192,73 @@ TEST(CloudSignature, InvalidPixelsAndThreadsDoNotChangeIt) {
     with_holes.push_back(p);
     with_holes.emplace_back(nan, nan, nan);
   }
-  const CloudSignature holed = measure_signature(with_holes);
+  const CloudSignature holed = measure_signature(with_holes, Vec3f::Zero());
   EXPECT_EQ(holed.point_spacing, one.point_spacing);
   EXPECT_EQ(holed.roughness, one.roughness);
+  EXPECT_TRUE(std::isnan(one.noise_growth));  // a plane at one range: no growth to read
 }
 
 TEST(CloudSignature, AnEmptyOrSinglePointCloudHasNone) {
-  const CloudSignature empty = measure_signature({});
+  const CloudSignature empty = measure_signature({}, Vec3f::Zero());
   EXPECT_TRUE(std::isnan(empty.point_spacing));
   EXPECT_TRUE(std::isnan(empty.roughness));
-  const CloudSignature single = measure_signature({Vec3f(1, 2, 3), Vec3f(1, 2, 3)});
+  const CloudSignature single = measure_signature({Vec3f(1, 2, 3), Vec3f(1, 2, 3)}, Vec3f::Zero());
   EXPECT_TRUE(std::isnan(single.point_spacing));  // coincident copies are no spacing
   EXPECT_TRUE(std::isnan(single.roughness));
+}
+
+// A table seen from a sensor at the origin: a plane z = -0.4 from 0.6 m to 1.6 m ahead, 2 mm
+// apart, with noise along the viewing ray of sigma(range) = sigma1 * range^growth.
+std::vector<Vec3f> receding_table(float sigma1, float growth, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> unit(0.0f, 1.0f);
+  std::vector<Vec3f> points;
+  for (float y = 0.6f; y <= 1.6f; y += 0.002f)
+    for (float x = -0.3f; x <= 0.3f; x += 0.002f) {
+      const Vec3f p(x, y, -0.4f);
+      const float range = p.norm();
+      points.push_back(p + p / range * (sigma1 * std::pow(range, growth) * unit(rng)));
+    }
+  return points;
+}
+
+TEST(CloudSignature, TheNoiseGrowthTellsADepthCameraFromALaserScanner) {
+  const CloudSignature camera = measure_signature(receding_table(0.0008f, 2.0f, 4), Vec3f::Zero());
+  const CloudSignature scanner = measure_signature(receding_table(0.0008f, 0.0f, 5), Vec3f::Zero());
+  EXPECT_NEAR(camera.noise_growth, 2.0f, 0.5f);
+  EXPECT_NEAR(scanner.noise_growth, 0.0f, 0.5f);
+  // The noise level alone does not change it: a noisier scanner still grows like a scanner.
+  const CloudSignature noisy = measure_signature(receding_table(0.003f, 0.0f, 6), Vec3f::Zero());
+  EXPECT_NEAR(noisy.noise_growth, 0.0f, 0.5f);
+  // All at one range: nothing to say.
+  EXPECT_TRUE(std::isnan(
+      measure_signature(noisy_plane(0.002f, 0.001f, 7), Vec3f(0.1f, 0.1f, 0)).noise_growth));
+}
+
+TEST(ModelChoice, TheNoiseGrowthSeparatesSensorsWhoseSpacingAndNoiseOverlap) {
+  TrainingSummary cam = camera(), laser = scanner();
+  laser.acquired_spacing_max = cam.acquired_spacing_max;  // a scanner trained at 0.5-4x noise
+  laser.roughness_max = 0.005f;
+  cam.noise_growth_min = 1.6f, cam.noise_growth_max = 2.2f;
+  laser.noise_growth_min = -0.3f, laser.noise_growth_max = 0.2f;
+  const std::vector<ModelCandidate> both{{"cam", &cam}, {"laser", &laser}};
+  ModelChooser camera_cloud(both, "laser", CloudShape{});
+  camera_cloud.consider(CloudSignature{0.002f, 0.002f, 1.9f});
+  EXPECT_EQ(camera_cloud.choice().model, "cam");
+  EXPECT_EQ(camera_cloud.choice().reason, ChoiceReason::kDomain);
+  EXPECT_NE(camera_cloud.choice().why.find("noise growth 1.90"), std::string::npos)
+      << camera_cloud.choice().why;
+  ModelChooser noisy_scan(both, "cam", CloudShape{});
+  noisy_scan.consider(CloudSignature{0.002f, 0.002f, 0.1f});
+  EXPECT_EQ(noisy_scan.choice().model, "laser");
+  EXPECT_EQ(noisy_scan.choice().reason, ChoiceReason::kDomain);
+  // Unmeasurable growth (a cloud at one range): spacing and roughness alone, both fit.
+  ModelChooser flat(both, "cam", CloudShape{});
+  flat.consider(CloudSignature{0.002f, 0.002f});
+  EXPECT_EQ(flat.choice().reason, ChoiceReason::kDefault);
+  // The tolerance is 0.5 each way.
+  EXPECT_EQ(judge_signature(cam, CloudSignature{0.002f, 0.002f, 1.15f}).fit, DomainFit::kFits);
+  EXPECT_EQ(judge_signature(cam, CloudSignature{0.002f, 0.002f, 1.05f}).fit, DomainFit::kOutside);
 }
 
 }  // namespace

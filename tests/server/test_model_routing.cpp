@@ -7,7 +7,7 @@
 
 #include <fstream>
 
-#include "primlabel/pipeline/cloud_signature.hpp"
+#include "primlabel/geometry/cloud_signature.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {
@@ -19,8 +19,7 @@ using testing::table_with_box_cloud;
 // `name`, trained (as its record says) on `width` x `height` frames (0 x 0: unorganised
 // scans), with signature ranges around `around` (factor `spread` each way) or far from it.
 LabelModel model_with_domain(const std::string& name, std::uint32_t width, std::uint32_t height,
-                             const pipeline::CloudSignature& around, bool fits,
-                             float spread = 1.2f) {
+                             const CloudSignature& around, bool fits, float spread = 1.2f) {
   LabelModel model = random_label_model(name, "1");
   TrainingSummary& t = model.training;
   t.sensor = height > 1 ? "camera" : "scanner";
@@ -55,7 +54,7 @@ void declare_default(const TestServer& server, const std::string& model) {
 
 TEST(ModelRouting, AFrameNamingNoModelGoesToTheModelTrainedOnFramesOfItsSize) {
   const PointCloud cloud = even_cloud();
-  const auto signature = pipeline::measure_signature(cloud.xyz);
+  const auto signature = measure_signature(cloud.xyz, cloud.viewpoint.origin);
   const std::uint32_t width = std::uint32_t(cloud.size() / 2);
   // The scanner model fits the cloud's signature too: the frame's shape decides before it.
   const LabelModel camera = model_with_domain("cam", width, 2, signature, false);
@@ -91,7 +90,7 @@ TEST(ModelRouting, AFrameNamingNoModelGoesToTheModelTrainedOnFramesOfItsSize) {
 
 TEST(ModelRouting, AnUnorganisedCloudGoesToTheOnlyModelItsSignatureFits) {
   const PointCloud cloud = even_cloud();
-  const auto signature = pipeline::measure_signature(cloud.xyz);
+  const auto signature = measure_signature(cloud.xyz, cloud.viewpoint.origin);
   const LabelModel near = model_with_domain("near", 640, 480, signature, true);
   const LabelModel far = model_with_domain("far", 0, 0, signature, false);
   TestServer server({far, near}, [](server::ServerConfig& c) { c.default_model = "far"; });
@@ -104,13 +103,13 @@ TEST(ModelRouting, AnUnorganisedCloudGoesToTheOnlyModelItsSignatureFits) {
 
 TEST(ModelRouting, WhenSeveralOrNoneFitTheRepositorysDefaultFileDecides) {
   const PointCloud cloud = even_cloud();
-  const auto signature = pipeline::measure_signature(cloud.xyz);
+  const auto signature = measure_signature(cloud.xyz, cloud.viewpoint.origin);
   TestServer server({model_with_domain("a", 0, 0, signature, true),
                      model_with_domain("b", 0, 0, signature, true)});
   // No default: refused, naming both.
   const LabelAnswer refused = label_cloud(*server.stub, cloud, header_for(""));
   EXPECT_EQ(refused.status.error_code(), grpc::StatusCode::NOT_FOUND);
-  EXPECT_NE(refused.status.error_message().find("a, b"), std::string::npos)
+  EXPECT_NE(refused.status.error_message().find(": a, b)"), std::string::npos)
       << refused.status.error_message();
   EXPECT_NE(refused.status.error_message().find("several models fit"), std::string::npos)
       << refused.status.error_message();
@@ -137,7 +136,7 @@ TEST(ModelRouting, WhenSeveralOrNoneFitTheRepositorysDefaultFileDecides) {
 
 TEST(ModelRouting, TheDefaultFlagOverridesTheRepositorysFile) {
   const PointCloud cloud = even_cloud();
-  const auto signature = pipeline::measure_signature(cloud.xyz);
+  const auto signature = measure_signature(cloud.xyz, cloud.viewpoint.origin);
   TestServer server({model_with_domain("a", 0, 0, signature, true),
                      model_with_domain("b", 0, 0, signature, true)},
                     [](server::ServerConfig& c) { c.default_model = "a"; });
@@ -148,7 +147,7 @@ TEST(ModelRouting, TheDefaultFlagOverridesTheRepositorysFile) {
 
 TEST(ModelRouting, ANamedModelKeepsItsNameAndWarnsOutsideItsDomain) {
   const PointCloud cloud = even_cloud();
-  const auto signature = pipeline::measure_signature(cloud.xyz);
+  const auto signature = measure_signature(cloud.xyz, cloud.viewpoint.origin);
   TestServer server({model_with_domain("laser", 0, 0, signature, true)});
   const LabelAnswer named = label_cloud(*server.stub, cloud, frame_header(cloud, "laser"));
   ASSERT_TRUE(named.status.ok()) << named.status.error_message();

@@ -147,6 +147,10 @@ v1::Model to_proto(const LabelModel& m) {
   t->set_acquired_spacing_min(m.training.acquired_spacing_min);
   t->set_acquired_spacing_max(m.training.acquired_spacing_max);
   t->set_roughness_min(m.training.roughness_min), t->set_roughness_max(m.training.roughness_max);
+  if (std::isfinite(m.training.noise_growth_min) && std::isfinite(m.training.noise_growth_max)) {
+    t->set_noise_growth_min(m.training.noise_growth_min);
+    t->set_noise_growth_max(m.training.noise_growth_max);
+  }
   t->set_class_balance(m.training.class_balance);
   for (double w : m.training.class_weights) t->add_class_weights(w);
 
@@ -258,6 +262,10 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
   m.training.acquired_spacing_min = t.acquired_spacing_min();
   m.training.acquired_spacing_max = t.acquired_spacing_max();
   m.training.roughness_min = t.roughness_min(), m.training.roughness_max = t.roughness_max();
+  if (t.has_noise_growth_min() && t.has_noise_growth_max()) {
+    m.training.noise_growth_min = t.noise_growth_min();
+    m.training.noise_growth_max = t.noise_growth_max();
+  }
   m.training.class_balance = t.class_balance();
   m.training.class_weights.assign(t.class_weights().begin(), t.class_weights().end());
 

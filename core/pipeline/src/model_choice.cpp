@@ -17,6 +17,12 @@ std::string millimetres(float metres) {
   return text;
 }
 
+std::string decimal(float value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f", double(value));
+  return text;
+}
+
 // Whether `value` lies within kSignatureTolerance of [low, high].
 bool within(float value, float low, float high) {
   return value >= low / kSignatureTolerance && value <= high * kSignatureTolerance;
@@ -29,8 +35,9 @@ std::string joined(const std::vector<std::string>& parts, const char* separator)
 }
 
 bool records_signature(const ModelCandidate& candidate) {
-  return candidate.training->acquired_spacing_min > 0.0f ||
-         candidate.training->roughness_min > 0.0f;
+  const TrainingSummary& t = *candidate.training;
+  return t.acquired_spacing_min > 0.0f || t.roughness_min > 0.0f ||
+         std::isfinite(t.noise_growth_min);
 }
 
 }  // namespace
@@ -52,31 +59,39 @@ DomainVerdict judge_shape(const TrainingSummary& training, const CloudShape& sha
 DomainVerdict judge_signature(const TrainingSummary& training, const CloudSignature& signature) {
   const bool spacing_recorded = training.acquired_spacing_min > 0.0f;
   const bool roughness_recorded = training.roughness_min > 0.0f;
-  if (!spacing_recorded && !roughness_recorded)
+  const bool growth_recorded =
+      std::isfinite(training.noise_growth_min) && std::isfinite(training.noise_growth_max);
+  if (!spacing_recorded && !roughness_recorded && !growth_recorded)
     return {DomainFit::kUnknown, "its training scans' signature is not recorded"};
   const bool spacing_known =
       spacing_recorded && std::isfinite(signature.point_spacing) && signature.point_spacing > 0.0f;
   const bool roughness_known = roughness_recorded && std::isfinite(signature.roughness);
-  if (!spacing_known && !roughness_known)
-    return {DomainFit::kUnknown, "the cloud has no measurable spacing or roughness"};
-  std::vector<std::string> outside;
-  const std::string spacing_range = millimetres(training.acquired_spacing_min) + "-" +
-                                    millimetres(training.acquired_spacing_max) + " mm";
-  const std::string roughness_range =
-      millimetres(training.roughness_min) + "-" + millimetres(training.roughness_max) + " mm";
-  if (spacing_known && !within(signature.point_spacing, training.acquired_spacing_min,
-                               training.acquired_spacing_max))
-    outside.push_back("spacing " + millimetres(signature.point_spacing) + " mm, trained on " +
-                      spacing_range);
-  if (roughness_known &&
-      !within(signature.roughness, training.roughness_min, training.roughness_max))
-    outside.push_back("roughness " + millimetres(signature.roughness) + " mm, trained on " +
-                      roughness_range);
-  if (!outside.empty()) return {DomainFit::kOutside, joined(outside, ", ")};
-  return {DomainFit::kFits, "spacing " + millimetres(signature.point_spacing) +
-                                " mm and roughness " + millimetres(signature.roughness) +
-                                " mm within its training scans' " + spacing_range + " and " +
-                                roughness_range};
+  const bool growth_known = growth_recorded && std::isfinite(signature.noise_growth);
+  if (!spacing_known && !roughness_known && !growth_known)
+    return {DomainFit::kUnknown, "the cloud has no measurable spacing, roughness or noise growth"};
+  std::vector<std::string> outside, inside;
+  const auto check = [&](bool known, bool fits, const std::string& measured,
+                         const std::string& trained) {
+    if (!known) return;
+    (fits ? inside : outside).push_back(measured + " (trained " + trained + ")");
+  };
+  check(
+      spacing_known,
+      within(signature.point_spacing, training.acquired_spacing_min, training.acquired_spacing_max),
+      "spacing " + millimetres(signature.point_spacing) + " mm",
+      millimetres(training.acquired_spacing_min) + "-" +
+          millimetres(training.acquired_spacing_max) + " mm");
+  check(roughness_known,
+        within(signature.roughness, training.roughness_min, training.roughness_max),
+        "roughness " + millimetres(signature.roughness) + " mm",
+        millimetres(training.roughness_min) + "-" + millimetres(training.roughness_max) + " mm");
+  check(growth_known,
+        signature.noise_growth >= training.noise_growth_min - kNoiseGrowthTolerance &&
+            signature.noise_growth <= training.noise_growth_max + kNoiseGrowthTolerance,
+        "noise growth " + decimal(signature.noise_growth),
+        decimal(training.noise_growth_min) + " to " + decimal(training.noise_growth_max));
+  if (!outside.empty()) return {DomainFit::kOutside, "outside: " + joined(outside, ", ")};
+  return {DomainFit::kFits, joined(inside, ", ")};
 }
 
 const char* choice_reason_name(ChoiceReason reason) {
@@ -153,9 +168,12 @@ void ModelChooser::consider(const CloudSignature& signature) {
                           "the only model that fits: " + fits_why};
     return;
   }
-  const std::string what = fitting.empty()
-                               ? std::string("no model fits the cloud")
-                               : "several models fit the cloud (" + joined(fitting, ", ") + ")";
+  const std::string measured = "spacing " + millimetres(signature.point_spacing) +
+                               " mm, roughness " + millimetres(signature.roughness) +
+                               " mm, noise growth " + decimal(signature.noise_growth);
+  const std::string what = fitting.empty() ? "no model fits the cloud (" + measured + ")"
+                                           : "several models fit the cloud (" + measured + ": " +
+                                                 joined(fitting, ", ") + ")";
   choice_ = fall_back(what, notes);
 }
 

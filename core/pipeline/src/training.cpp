@@ -183,6 +183,13 @@ TrainingSummary summarize_training(std::span<const SceneData> training, std::siz
   for (const SceneData& s : training) {
     widen(s.acquired.point_spacing, summary.acquired_spacing_min, summary.acquired_spacing_max);
     widen(s.acquired.roughness, summary.roughness_min, summary.roughness_max);
+    // The growth may be 0 or below: NaN alone means not measured.
+    if (std::isfinite(s.acquired.noise_growth)) {
+      const float g = s.acquired.noise_growth;
+      const bool first = !std::isfinite(summary.noise_growth_min);
+      summary.noise_growth_min = first ? g : std::min(summary.noise_growth_min, g);
+      summary.noise_growth_max = first ? g : std::max(summary.noise_growth_max, g);
+    }
   }
   // An image size only when every scene was a frame of that one size.
   if (!training.empty() && training.front().image_height > 1 &&

@@ -9,6 +9,7 @@
 // inconsistent with itself is rejected with a ModelError naming the file and the reason.
 
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -77,6 +78,9 @@ struct TrainingSummary {
   // median point spacing and the roughness of small patches, m); 0 when not recorded.
   float acquired_spacing_min = 0, acquired_spacing_max = 0;
   float roughness_min = 0, roughness_max = 0;
+  // The range of the noise growth exponent (geometry/cloud_signature.hpp); NaN: not recorded.
+  float noise_growth_min = std::numeric_limits<float>::quiet_NaN();
+  float noise_growth_max = std::numeric_limits<float>::quiet_NaN();
   // The class balance alpha of the objective (crf::class_balance_weights; 0 = unweighted, as in
   // older files) and the resulting weight per model class (empty when unweighted).
   double class_balance = 0;

@@ -8,7 +8,8 @@
 //   1. the shape the request announces: an organised frame fits the models trained on frames of
 //      its size, leaves open those trained on frames of another size, and fits no model trained
 //      on unorganised scans; an unorganised cloud says nothing;
-//   2. the cloud's signature against each remaining model's ranges (within kSignatureTolerance).
+//   2. the cloud's signature (spacing, roughness, noise growth with range) against each
+//      remaining model's ranges, widened by kSignatureTolerance and kNoiseGrowthTolerance.
 // One model left fitting: it labels the cloud (by domain). Several or none: the repository's
 // default model, when there is one. Otherwise the request is refused, naming the candidates.
 // No transport here: the server maps the refusal to its status.
@@ -18,13 +19,16 @@
 #include <vector>
 
 #include "primlabel/model/label_model.hpp"
-#include "primlabel/pipeline/cloud_signature.hpp"
+#include "primlabel/geometry/cloud_signature.hpp"
 
 namespace primlabel::pipeline {
 
-// A signature within this factor of a model's training range fits it: about the spread of one
-// sensor's spacing over a table's depth, and twice its noise.
+// A spacing and roughness within this factor of a model's training range fit it: about the
+// spread of one sensor's spacing over a table's depth, and twice its noise.
 inline constexpr float kSignatureTolerance = 2.0f;
+// A noise growth exponent within this much of a model's training range fits it: a quarter of
+// the way between a laser scanner's (0) and a depth camera's (2).
+inline constexpr float kNoiseGrowthTolerance = 0.5f;
 
 // The organisation a request announces (0 x 0: unorganised or not said).
 struct CloudShape {

@@ -13,7 +13,7 @@
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/model/svm_baseline.hpp"
-#include "primlabel/pipeline/cloud_signature.hpp"
+#include "primlabel/geometry/cloud_signature.hpp"
 
 namespace primlabel::pipeline {
 
