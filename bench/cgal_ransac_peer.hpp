@@ -36,7 +36,7 @@ struct CgalRansacParameters {
   double degenerate_radius = 2.0;
 
   // cluster_epsilon = 4x the median point spacing (as primlabel's segments connect points within
-  // 4x the spacing, README: Primitive instances); the rest as above.
+  // 4x the spacing, docs/tools.md: Primitive instances); the rest as above.
   static CgalRansacParameters for_spacing(double point_spacing);
 };
 

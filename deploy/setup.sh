@@ -9,8 +9,9 @@
 #   deploy/setup.sh deps    install only
 #   deploy/setup.sh default-model [DIR]
 #                           install + build + the default models into DIR (a model repository,
-#                           default build/models): DIR/tabletop-lms400/1/model.plm and
-#                           DIR/tabletop-kinect/1/model.plm
+#                           default build/models): DIR/tabletop-lms400/1/model.plm,
+#                           DIR/tabletop-kinect/1/model.plm and DIR/default_model (the model
+#                           for requests naming none that no model's domain decides)
 #
 # Environment: BUILD_DIR (default build), BUILD_TYPE (Release), JOBS (nproc),
 #              PRIMLABEL_WITH_PCL=1 also installs libpcl-dev and libcgal-dev so benchmarks compare
@@ -94,8 +95,8 @@ build() {
 #   augmentation and with 10 mm normals 98.5%, 78.9%, 91.8%. About 112 s and 1.03 GB peak.
 # tabletop-kinect: trained and served on 5 mm voxels (the model records the size and the server
 #   applies it, so a 640x480 frame is labeled in a fraction of a second), normals over 30 mm,
-#   class balance 0.25, no augmentation (it did not help on the real mOSD scenes); see the
-#   README's "Depth cameras" for its figures there, its time and memory. About 50 s and 0.5 GB.
+#   class balance 0.25, no augmentation (it did not help on the real mOSD scenes); see
+#   docs/models.md "The default models" for its figures, time and memory. About 50 s and 0.5 GB.
 LMS400_RECIPE=(--sensor lms400 --normal-radius 0.015 --feature-radius 0.03 --class-balance 0.25
   --augment "$DEFAULT_AUGMENT")
 KINECT_RECIPE=(--sensor kinect --voxel-size 0.005 --normal-radius 0.03 --class-balance 0.25)

@@ -1,6 +1,6 @@
 #pragma once
 // A fitted primitive instance: one connected segment of same-class points and the parametric
-// model its class calls for (README: Primitive instances). Lengths in metres, directions unit.
+// model its class calls for (docs/tools.md: Primitive instances). Lengths in metres, directions unit.
 
 #include <Eigen/Core>
 #include <cstddef>

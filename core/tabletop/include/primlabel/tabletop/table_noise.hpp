@@ -1,6 +1,6 @@
 #pragma once
 // Clusters that are only the table seen through depth noise. A Kinect's depth error grows with
-// the square of the range (README "Kinect calibration": sigma = 2.82e-3 z^2 m to the frame's
+// the square of the range (docs/results.md "Kinect calibration": sigma = 2.82e-3 z^2 m to the frame's
 // plane, levels z^2 / 345 m apart), so at 1.5 m the table's far end scatters beyond any fixed
 // table band and leaves flat patches that Euclidean clustering counts as objects. A cluster is
 // table noise when nearly all of its points lie within the noise band of their own range; such

@@ -2,7 +2,7 @@
 // The table-top stage's answer as instances, per scan: the table (its plane, hull and point
 // count) and one TabletopObject per object cluster (points, centroid, axis-aligned bounds, height
 // above the table and, when primitives were fitted, the primitive segments lying in it), with
-// every point's object id. README: Table-top objects.
+// every point's object id. docs/service.md: Primitives and table-top objects.
 
 #include <Eigen/Core>
 #include <cstddef>
