@@ -14,7 +14,9 @@ namespace primlabel::server {
 std::vector<const ModelEntry*> LabelPlan::possible_models() const {
   if (entry) return {entry.get()};
   std::vector<const ModelEntry*> models;
-  for (const auto& candidate : candidates) models.push_back(candidate.get());
+  for (const auto& candidate : candidates)
+    for (const pipeline::ModelCandidate& open : chooser->remaining())
+      if (candidate->name == open.name) models.push_back(candidate.get());
   return models;
 }
 
@@ -50,11 +52,6 @@ std::optional<ServiceError> start_choice(const pipeline::CloudShape& shape,
   plan.chooser =
       std::make_shared<pipeline::ModelChooser>(candidates, registry.default_model(), shape);
   if (plan.chooser->decided()) return apply_choice(plan);
-  std::vector<std::shared_ptr<const ModelEntry>> open;  // only those the shape left in
-  for (const pipeline::ModelCandidate& remaining : plan.chooser->remaining())
-    for (const auto& candidate : plan.candidates)
-      if (candidate->name == remaining.name) open.push_back(candidate);
-  plan.candidates = std::move(open);
   return std::nullopt;
 }
 

@@ -22,8 +22,9 @@ struct LabelPlan {
   // The model, held for the whole request: reloads cannot touch it. Empty until the job when
   // the request names no model and the header leaves the choice to the cloud's signature.
   std::shared_ptr<const ModelEntry> entry;
-  // A request naming no model: the models it may still go to (held, like entry) and the
-  // choice in progress (pipeline/model_choice.hpp); how it was decided, once it is.
+  // A request naming no model: every model served when it arrived (held, like entry: the
+  // chooser reads their training summaries) and the choice in progress
+  // (pipeline/model_choice.hpp); how it was decided, once it is.
   std::vector<std::shared_ptr<const ModelEntry>> candidates;
   std::shared_ptr<pipeline::ModelChooser> chooser;
   pipeline::ChoiceReason choice = pipeline::ChoiceReason::kNamed;
@@ -34,7 +35,7 @@ struct LabelPlan {
   std::string shape_warning;
   pipeline::LabelingOptions options;  // without stop token and thread count
 
-  // The models the answer may come from: the chosen one, or every candidate still open.
+  // The models the answer may come from: the chosen one, or the candidates the shape left open.
   std::vector<const ModelEntry*> possible_models() const;
 };
 
