@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cfloat>
+#include <cmath>
 #include <fstream>
+#include <random>
 
 #include "primlabel/geometry/cloud_signature.hpp"
 #include "server_test_util.hpp"
@@ -182,6 +185,52 @@ TEST(ModelRouting, AFrameLayoutMustMatchThePoints) {
   EXPECT_NE(huge.status.error_message().find("at most"), std::string::npos)
       << huge.status.error_message();
   EXPECT_TRUE(label_cloud(*server.stub, cloud, header_for("m")).status.ok());  // still serving
+}
+
+// Clouds an attacker or a broken sensor sends, naming no model, to a server whose models need
+// the signature to choose: each gets an answer in bounded time and the server keeps serving.
+TEST(ModelRouting, HostileCloudsNamingNoModelAreChosenForInBoundedTime) {
+  const PointCloud table = even_cloud();
+  const auto signature = measure_signature(table.xyz, table.viewpoint.origin);
+  TestServer server({model_with_domain("a", 0, 0, signature, true),
+                     model_with_domain("b", 0, 0, signature, false)},
+                    [](server::ServerConfig& c) { c.default_model = "b"; });
+  const float nan = std::nanf("");
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> mm(0.0f, 0.001f);
+  std::vector<Vec3f> cube(20000);
+  for (Vec3f& p : cube) p = Vec3f(mm(rng), mm(rng), 0.5f + mm(rng));
+  std::vector<Vec3f> far = table.xyz;
+  far.insert(far.end(), {{1e30f, 0, 0}, {FLT_MAX, FLT_MAX, -FLT_MAX}, {0.1f, -1e18f, 3}});
+  const std::vector<std::pair<const char*, std::vector<Vec3f>>> clouds = {
+      {"coincident", std::vector<Vec3f>(100000, Vec3f(0.1f, 0.2f, 0.3f))},
+      {"millimetre cube", cube},
+      {"far points", far},
+      {"all NaN but one",
+       [&] {
+         std::vector<Vec3f> points(5000, Vec3f(nan, nan, nan));
+         points[17] = Vec3f(0, 0, 1);
+         return points;
+       }()},
+  };
+  for (const auto& [what, points] : clouds) {
+    SCOPED_TRACE(what);
+    PointCloud cloud;
+    cloud.resize_unorganized(points.size());
+    cloud.xyz = points;
+    const auto start = std::chrono::steady_clock::now();
+    const LabelAnswer answer =
+        label_stream(*server.stub, scan_requests(cloud, header_for("")), std::chrono::seconds(60));
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+    EXPECT_EQ(answer.labels.size(), points.size());
+    EXPECT_NE(answer.summary->model_choice(), v1::MODEL_CHOICE_UNSPECIFIED);
+    EXPECT_LT(seconds, 30.0);
+  }
+  const LabelAnswer legit = label_cloud(*server.stub, table, header_for(""));
+  ASSERT_TRUE(legit.status.ok()) << legit.status.error_message();
+  EXPECT_EQ(legit.summary->model(), "a");  // still chosen by its domain
 }
 
 }  // namespace
