@@ -3,6 +3,7 @@
 //
 //   primlabel-train --synth-train 4 --synth-val 1 --sensor lms400 -o table.plm --curve curve.csv
 //   primlabel-train --train a.pcd b.pcd --val c.pcd --classes map.txt --kind node -o m.plm
+//   primlabel-train --train real*.pcd --synth-train 8 --sensor kinect -o mixed.plm  # both
 //   primlabel-train --synth-train 3 --kind svm --svm-max-points 20000 -o svm.plm
 
 #include <CLI/CLI.hpp>
@@ -15,8 +16,8 @@
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
-#include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/geometry/cloud_signature.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/pipeline/labeled_voxels.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/research/curve_plot.hpp"
@@ -40,7 +41,9 @@ struct Arguments {
   float feature_sample = 0.0f;  // > 0: FPFH against one point per voxel of this edge
   std::vector<std::string> train_files, val_files;
   std::string sensor_name;  // --sensor-name: the sensor of --train files
-  std::string classes, output, curve_csv, curve_png, name, augment;
+  // --train with an explicit --synth-train: the synthetic scenes are trained on beside the files.
+  bool synth_with_files = false;
+  std::string classes, output, curve_csv, curve_png, name, augment, attribution;
   synth::Augmentation augmentation;  // --augment, parsed
   bool quiet = false;
 };
@@ -85,7 +88,7 @@ std::vector<pipeline::SceneData> load_scenes(const Arguments& args, bool validat
     const ClassMap map = args.classes.empty() ? ClassMap{} : read_class_map(args.classes);
     for (const std::string& path : files)
       add(args.classes.empty() ? load_labeled_cloud(path) : load_labeled_cloud(path, map), path);
-    return scenes;
+    if (!args.synth_with_files) return scenes;
   }
   const auto sensor = synth::sensor_from_name(args.sensor);
   const auto set = validation ? synth::SceneSet::kVal : synth::SceneSet::kTrain;
@@ -170,8 +173,12 @@ int run(const Arguments& args) {
   if (options.kind != ModelKind::kNodeOnly) say(args, model.training.objective);
   if (!args.name.empty()) model.name = args.name;
   model.features.voxel_size = args.voxel_size;  // applied by label_cloud (and so the server)
-  if (args.train_files.empty() || !args.sensor_name.empty())  // part of the model's domain
-    model.training.sensor = args.train_files.empty() ? args.sensor : args.sensor_name;
+  // Part of the model's domain: the synthetic scenes' sensor, or the one named for the files.
+  if (!args.sensor_name.empty())
+    model.training.sensor = args.sensor_name;
+  else if (args.train_files.empty() || args.synth_with_files)
+    model.training.sensor = args.sensor;
+  model.training.data_attribution = args.attribution;
   save_model(args.output, model);
 
   if (!args.curve_csv.empty()) {
@@ -213,14 +220,16 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"lms400", "kinect"}));
   app.add_option("--radius", args.label_radius, "label radius of the synthetic ground truth (m)")
       ->check(CLI::PositiveNumber);
-  auto* train_files = app.add_option("--train", args.train_files, "labeled PCD/PLY training files")
-                          ->excludes(synth_train);
+  auto* train_files = app.add_option(
+      "--train", args.train_files,
+      "labeled PCD/PLY training files (with --synth-train N: beside N synthetic scenes)");
   app.add_option("--sensor-name", args.sensor_name,
                  "the sensor that made the --train files (e.g. kinect), recorded in the model")
       ->needs(train_files);
-  app.add_option("--val", args.val_files, "labeled PCD/PLY validation files")
-      ->needs(train_files)
-      ->excludes(synth_val);
+  app.add_option("--val", args.val_files,
+                 "labeled PCD/PLY validation files (with --synth-train: beside the --synth-val "
+                 "scenes)")
+      ->needs(train_files);
   app.add_option("--classes", args.classes, "class map of the files' labels (id name per line)")
       ->needs(train_files);
   app.add_option("--kind", args.kind, "crf, node (node-only) or svm")
@@ -272,8 +281,9 @@ int main(int argc, char** argv) {
   app.add_option("--augment", args.augment,
                  "synthetic training: also scan each scene with other noise, density, range and "
                  "incidence, e.g. noise=0.5:4,density=0.25:1,range=0.9:1.4,elevation=-10:10,"
-                 "copies=1 (noise log-uniform, the rest uniform; seeded by the scene)")
-      ->excludes(train_files);
+                 "copies=1 (noise log-uniform, the rest uniform; seeded by the scene)");
+  app.add_option("--attribution", args.attribution,
+                 "credit and licence of the training data, recorded in the model");
   app.add_option("-o,--output", args.output, "model file to write")->required();
   app.add_option("--name", args.name, "model name recorded in the file");
   app.add_option("--curve", args.curve_csv, "training curve CSV (objective, accuracies)");
@@ -288,6 +298,20 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
     std::fprintf(stderr, "primlabel-train: usage error: %s (see --help)\n", e.what());
+    return cli::kExitUsage;
+  }
+  // Synthetic scenes with files only when asked for; they alone can be augmented.
+  args.synth_with_files = !args.train_files.empty() && synth_train->count() > 0;
+  const bool synthetic = args.train_files.empty() || args.synth_with_files;
+  const char* usage = nullptr;
+  if (!args.augment.empty() && !synthetic)
+    usage = "--augment rescans synthetic scenes: with --train it needs --synth-train";
+  else if (synth_val->count() > 0 && !synthetic)
+    usage = "--synth-val with --train needs --synth-train";
+  else if (args.synth_with_files && !args.sensor_name.empty() && args.sensor_name != args.sensor)
+    usage = "--sensor-name differs from the synthetic scenes' --sensor";
+  if (usage) {
+    std::fprintf(stderr, "primlabel-train: usage error: %s\n", usage);
     return cli::kExitUsage;
   }
   try {  // before any scene is described

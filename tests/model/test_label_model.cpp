@@ -44,6 +44,7 @@ LabelModel sample_crf() {
   m.training.objective = "pseudo-likelihood";
   m.training.class_balance = 0.5;
   m.training.class_weights = {0.25, 0.5, 1.5};
+  m.training.data_attribution = "Scans by A. N. Other, CC-BY 4.0";
   m.validation.accuracy = 0.975;
   m.validation.per_class = {{0.99, 0.98, 0.985, 100}, {0.9, 0.8, 0.85, 10}, {0.7, 0.6, 0.65, 5}};
   m.created_unix_ms = 1763776800000;
@@ -89,6 +90,7 @@ TEST(LabelModel, CrfRoundTrip) {
   EXPECT_EQ(loaded.training.class_points, saved.training.class_points);
   EXPECT_EQ(loaded.training.class_balance, 0.5);
   EXPECT_EQ(loaded.training.class_weights, saved.training.class_weights);
+  EXPECT_EQ(loaded.training.data_attribution, saved.training.data_attribution);
   EXPECT_EQ(loaded.validation.per_class.size(), 3u);
   EXPECT_DOUBLE_EQ(loaded.validation.per_class[1].f1, 0.85);
   EXPECT_EQ(loaded.created_unix_ms, saved.created_unix_ms);

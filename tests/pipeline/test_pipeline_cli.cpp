@@ -195,7 +195,10 @@ TEST_F(PipelineCli, BadUsageExitsTwo) {
         test::binary("primlabel-train") + " --kind nonsense -o m.plm",
         test::binary("primlabel-train") + " --synth-train 1",
         test::binary("primlabel-train") + " --kind svm --curve c.csv -o m.plm",
-        test::binary("primlabel-train") + " --train a.pcd --synth-train 2 -o m.plm",
+        // Synthetic validation scenes, or a sensor other than theirs, with files alone.
+        test::binary("primlabel-train") + " --train a.pcd --synth-val 1 -o m.plm",
+        test::binary("primlabel-train") +
+            " --train a.pcd --synth-train 1 --sensor-name kinect -o m.plm",
         // Bad node knots are refused before any scene is described (one line, no progress).
         eval() + " --table1 --node-knots 0,0.5,0.2",
         eval() + " --table1 --node-basis linear --node-knots 0,1",
@@ -230,6 +233,30 @@ TEST_F(PipelineCli, TrainAugmentsTheTrainingScenes) {
       << r.output;
   const LabelModel model = load_model((*dir_ / "augmented.plm").string());
   EXPECT_EQ(model.training.scenes, 2u);
+}
+
+// --train files beside --synth-train scenes: one training set (real scans with the simulator's),
+// validated on --val files and --synth-val scenes; the model records both and the attribution.
+TEST_F(PipelineCli, TrainOnFilesBesideSyntheticScenes) {
+  const std::string path = (*dir_ / "mixed.plm").string();
+  const Result r =
+      run(test::binary("primlabel-train") + " --train " + scene_path() + " --val " + scene_path() +
+          " --synth-train 1 --synth-val 1 --kind node --iterations 5 --threads 2 "
+          "--attribution 'Test data (CC0)' -o " +
+          path);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("training: " + scene_path() + ", "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("training: synth:lms400:train:seed1000, "), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("validation: " + scene_path() + ", "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("validation: synth:lms400:val:"), std::string::npos) << r.output;
+  const LabelModel model = load_model(path);
+  EXPECT_EQ(model.training.scenes, 2u);
+  ASSERT_EQ(model.training.sources.size(), 2u);
+  EXPECT_EQ(model.training.sources[0], scene_path());
+  EXPECT_EQ(model.training.sources[1], "synth:lms400:train:seed1000");
+  EXPECT_EQ(model.training.sensor, "lms400");  // the synthetic scenes' sensor
+  EXPECT_EQ(model.training.data_attribution, "Test data (CC0)");
 }
 
 // --voxel-size trains on voxel centroids and records the size, so label_cloud (and the server)

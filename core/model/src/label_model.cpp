@@ -153,6 +153,7 @@ v1::Model to_proto(const LabelModel& m) {
   }
   t->set_class_balance(m.training.class_balance);
   for (double w : m.training.class_weights) t->add_class_weights(w);
+  t->set_data_attribution(m.training.data_attribution);
 
   v1::Evaluation* e = out.mutable_validation();
   e->set_points(m.validation.points), e->set_accuracy(m.validation.accuracy);
@@ -268,6 +269,7 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
   }
   m.training.class_balance = t.class_balance();
   m.training.class_weights.assign(t.class_weights().begin(), t.class_weights().end());
+  m.training.data_attribution = t.data_attribution();
 
   const v1::Evaluation& e = in.validation();
   m.validation.points = e.points(), m.validation.accuracy = e.accuracy();

@@ -85,6 +85,8 @@ struct TrainingSummary {
   // older files) and the resulting weight per model class (empty when unweighted).
   double class_balance = 0;
   std::vector<double> class_weights;
+  // Credit and licence of the training data (primlabel-train --attribution); empty: none given.
+  std::string data_attribution;
 };
 
 struct EvaluationSummary {

@@ -1,0 +1,128 @@
+#!/usr/bin/env bash
+# Scene-level 5-fold cross-validation on the 45 real mOSD learning scenes: does training on their
+# fitted truth (beside the synthetic scenes) beat the synthetic-only depth-camera recipe?
+#
+#   bench/real_crossval.sh [BUILD_DIR] [OUT_DIR]
+#
+# 1. The fitted truth of learn0..44 once (`primlabel-eval --write-truth`, OUT_DIR/truth; kept).
+# 2. Folds by scene: scene n is in fold n mod 5; a fold's scenes are never trained on when it is
+#    scored.
+# 3. Model (i), `synthetic`: the shipped synthetic-only recipe (8 synthetic Kinect scenes). It
+#    sees no real scene, so one model serves every fold.
+#    Model (ii), `real`, per fold: the fitted truth of the other 36 scenes (unknown points, label
+#    0, are not trained on) + the same 8 synthetic scenes, same recipe otherwise.
+# 4. Each model labels the held-out scenes (`primlabel-eval --mosd-report --object-truth`): table
+#    points labeled plane (against mOSD's table labels) and the object points against the fitted
+#    truth; the per-class counts are summed over the folds (support, true positives and
+#    predictions, recovered from each report's recall, precision and support), then printed as
+#    one table per model and written to OUT_DIR/crossval.json.
+#
+# Defaults: build and build/real_crossval. Needs ../shared/data/mosd (exit 77 without it) and
+# Debian's python3. About 20 min on 2 cores; every step runs under `nice`.
+set -euo pipefail
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+BUILD_DIR=${1:-$ROOT/build}
+OUT=${2:-$BUILD_DIR/real_crossval}
+BUILD_DIR=$(cd "$BUILD_DIR" && pwd)  # absolute: training runs from OUT_DIR
+BIN=$BUILD_DIR/bin
+MOSD=${MOSD:-$ROOT/../shared/data/mosd}
+FOLDS=5
+# The shipped depth-camera recipe (deploy/setup.sh KINECT_RECIPE) and its 8 synthetic scenes.
+RECIPE=(--kind crf --sensor kinect --voxel-size 0.005 --normal-radius 0.03 --class-balance 0.25)
+SYNTH_SCENES=8
+[[ -f "$MOSD/learn0.pcd" ]] || { echo "real_crossval.sh: no mOSD scenes in $MOSD" >&2; exit 77; }
+for tool in primlabel-train primlabel-eval; do
+  [[ -x "$BIN/$tool" ]] || { echo "real_crossval.sh: $BIN/$tool missing" >&2; exit 2; }
+done
+mkdir -p "$OUT"
+OUT=$(cd "$OUT" && pwd)
+N="nice -n 19"
+log() { echo "real_crossval: $(date +%H:%M:%S) $*" >&2; }
+
+scenes=()
+for n in $(seq 0 44); do scenes+=("$MOSD/learn$n.pcd"); done
+missing=0
+for n in $(seq 0 44); do [[ -f "$OUT/truth/learn${n}_truth.pcd" ]] || missing=1; done
+if ((missing)); then
+  log "writing the fitted truth of the 45 scenes into $OUT/truth"
+  $N "$BIN/primlabel-eval" --write-truth "$OUT/truth" "${scenes[@]}" >"$OUT/truth.log"
+fi
+
+if [[ ! -f "$OUT/synthetic.plm" ]]; then
+  log "training (i) synthetic only"
+  $N "$BIN/primlabel-train" "${RECIPE[@]}" --synth-train $SYNTH_SCENES -q -o "$OUT/synthetic.plm"
+fi
+
+for f in $(seq 0 $((FOLDS - 1))); do
+  held=() train=()
+  for n in $(seq 0 44); do
+    if ((n % FOLDS == f)); then held+=("$MOSD/learn$n.pcd"); else train+=("truth/learn${n}_truth.pcd"); fi
+  done
+  dir=$OUT/fold$f
+  mkdir -p "$dir"
+  if [[ ! -f "$dir/real.plm" ]]; then
+    log "fold $f: training (ii) on ${#train[@]} real scenes + $SYNTH_SCENES synthetic"
+    # From OUT, so the model records the truth files by their relative names.
+    (cd "$OUT" && $N "$BIN/primlabel-train" "${RECIPE[@]}" --train "${train[@]}" \
+      --synth-train $SYNTH_SCENES -q -o "$dir/real.plm")
+  fi
+  # (i) is the same model in every fold: its fold reports are its scores on the fold's scenes.
+  for model in synthetic real; do
+    [[ -f "$dir/$model.json" ]] && continue
+    log "fold $f: scoring ($model) on ${#held[@]} held-out scenes"
+    path=$OUT/synthetic.plm
+    [[ $model == real ]] && path=$dir/real.plm
+    $N "$BIN/primlabel-eval" --model "$path" --mosd-report "$dir/$model" --object-truth -q --json \
+      "${held[@]}" >"$dir/$model.json"
+  done
+done
+
+python3 - "$OUT" "$FOLDS" <<'PYEOF'
+import json, sys
+out, folds = sys.argv[1], int(sys.argv[2])
+result = {}
+for model in ("synthetic", "real"):
+    table = {"points": 0, "plane": 0, "away": 0, "away_plane": 0}
+    classes = {}
+    for f in range(folds):
+        r = json.load(open(f"{out}/fold{f}/{model}.json"))
+        for s in r["scenes"]:
+            table["points"] += s["table_points"]
+            table["plane"] += s["table_plane"]
+            table["away"] += s["table_away"]
+            table["away_plane"] += round((s["away_plane_share"] or 0) * s["table_away"])
+        scores = r["object_truth"]["scores"]["classes"]
+        for name, c in scores.items():
+            k = classes.setdefault(name, {"support": 0, "tp": 0, "predicted": 0, "wrong_only": False})
+            tp = round((c["recall"] or 0) * c["support"])
+            k["support"] += c["support"]
+            k["tp"] += tp
+            if c["precision"]:
+                k["predicted"] += round(tp / c["precision"])
+            elif c["precision"] == 0:  # predicted, never right: the count is not in the report
+                k["wrong_only"] = True
+    support = sum(c["support"] for c in classes.values())
+    right = sum(c["tp"] for c in classes.values())
+    for c in classes.values():
+        c["recall"] = c["tp"] / c["support"] if c["support"] else None
+        wrong_only = c.pop("wrong_only")
+        c["precision"] = (c["tp"] / c["predicted"] if c["predicted"]
+                          else 0.0 if wrong_only else None)
+    result[model] = {"table_points": table["points"],
+                     "table_plane_share": table["plane"] / table["points"],
+                     "table_away_plane_share": table["away_plane"] / table["away"],
+                     "object_points": support, "object_accuracy": right / support,
+                     "classes": classes}
+json.dump(result, open(f"{out}/crossval.json", "w"), indent=1)
+fmt = lambda v: "   -  " if v is None else f"{100 * v:6.2f}"
+print(f"{folds}-fold cross-validation by scene on mOSD learn0-44 (fold = scene mod {folds})")
+for model, r in result.items():
+    print(f"\n({'i' if model == 'synthetic' else 'ii'}) {model}: table points plane "
+          f"{fmt(r['table_plane_share'])}% of {r['table_points']} "
+          f"({fmt(r['table_away_plane_share'])}% away from the objects' contact band); object points right "
+          f"{fmt(r['object_accuracy'])}% of {r['object_points']} scored")
+    print(f"  {'class':18s} {'recall':>7s} {'precision':>9s} {'support':>9s}")
+    for name, c in r["classes"].items():
+        if c["support"] or c["precision"] is not None:
+            print(f"  {name:18s} {fmt(c['recall']):>7s} {fmt(c['precision']):>9s} {c['support']:9d}")
+PYEOF
