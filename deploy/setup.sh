@@ -103,8 +103,8 @@ build() {
 #   fitted truth of the 45 real mOSD learning scenes (primlabel-eval --write-truth; its unknown
 #   points are not trained on) beside the 8 synthetic Kinect scenes: it beat the synthetic-only
 #   recipe in scene-level cross-validation (bench/real_crossval.sh). A fresh clone has no
-#   ../shared/data/mosd: it gets the committed deploy/models/tabletop-kinect.plm (checked against
-#   its .sha256). docs/models.md "The default models" has its figures, time and memory.
+#   ../shared/data/mosd, so every machine gets the committed deploy/models/tabletop-kinect.plm
+#   (checked against its .sha256); `deploy/setup.sh kinect-model OUT` retrains it. docs/models.md "The default models" has its figures, time and memory.
 LMS400_RECIPE=(--sensor lms400 --normal-radius 0.015 --feature-radius 0.03 --class-balance 0.25
   --augment "$DEFAULT_AUGMENT")
 KINECT_RECIPE=(--sensor kinect --voxel-size 0.005 --normal-radius 0.03 --class-balance 0.25
@@ -155,8 +155,9 @@ kinect_real_model() {
     "${KINECT_RECIPE[@]}" --train "${files[@]}" --attribution "$MOSD_ATTRIBUTION" -q -o "$out")
 }
 
-# tabletop-kinect into REPO: retrained where the mOSD scenes are (and primlabel-eval, which fits
-# their truth, is built), else the committed file.
+# tabletop-kinect into REPO: the committed file, checked against its checksum, on every machine
+# alike (a fresh clone has no ../shared to retrain it from; `kinect-model` regenerates it and
+# test_kinect_model retrains a subset where ../shared is).
 kinect_model() {
   local model="$1/tabletop-kinect/1/model.plm"
   if [[ -f "$model" ]]; then
@@ -164,16 +165,11 @@ kinect_model() {
     return
   fi
   mkdir -p "$(dirname "$model")"
-  if [[ -f "$MOSD_DIR/learn0.pcd" && -x "$BUILD_DIR/bin/primlabel-eval" ]]; then
-    log "training tabletop-kinect on the real mOSD scenes in $MOSD_DIR"
-    kinect_real_model "$model.tmp"
-  else
-    (cd "$(dirname "$KINECT_MODEL")" && sha256sum --quiet -c "$(basename "$KINECT_MODEL").sha256") ||
-      { log "$KINECT_MODEL does not match its checksum"; return 1; }
-    cp "$KINECT_MODEL" "$model.tmp"
-  fi
+  (cd "$(dirname "$KINECT_MODEL")" && sha256sum --quiet -c "$(basename "$KINECT_MODEL").sha256") ||
+    { log "$KINECT_MODEL does not match its checksum"; return 1; }
+  cp "$KINECT_MODEL" "$model.tmp"
   mv "$model.tmp" "$model"
-  log "wrote $model"
+  log "wrote $model (the committed real-trained model)"
 }
 
 # What the default models are made from; a repository made by another recipe (or before the
