@@ -470,7 +470,9 @@ def check_dockerignore(root):
         problems.check(dockerignored(rules, left_out), ".dockerignore keeps %s" % left_out)
     for needed in ("CMakeLists.txt", "deploy/setup.sh", "deploy/make-default-model.sh",
                    "deploy/Dockerfile", "core/CMakeLists.txt", "server/src/server_main.cpp",
-                   "client/CMakeLists.txt", "proto/primlabel/v1/model.proto"):
+                   "client/CMakeLists.txt", "proto/primlabel/v1/model.proto",
+                   # the committed real-trained depth-camera model and its checksum
+                   "deploy/models/tabletop-kinect.plm", "deploy/models/tabletop-kinect.plm.sha256"):
         problems.check(not dockerignored(rules, needed), ".dockerignore leaves out %s" % needed)
     # BuildKit prefers <Dockerfile>.dockerignore over the root file and podman ignores it: one file.
     problems.check(not os.path.exists(os.path.join(root, "deploy", "Dockerfile.dockerignore")),
