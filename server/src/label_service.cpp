@@ -120,11 +120,10 @@ std::optional<ServiceError> LabelSession::outcome() {
   stages.normals = result_.normal_seconds + (own_normals ? 0.0 : search);
   stages.features = result_.descriptor_seconds + (own_normals ? search : 0.0);
   const double primitives = result_.primitives ? result_.primitive_seconds : 0.0;
-  const double before_labeling = plan_.choice_seconds;
   if (result_.primitives) stages.primitives = primitives;
   // The rest of the job: graph, BP, duplicates and the fan-out (never below 0 by rounding).
   stages.inference =
-      std::max(0.0, seconds_between(job_start_, job_end_) - before_labeling -
+      std::max(0.0, seconds_between(job_start_, job_end_) - plan_.choice_seconds -
                         result_.prefilter_seconds - stages.normals - stages.features - primitives);
   return std::nullopt;
 }

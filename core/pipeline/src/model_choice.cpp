@@ -11,17 +11,13 @@ std::string size_text(std::uint32_t width, std::uint32_t height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
-std::string millimetres(float metres) {
+std::string decimal(double value) {
   char text[32];
-  std::snprintf(text, sizeof text, "%.2f", double(metres) * 1e3);
+  std::snprintf(text, sizeof text, "%.2f", value);
   return text;
 }
 
-std::string decimal(float value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.2f", double(value));
-  return text;
-}
+std::string millimetres(float metres) { return decimal(double(metres) * 1e3); }
 
 // Whether `value` lies within kSignatureTolerance of [low, high].
 bool within(float value, float low, float high) {
@@ -34,10 +30,15 @@ std::string joined(const std::vector<std::string>& parts, const char* separator)
   return out;
 }
 
+// Which parts of the signature a model recorded (0 or NaN: a file from before they were).
+bool spacing_recorded(const TrainingSummary& t) { return t.acquired_spacing_min > 0.0f; }
+bool roughness_recorded(const TrainingSummary& t) { return t.roughness_min > 0.0f; }
+bool growth_recorded(const TrainingSummary& t) {
+  return std::isfinite(t.noise_growth_min) && std::isfinite(t.noise_growth_max);
+}
 bool records_signature(const ModelCandidate& candidate) {
   const TrainingSummary& t = *candidate.training;
-  return t.acquired_spacing_min > 0.0f || t.roughness_min > 0.0f ||
-         std::isfinite(t.noise_growth_min);
+  return spacing_recorded(t) || roughness_recorded(t) || growth_recorded(t);
 }
 
 }  // namespace
@@ -57,16 +58,12 @@ DomainVerdict judge_shape(const TrainingSummary& training, const CloudShape& sha
 }
 
 DomainVerdict judge_signature(const TrainingSummary& training, const CloudSignature& signature) {
-  const bool spacing_recorded = training.acquired_spacing_min > 0.0f;
-  const bool roughness_recorded = training.roughness_min > 0.0f;
-  const bool growth_recorded =
-      std::isfinite(training.noise_growth_min) && std::isfinite(training.noise_growth_max);
-  if (!spacing_recorded && !roughness_recorded && !growth_recorded)
+  if (!records_signature({"", &training}))
     return {DomainFit::kUnknown, "its training scans' signature is not recorded"};
-  const bool spacing_known =
-      spacing_recorded && std::isfinite(signature.point_spacing) && signature.point_spacing > 0.0f;
-  const bool roughness_known = roughness_recorded && std::isfinite(signature.roughness);
-  const bool growth_known = growth_recorded && std::isfinite(signature.noise_growth);
+  const bool spacing_known = spacing_recorded(training) && std::isfinite(signature.point_spacing) &&
+                             signature.point_spacing > 0.0f;
+  const bool roughness_known = roughness_recorded(training) && std::isfinite(signature.roughness);
+  const bool growth_known = growth_recorded(training) && std::isfinite(signature.noise_growth);
   if (!spacing_known && !roughness_known && !growth_known)
     return {DomainFit::kUnknown, "the cloud has no measurable spacing, roughness or noise growth"};
   std::vector<std::string> outside, inside;
@@ -108,7 +105,7 @@ const char* choice_reason_name(ChoiceReason reason) {
 
 ModelChooser::ModelChooser(std::vector<ModelCandidate> candidates, std::string default_model,
                            const CloudShape& shape)
-    : all_(std::move(candidates)), default_model_(std::move(default_model)), shape_(shape) {
+    : all_(std::move(candidates)), default_model_(std::move(default_model)) {
   std::vector<ModelCandidate> fitting;
   std::string fits_why;
   for (const ModelCandidate& candidate : all_) {

@@ -18,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "primlabel/model/label_model.hpp"
 #include "primlabel/geometry/cloud_signature.hpp"
+#include "primlabel/model/label_model.hpp"
 
 namespace primlabel::pipeline {
 
@@ -87,7 +87,6 @@ class ModelChooser {
 
   std::vector<ModelCandidate> all_;
   std::string default_model_;
-  CloudShape shape_;
   std::vector<ModelCandidate> remaining_;
   std::vector<std::string> shape_notes_;  // "model: why" for those the shape ruled out
   std::optional<ModelChoice> choice_;
