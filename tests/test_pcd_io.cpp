@@ -477,6 +477,25 @@ TEST(PcdRead, OldHeaderWithoutCountOrViewpoint) {
   EXPECT_TRUE(cloud.viewpoint.orientation.coeffs() == Eigen::Quaternionf::Identity().coeffs());
 }
 
+// A zero-area shape (found by fuzz_pcd_reader: WIDTH 3 HEIGHT 0 and no POINTS line) is an empty
+// cloud whose width x height still equals its size.
+TEST(PcdRead, ZeroAreaShapesAreOneEmptyRow) {
+  test::TempDir dir;
+  for (const std::string shape :
+       {"WIDTH 3\nHEIGHT 0\n", "WIDTH 0\nHEIGHT 5\n", "WIDTH 3\nHEIGHT 0\nPOINTS 0\n"}) {
+    for (const std::string data : {"ascii", "binary", "binary_compressed"}) {
+      SCOPED_TRACE(shape + data);
+      const std::string path = dir.file("empty.pcd");
+      write_bytes(path, "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n" + shape +
+                            "DATA " + data + "\n");
+      const PointCloud cloud = read_pcd(path);
+      EXPECT_EQ(cloud.size(), 0u);
+      EXPECT_EQ(std::size_t{cloud.width} * cloud.height, cloud.size());
+      EXPECT_EQ(cloud.height, 1u);
+    }
+  }
+}
+
 TEST(PcdRead, PartialNormalsBecomeOrdinaryFields) {
   test::TempDir dir;
   const std::string path = dir.file("partial.pcd");

@@ -49,6 +49,9 @@ def pcd_seeds():
                            "ascii")
     organised += "".join("%d %d 1 %d 0 -3 7\n" % (i % 2, i // 2, 0xff0000 + i) for i in range(4))
     write("pcd_reader", "organised_ascii.pcd", organised)
+    # A zero-area shape with no POINTS line (a past finding: the cloud came back 3 wide, 0 long).
+    write("pcd_reader", "zero_area_binary.pcd",
+          "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 3\nHEIGHT 0\nDATA binary\n")
 
 
 def ply_seeds():

@@ -302,8 +302,12 @@ class PcdHeaderParser {
     header_.width = static_cast<std::uint32_t>(width_->value);
     header_.height = static_cast<std::uint32_t>(height);
     header_.points = points_->value;
-    // An empty cloud may say HEIGHT 0; PointCloud uses one (empty) row.
-    if (header_.points == 0) header_.height = std::max<std::uint32_t>(header_.height, 1);
+    // An empty cloud may say WIDTH 3 HEIGHT 0 (or 0 x 5); PointCloud keeps width x height equal
+    // to its size, so any zero-area shape becomes one empty row.
+    if (header_.points == 0) {
+      header_.width = 0;
+      header_.height = 1;
+    }
   }
 
   const std::string& path_;
