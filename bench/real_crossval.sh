@@ -17,6 +17,11 @@
 #    predictions, recovered from each report's recall, precision and support), then printed as
 #    one table per model and written to OUT_DIR/crossval.json.
 #
+# A third model, the same as (ii) plus VARIANT_RECIPE (e.g. VARIANT_RECIPE="--extra-radii
+# 0.015,0.04 --surface-variation" VARIANT_NAME=multiscale), is trained and scored per fold when
+# VARIANT_RECIPE is set. Every model and report already in OUT_DIR is kept, so a variant can be
+# added to an earlier run's directory.
+#
 # Defaults: build and build/real_crossval. Needs ../shared/data/mosd (exit 77 without it) and
 # Debian's python3. About 20 min on 2 cores; every step runs under `nice`.
 set -euo pipefail
@@ -30,6 +35,10 @@ FOLDS=5
 # The shipped depth-camera recipe (deploy/setup.sh KINECT_RECIPE) and its 8 synthetic scenes.
 RECIPE=(--kind crf --sensor kinect --voxel-size 0.005 --normal-radius 0.03 --class-balance 0.25)
 SYNTH_SCENES=8
+read -r -a VARIANT <<<"${VARIANT_RECIPE:-}"
+VARIANT_NAME=${VARIANT_NAME:-variant}
+MODELS=(synthetic real)
+((${#VARIANT[@]})) && MODELS+=("$VARIANT_NAME")
 [[ -f "$MOSD/learn0.pcd" ]] || { echo "real_crossval.sh: no mOSD scenes in $MOSD" >&2; exit 77; }
 for tool in primlabel-train primlabel-eval; do
   [[ -x "$BIN/$tool" ]] || { echo "real_crossval.sh: $BIN/$tool missing" >&2; exit 2; }
@@ -66,22 +75,27 @@ for f in $(seq 0 $((FOLDS - 1))); do
     (cd "$OUT" && $N "$BIN/primlabel-train" "${RECIPE[@]}" --train "${train[@]}" \
       --synth-train $SYNTH_SCENES -q -o "$dir/real.plm")
   fi
+  if ((${#VARIANT[@]})) && [[ ! -f "$dir/$VARIANT_NAME.plm" ]]; then
+    log "fold $f: training ($VARIANT_NAME: ii + ${VARIANT[*]})"
+    (cd "$OUT" && $N "$BIN/primlabel-train" "${RECIPE[@]}" "${VARIANT[@]}" --train "${train[@]}" \
+      --synth-train $SYNTH_SCENES -q -o "$dir/$VARIANT_NAME.plm")
+  fi
   # (i) is the same model in every fold: its fold reports are its scores on the fold's scenes.
-  for model in synthetic real; do
+  for model in "${MODELS[@]}"; do
     [[ -f "$dir/$model.json" ]] && continue
     log "fold $f: scoring ($model) on ${#held[@]} held-out scenes"
     path=$OUT/synthetic.plm
-    [[ $model == real ]] && path=$dir/real.plm
+    [[ $model != synthetic ]] && path=$dir/$model.plm
     $N "$BIN/primlabel-eval" --model "$path" --mosd-report "$dir/$model" --object-truth -q --json \
       "${held[@]}" >"$dir/$model.json"
   done
 done
 
-python3 - "$OUT" "$FOLDS" <<'PYEOF'
+python3 - "$OUT" "$FOLDS" "${MODELS[@]}" <<'PYEOF'
 import json, sys
-out, folds = sys.argv[1], int(sys.argv[2])
+out, folds, models = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
 result = {}
-for model in ("synthetic", "real"):
+for model in models:
     table = {"points": 0, "plane": 0, "away": 0, "away_plane": 0}
     classes = {}
     for f in range(folds):
@@ -117,7 +131,8 @@ json.dump(result, open(f"{out}/crossval.json", "w"), indent=1)
 fmt = lambda v: "   -  " if v is None else f"{100 * v:6.2f}"
 print(f"{folds}-fold cross-validation by scene on mOSD learn0-44 (fold = scene mod {folds})")
 for model, r in result.items():
-    print(f"\n({'i' if model == 'synthetic' else 'ii'}) {model}: table points plane "
+    tag = {"synthetic": "(i) ", "real": "(ii) "}.get(model, "")
+    print(f"\n{tag}{model}: table points plane "
           f"{fmt(r['table_plane_share'])}% of {r['table_points']} "
           f"({fmt(r['table_away_plane_share'])}% away from the objects' contact band); object points right "
           f"{fmt(r['object_accuracy'])}% of {r['object_points']} scored")

@@ -39,6 +39,8 @@ struct Arguments {
   float feature_radius = 0.025f, normal_radius = 0.01f;
   float voxel_size = 0.0f;      // > 0: train on voxels of this edge and record it in the model
   float feature_sample = 0.0f;  // > 0: FPFH against one point per voxel of this edge
+  std::vector<float> extra_radii;        // --extra-radii: the descriptor at further scales
+  bool surface_variation_features = false;  // --surface-variation
   std::vector<std::string> train_files, val_files;
   std::string sensor_name;  // --sensor-name: the sensor of --train files
   // --train with an explicit --synth-train: the synthetic scenes are trained on beside the files.
@@ -122,6 +124,8 @@ int run(const Arguments& args) {
   features.normals = Neighborhood::Radius(args.normal_radius);
   features.features = Neighborhood::Radius(args.feature_radius);
   features.feature_sample_size = args.feature_sample;
+  features.extra_feature_radii = args.extra_radii;
+  features.surface_variation_features = args.surface_variation_features;
   crf::GraphSettings graph;
   graph.neighborhood = Neighborhood::Knn(args.graph_k);
 
@@ -276,6 +280,14 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--normal-radius", args.normal_radius, "normal radius (m, default 0.01)")
       ->check(CLI::PositiveNumber);
+  app.add_option("--extra-radii", args.extra_radii,
+                 "multi-scale model input: the descriptor also at these radii (m, comma-separated, "
+                 "at most 4; FPFH only); clients still get the one at --feature-radius")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--surface-variation", args.surface_variation_features,
+               "multi-scale model input: also each point's surface variation at the normal, "
+               "feature and extra radii (FPFH only)");
   app.add_option("--graph-k", args.graph_k, "CRF graph: K nearest neighbours (default 8)")
       ->check(CLI::PositiveNumber);
   app.add_option("--augment", args.augment,
@@ -310,6 +322,11 @@ int main(int argc, char** argv) {
     usage = "--synth-val with --train needs --synth-train";
   else if (args.synth_with_files && !args.sensor_name.empty() && args.sensor_name != args.sensor)
     usage = "--sensor-name differs from the synthetic scenes' --sensor";
+  else if (args.extra_radii.size() > kMaxExtraFeatureRadii)
+    usage = "--extra-radii takes at most 4 radii";
+  else if ((!args.extra_radii.empty() || args.surface_variation_features) &&
+           args.descriptor != "fpfh")
+    usage = "--extra-radii and --surface-variation need --descriptor fpfh";
   if (usage) {
     std::fprintf(stderr, "primlabel-train: usage error: %s\n", usage);
     return cli::kExitUsage;

@@ -209,6 +209,10 @@ TEST_F(PipelineCli, BadUsageExitsTwo) {
         test::binary("primlabel-train") + " --augment noise=4:1 -o m.plm",
         test::binary("primlabel-train") + " --augment density=0:1 -o m.plm",
         test::binary("primlabel-train") + " --train a.pcd --augment noise=1:2 -o m.plm",
+        // Multi-scale input: FPFH only, at most 4 further radii, each > 0.
+        test::binary("primlabel-train") + " --descriptor pfh --surface-variation -o m.plm",
+        test::binary("primlabel-train") + " --extra-radii 0.01,0.02,0.03,0.04,0.05 -o m.plm",
+        test::binary("primlabel-train") + " --extra-radii 0.01,-0.02 -o m.plm",
         eval() + " --calibrate-kinect dir --model m.plm", eval() + " --calibrate-kinect dir x.pcd",
         eval() + " --calibration-json c.json --table1"}) {
     const Result r = run(command);

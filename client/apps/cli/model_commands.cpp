@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <string>
 
 #include "commands.hpp"
 #include "common/human_format.hpp"
@@ -61,6 +62,17 @@ int run_info(Client& client, const std::string& model, const std::string& versio
       v1::Descriptor_Name(f.descriptor_kind()).c_str(), f.descriptor_dim(), f.normal_radius(),
       f.normal_k(), f.feature_radius(), f.feature_k(), f.voxel_size(),
       f.radii_overridable() ? "yes" : "no");
+  if (f.extra_feature_radii_size() > 0 || f.surface_variation_features()) {
+    std::string scales;
+    for (float r : f.extra_feature_radii()) {
+      char radius[32];
+      std::snprintf(radius, sizeof radius, "%s%g", scales.empty() ? "" : ", ", r);
+      scales += radius;
+    }
+    std::printf("multiscale the descriptor also at radii %s; surface variations: %s\n",
+                scales.empty() ? "none" : scales.c_str(),
+                f.surface_variation_features() ? "yes" : "no");
+  }
   std::printf("graph      k %u, radius %g\n", m.graph().k(), m.graph().radius());
   // No validation points: no accuracy and no F1 to show, not 0 or nan.
   const bool validated = m.validation().points() > 0;

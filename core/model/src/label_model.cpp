@@ -107,6 +107,8 @@ v1::Model to_proto(const LabelModel& m) {
   f->set_voxel_size(m.features.voxel_size);
   f->set_feature_sample_size(m.features.feature_sample_size);
   f->set_radii_overridable(m.features.radii_overridable);
+  for (float r : m.features.extra_feature_radii) f->add_extra_feature_radii(r);
+  f->set_surface_variation_features(m.features.surface_variation_features);
 
   v1::GraphParameters* g = out.mutable_graph();
   set_neighborhood(m.graph.neighborhood, &radius, &k, &max_nn);
@@ -215,6 +217,15 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
   if (!(m.features.feature_sample_size >= 0.0f) || !std::isfinite(m.features.feature_sample_size))
     fail(source, "feature_sample_size must be finite and >= 0");
   m.features.radii_overridable = f.radii_overridable();
+  m.features.extra_feature_radii.assign(f.extra_feature_radii().begin(),
+                                        f.extra_feature_radii().end());
+  m.features.surface_variation_features = f.surface_variation_features();
+  if (m.features.extra_feature_radii.size() > kMaxExtraFeatureRadii)
+    fail(source, "more than " + std::to_string(kMaxExtraFeatureRadii) + " extra feature radii");
+  for (float r : m.features.extra_feature_radii)
+    if (!(r > 0.0f) || !std::isfinite(r)) fail(source, "an extra feature radius is not > 0");
+  if (m.features.multi_scale() && m.features.descriptor != DescriptorKind::kFpfh)
+    fail(source, "multi-scale features need the FPFH descriptor");
 
   const v1::GraphParameters& g = in.graph();
   m.graph.neighborhood = neighborhood_from(g.radius(), g.k(), g.max_neighbors(), source, "graph");
@@ -225,11 +236,11 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
     m.svm_class_ids = ids;
     m.weights.feature_scale = in.svm().feature_scale();
     m.weights.class_ids = ids;
-    m.weights.descriptor_dim = m.features.descriptor_dim();
+    m.weights.descriptor_dim = m.features.model_input_dim();
   } else {
     if (!in.has_crf()) fail(source, "a CRF model without weights");
     m.weights.class_ids = ids;
-    m.weights.descriptor_dim = m.features.descriptor_dim();
+    m.weights.descriptor_dim = m.features.model_input_dim();
     m.weights.feature_scale = in.crf().feature_scale();
     m.weights.node_knots.assign(in.crf().node_knots().begin(), in.crf().node_knots().end());
     m.weights.node_weights = from_proto(in.crf().node_weights(), source, "node weights");
@@ -292,17 +303,17 @@ void LabelModel::validate(const std::string& source) const {
   if (kind == ModelKind::kSvm) {
     if (svm_model.empty()) fail(source, "the SVM model is empty");
     try {
-      svm::SvmClassifier::from_libsvm_text(svm_model, svm_class_ids, features.descriptor_dim(),
+      svm::SvmClassifier::from_libsvm_text(svm_model, svm_class_ids, features.model_input_dim(),
                                            weights.feature_scale);
     } catch (const std::invalid_argument& e) {
       fail(source, std::string("SVM model: ") + e.what());
     }
     return;
   }
-  if (weights.descriptor_dim != features.descriptor_dim())
+  if (weights.descriptor_dim != features.model_input_dim())
     fail(source, "weights are for " + std::to_string(weights.descriptor_dim) +
                      "-value descriptors but the features give " +
-                     std::to_string(features.descriptor_dim()));
+                     std::to_string(features.model_input_dim()));
   try {
     weights.validate();
   } catch (const std::invalid_argument& e) {

@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "multi_scale_input.hpp"
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/normals.hpp"
 #include "primlabel/geometry/point_spacing.hpp"
@@ -130,6 +131,8 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
                                           out.lists.get())
                            : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
   }
+  out.descriptors =
+      multi_scale_input(cloud, std::move(out.descriptors), settings, *out.search, stage);
   out.feature_seconds = seconds_since(start);
   return out;
 }

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "multi_scale_input.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/pipeline/domain.hpp"
@@ -101,9 +102,9 @@ LabelingResult label_distinct_points(const LabelModel& model, const FeatureSetti
 
   result.labels = std::move(inferred.labels);
   if (options.want_probabilities) result.probabilities = std::move(inferred.marginals);
-  if (options.want_descriptors) {
-    result.descriptors = std::move(described.descriptors);
-  }
+  if (options.want_descriptors)
+    result.descriptors =
+        leading_values(std::move(described.descriptors), model.features.descriptor_dim());
   result.labeled_points = graph.num_active();
   if (options.want_primitives && input == &cloud)
     fit_primitives_of_input(cloud, described, options, context, result);

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <ctime>
 
+#include "multi_scale_input.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 
 namespace primlabel::pipeline {
@@ -42,7 +43,7 @@ ModelTrainingResult train_svm_model(std::span<const SceneData> training,
   m.svm_model = svm.to_libsvm_text();
   m.svm_class_ids = class_ids;
   m.weights.class_ids = class_ids;
-  m.weights.descriptor_dim = features.descriptor_dim();
+  m.weights.descriptor_dim = features.model_input_dim();
   m.weights.feature_scale = svm.feature_scale();
   m.created_unix_ms = std::int64_t(std::time(nullptr)) * 1000;
   m.created_by = "primlabel-train";
@@ -63,7 +64,7 @@ svm::SvmClassifier svm_classifier_of(const LabelModel& model) {
   if (model.kind != ModelKind::kSvm) throw ModelError(model.name + ": not an SVM model");
   try {
     return svm::SvmClassifier::from_libsvm_text(model.svm_model, model.svm_class_ids,
-                                                model.features.descriptor_dim(),
+                                                model.features.model_input_dim(),
                                                 model.weights.feature_scale);
   } catch (const std::invalid_argument& e) {
     throw ModelError(model.name + ": SVM model: " + e.what());
@@ -84,7 +85,8 @@ void classify_with_svm(const LabelModel& model, DescribedCloud&& described,
   for (std::size_t i = 0; i < described.descriptors.size(); ++i)
     result.labeled_points += std::isfinite(described.descriptors.row(i)[0]) ? 1 : 0;
   if (options.want_descriptors) {
-    result.descriptors = std::move(described.descriptors);
+    result.descriptors =
+        leading_values(std::move(described.descriptors), model.features.descriptor_dim());
   }
   result.inference_seconds = seconds_since(start);
 }

@@ -29,6 +29,9 @@ class ModelError : public std::runtime_error {
 };
 
 enum class ModelKind { kCrf, kNodeOnly, kSvm };
+
+// Further descriptor radii a model may ask for (each costs one more FPFH pass per cloud).
+inline constexpr std::size_t kMaxExtraFeatureRadii = 4;
 enum class DescriptorKind { kFpfh, kPfh };
 
 // How a cloud is described before labeling; the labels are only meaningful for the same settings.
@@ -42,8 +45,20 @@ struct FeatureSettings {
   // described, against the sample): fewer pairs per point on dense scans; 0 = every neighbour.
   float feature_sample_size = 0.0f;
   bool radii_overridable = false;  // whether a request may change the radii
+  // Multi-scale model input (FPFH only): the same descriptor at these further radii (m), and,
+  // with surface_variation_features, each point's surface variation (PCA smallest eigenvalue
+  // over the sum) at the normal radius, the feature radius and every further radius. Clients
+  // still get the descriptor at the feature radius; the CRF sees all of it (model_input_dim).
+  std::vector<float> extra_feature_radii;
+  bool surface_variation_features = false;
 
   int descriptor_dim() const { return descriptor == DescriptorKind::kFpfh ? kFpfhSize : kPfhSize; }
+  // Values per point the model weighs: the descriptor at every radius, then the variations.
+  int model_input_dim() const {
+    const int scales = 1 + static_cast<int>(extra_feature_radii.size());
+    return descriptor_dim() * scales + (surface_variation_features ? scales + 1 : 0);
+  }
+  bool multi_scale() const { return model_input_dim() != descriptor_dim(); }
   // "fpfh", "fpfh_paper" or "pfh": the field name of these descriptors in written clouds.
   std::string descriptor_name() const {
     return descriptor == DescriptorKind::kPfh ? "pfh" : fpfh_field_name(fpfh_variant);
