@@ -37,9 +37,9 @@ struct Arguments {
   std::size_t svm_max_points = 20000;
   std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
   float feature_radius = 0.025f, normal_radius = 0.01f;
-  float voxel_size = 0.0f;      // > 0: train on voxels of this edge and record it in the model
-  float feature_sample = 0.0f;  // > 0: FPFH against one point per voxel of this edge
-  std::vector<float> extra_radii;        // --extra-radii: the descriptor at further scales
+  float voxel_size = 0.0f;         // > 0: train on voxels of this edge and record it in the model
+  float feature_sample = 0.0f;     // > 0: FPFH against one point per voxel of this edge
+  std::vector<float> extra_radii;  // --extra-radii: the descriptor at further scales
   bool surface_variation_features = false;  // --surface-variation
   std::vector<std::string> train_files, val_files;
   std::string sensor_name;  // --sensor-name: the sensor of --train files

@@ -51,7 +51,8 @@ Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
     std::vector<float> radii = {settings.normals.radius, settings.features.radius};
     radii.insert(radii.end(), settings.extra_feature_radii.begin(),
                  settings.extra_feature_radii.end());
-    for (float radius : radii) variations.push_back(scaled_variation(cloud, radius, search, context));
+    for (float radius : radii)
+      variations.push_back(scaled_variation(cloud, radius, search, context));
   }
 
   const int dim = settings.model_input_dim();
