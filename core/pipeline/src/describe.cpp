@@ -131,8 +131,8 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
                                           out.lists.get())
                            : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
   }
-  out.descriptors =
-      multi_scale_input(cloud, std::move(out.descriptors), settings, *out.search, stage);
+  out.descriptors = multi_scale_input(cloud, std::move(out.descriptors), settings, *out.search,
+                                      !options.use_cloud_normals, stage);
   out.feature_seconds = seconds_since(start);
   return out;
 }

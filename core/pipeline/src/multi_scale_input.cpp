@@ -2,57 +2,137 @@
 
 #include "multi_scale_input.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
 
 #include "primlabel/geometry/features.hpp"
-#include "primlabel/geometry/normals.hpp"
+#include "primlabel/geometry/neighbor_lists.hpp"
+#include "primlabel/geometry/parallel.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 
 namespace primlabel::pipeline {
 
 namespace {
-// Surface variation (curvature as estimate_normals defines it) of every point at `radius`,
-// scaled; 0 where it cannot be measured.
-std::vector<float> scaled_variation(const PointCloud& cloud, float radius,
-                                    const NeighborSearch& search, const RunContext& context) {
-  PointCloud probe;
-  probe.resize_unorganized(cloud.size());
-  probe.xyz = cloud.xyz;
-  probe.viewpoint = cloud.viewpoint;
-  NormalOptions options;
-  options.neighborhood = capped(Neighborhood::Radius(radius));
-  estimate_normals(probe, options, context, &search);
-  std::vector<float> out(cloud.size());
-  for (std::size_t i = 0; i < out.size(); ++i)
-    out[i] = std::isfinite(probe.curvature[i]) ? probe.curvature[i] * kSurfaceVariationScale : 0.f;
+// The shared lists' budget: a 5 mm voxel frame holds ~200 neighbours a point within 40 mm.
+constexpr std::size_t kListBytes = std::size_t(256) << 20;
+constexpr std::size_t kBlock = 512;  // points per parallel block
+
+// Surface variation of every point at each of `radii` (ascending), scaled, from one neighbour
+// list a point at the largest: each smaller neighbourhood is the part of it within its radius
+// (the same set a search at that radius finds, the nearest 1024 when capped). The covariance is
+// accumulated in double around the point, as estimate_normals does; 0 where it is undefined.
+std::vector<std::vector<float>> scaled_variations(const std::vector<Vec3f>& xyz,
+                                                  const std::vector<float>& radii,
+                                                  const NeighborLists& lists,
+                                                  const RunContext& context) {
+  const std::size_t n = xyz.size(), scales = radii.size();
+  std::vector<std::vector<float>> out(scales, std::vector<float>(n, 0.0f));
+  if (scales == 0) return out;
+  const Neighborhood widest = capped(Neighborhood::Radius(radii.back()));
+  const std::ptrdiff_t blocks = std::ptrdiff_t((n + kBlock - 1) / kBlock);
+  struct Moments {
+    double count = 0, s[3] = {0, 0, 0}, ss[6] = {0, 0, 0, 0, 0, 0};
+  };
+  detail::for_each_block(
+      blocks, context, [] { return NeighborList{}; },
+      [&](NeighborList& list, std::ptrdiff_t block) {
+        std::vector<Moments> moments(scales);
+        const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+        for (std::size_t i = first; i < last; ++i) {
+          if (!is_finite(xyz[i])) continue;
+          lists.find(i, widest, list);
+          std::fill(moments.begin(), moments.end(), Moments{});
+          for (std::size_t j = 0; j < list.size(); ++j) {
+            const Vec3f& p = xyz[list.indices[j]];
+            const double x = double(p.x()) - xyz[i].x(), y = double(p.y()) - xyz[i].y(),
+                         z = double(p.z()) - xyz[i].z();
+            for (std::size_t r = scales; r-- > 0;) {
+              if (list.sq_dists[j] > radii[r] * radii[r]) break;  // nor within any smaller radius
+              Moments& m = moments[r];
+              m.count += 1, m.s[0] += x, m.s[1] += y, m.s[2] += z;
+              m.ss[0] += x * x, m.ss[1] += x * y, m.ss[2] += x * z;
+              m.ss[3] += y * y, m.ss[4] += y * z, m.ss[5] += z * z;
+            }
+          }
+          for (std::size_t r = 0; r < scales; ++r) {
+            const Moments& m = moments[r];
+            if (m.count < 3) continue;
+            const double inv = 1.0 / m.count;
+            const double mx = m.s[0] * inv, my = m.s[1] * inv, mz = m.s[2] * inv;
+            Eigen::Matrix3d cov;
+            cov(0, 0) = m.ss[0] * inv - mx * mx;
+            cov(0, 1) = cov(1, 0) = m.ss[1] * inv - mx * my;
+            cov(0, 2) = cov(2, 0) = m.ss[2] * inv - mx * mz;
+            cov(1, 1) = m.ss[3] * inv - my * my;
+            cov(1, 2) = cov(2, 1) = m.ss[4] * inv - my * mz;
+            cov(2, 2) = m.ss[5] * inv - mz * mz;
+            const double trace = cov.trace();
+            if (!(trace > 0.0)) continue;
+            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+            solver.computeDirect(cov, Eigen::EigenvaluesOnly);
+            const double variation = std::max(solver.eigenvalues()(0), 0.0) / trace;
+            if (std::isfinite(variation)) out[r][i] = float(variation) * kSurfaceVariationScale;
+          }
+        }
+      });
+  throw_if_stopped(context.stop, "multi-scale features");
   return out;
 }
 }  // namespace
 
 Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
                               const FeatureSettings& settings, const NeighborSearch& search,
-                              const RunContext& context) {
+                              bool curvature_at_normal_radius, const RunContext& context) {
   if (!settings.multi_scale()) return descriptors;
   const std::size_t n = cloud.size();
   const int d = settings.descriptor_dim();
+  // One search a point at the largest radius, shared by every further FPFH and every variation.
+  float widest = settings.features.radius;
+  for (float radius : settings.extra_feature_radii) widest = std::max(widest, radius);
+  if (settings.surface_variation_features) widest = std::max(widest, settings.normals.radius);
+  const NeighborLists lists(cloud.xyz, search, capped(Neighborhood::Radius(widest)), kListBytes,
+                            context);
+
   std::vector<Descriptors> blocks;
   blocks.push_back(std::move(descriptors));
   for (float radius : settings.extra_feature_radii) {
     FeatureOptions options;
     options.neighborhood = capped(Neighborhood::Radius(radius));
     options.fpfh_variant = settings.fpfh_variant;
-    blocks.push_back(compute_fpfh(cloud, options, context, nullptr, &search, nullptr));
+    blocks.push_back(compute_fpfh(cloud, options, context, nullptr, &search, &lists));
   }
-  std::vector<std::vector<float>> variations;
+  // Variations at the normal radius (estimate_normals' curvature when it ran at that radius),
+  // the feature radius and the further radii, in that order.
+  std::vector<const std::vector<float>*> variations;
+  std::vector<std::vector<float>> measured;
+  std::vector<float> at_normal_radius;
   if (settings.surface_variation_features) {
-    std::vector<float> radii = {settings.normals.radius, settings.features.radius};
+    std::vector<float> radii = {settings.features.radius};
     radii.insert(radii.end(), settings.extra_feature_radii.begin(),
                  settings.extra_feature_radii.end());
-    for (float radius : radii)
-      variations.push_back(scaled_variation(cloud, radius, search, context));
+    if (!curvature_at_normal_radius) radii.push_back(settings.normals.radius);
+    std::vector<float> ascending = radii;
+    std::sort(ascending.begin(), ascending.end());
+    ascending.erase(std::unique(ascending.begin(), ascending.end()), ascending.end());
+    measured = scaled_variations(cloud.xyz, ascending, lists, context);
+    const auto at = [&](float radius) {
+      return &measured[std::size_t(std::lower_bound(ascending.begin(), ascending.end(), radius) -
+                                   ascending.begin())];
+    };
+    if (curvature_at_normal_radius) {
+      at_normal_radius.resize(n, 0.0f);
+      for (std::size_t i = 0; i < n; ++i)
+        if (i < cloud.curvature.size() && std::isfinite(cloud.curvature[i]))
+          at_normal_radius[i] = cloud.curvature[i] * kSurfaceVariationScale;
+      variations.push_back(&at_normal_radius);
+    } else {
+      variations.push_back(at(settings.normals.radius));
+    }
+    variations.push_back(at(settings.features.radius));
+    for (float radius : settings.extra_feature_radii) variations.push_back(at(radius));
   }
 
   const int dim = settings.model_input_dim();
@@ -65,7 +145,7 @@ Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
       std::copy(part.begin(), part.end(), row.begin() + std::ptrdiff_t(b) * d);
     }
     const std::size_t tail = blocks.size() * std::size_t(d);
-    for (std::size_t v = 0; v < variations.size(); ++v) row[tail + v] = variations[v][i];
+    for (std::size_t v = 0; v < variations.size(); ++v) row[tail + v] = (*variations[v])[i];
     // An extra scale can be NaN where the first is not only through a NaN normal, which the
     // first would share; zero keeps the row usable all the same.
     for (float& value : row)

@@ -19,11 +19,12 @@ inline constexpr float kSurfaceVariationScale = 300.0f;
 
 // `descriptors` (the descriptor at the feature radius, cloud.size() rows) widened to
 // settings.model_input_dim() values a point. Needs cloud.normals; `search` indexes cloud.xyz.
-// A point whose descriptor is NaN keeps an all-NaN row; a variation that cannot be measured (too
-// few neighbours) is 0.
+// `curvature_at_normal_radius`: cloud.curvature is estimate_normals' at the model's normal
+// radius, so it is the first variation (else that is measured too). A point whose descriptor is
+// NaN keeps an all-NaN row; a variation that cannot be measured (too few neighbours) is 0.
 Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
                               const FeatureSettings& settings, const NeighborSearch& search,
-                              const RunContext& context);
+                              bool curvature_at_normal_radius, const RunContext& context);
 
 // The first `dim` values of each row: what clients get back as the descriptor.
 Descriptors leading_values(Descriptors descriptors, int dim);
