@@ -56,7 +56,8 @@ TEST(KinectModel, RecordsItsDomainTrainingDataAndAttribution) {
 // The subset (one scene of each mOSD learning category: boxes, stacked boxes, occluded objects,
 // cylinders) keeps the test near a minute and a half on 2 cores; the full recipe takes about
 // 11 min with its truth.
-// Figures recorded 2026-12-05 (the multi-scale recipe) with `deploy/setup.sh kinect-model OUT 0 17 25 33`, then
+// Figures recorded 2026-12-05 (the multi-scale recipe) with
+// `deploy/setup.sh kinect-model OUT 0 17 25 33`, then
 // `primlabel-eval --model OUT --mosd-report DIR --object-truth learn5.pcd learn36.pcd`
 // (held-out scenes). Tolerances cover thread-count rounding in training, not recipe changes.
 TEST(KinectModel, RecipeRetrainedOnTheSubsetReproducesItsFigures) {
