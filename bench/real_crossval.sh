@@ -97,17 +97,28 @@ done
 python3 - "$OUT" "$FOLDS" "${MODELS[@]}" <<'PYEOF'
 import json, sys
 out, folds, models = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
-result = {}
+result, confusion = {}, {}
 for model in models:
     table = {"points": 0, "plane": 0, "away": 0, "away_plane": 0}
     classes = {}
-    for f in range(folds):
-        r = json.load(open(f"{out}/fold{f}/{model}.json"))
+    reports = [json.load(open(f"{out}/fold{f}/{model}.json")) for f in range(folds)]
+    exact = all("confusion" in r["object_truth"]["scores"] for r in reports)
+    for r in reports:
         for s in r["scenes"]:
             table["points"] += s["table_points"]
             table["plane"] += s["table_plane"]
             table["away"] += s["table_away"]
             table["away_plane"] += round((s["away_plane_share"] or 0) * s["table_away"])
+        if exact:  # the counts themselves (reports since 2026-12-05)
+            m = r["object_truth"]["scores"]["confusion"]
+            names = m["columns"]
+            total = confusion.setdefault(model, {"columns": names, "rows": None})
+            if total["rows"] is None:
+                total["rows"] = [[0] * len(names) for _ in m["rows"]]
+            for t, row in enumerate(m["rows"]):
+                for p, n in enumerate(row):
+                    total["rows"][t][p] += n
+            continue
         scores = r["object_truth"]["scores"]["classes"]
         for name, c in scores.items():
             k = classes.setdefault(name, {"support": 0, "tp": 0, "predicted": 0, "wrong_only": False})
@@ -118,6 +129,13 @@ for model in models:
                 k["predicted"] += round(tp / c["precision"])
             elif c["precision"] == 0:  # predicted, never right: the count is not in the report
                 k["wrong_only"] = True
+    if model in confusion:  # recall and precision from the summed matrix
+        m = confusion[model]
+        for t, name in enumerate(m["columns"][:-1]):
+            classes[name] = {"support": sum(m["rows"][t]), "tp": m["rows"][t][t],
+                             "predicted": sum(row[t] for row in m["rows"]),
+                             "wrong_only": False}
+        classes = {k: c for k, c in classes.items() if c["support"] or c["predicted"]}
     support = sum(c["support"] for c in classes.values())
     right = sum(c["tp"] for c in classes.values())
     for c in classes.values():
@@ -130,6 +148,8 @@ for model in models:
                      "table_away_plane_share": table["away_plane"] / table["away"],
                      "object_points": support, "object_accuracy": right / support,
                      "classes": classes}
+    if model in confusion:
+        result[model]["confusion"] = confusion[model]
 json.dump(result, open(f"{out}/crossval.json", "w"), indent=1)
 fmt = lambda v: "   -  " if v is None else f"{100 * v:6.2f}"
 print(f"{folds}-fold cross-validation by scene on mOSD learn0-44 (fold = scene mod {folds})")
@@ -143,4 +163,16 @@ for model, r in result.items():
     for name, c in r["classes"].items():
         if c["support"] or c["precision"] is not None:
             print(f"  {name:18s} {fmt(c['recall']):>7s} {fmt(c['precision']):>9s} {c['support']:9d}")
+    if "confusion" in r:  # where each scored class's points went, % of its support
+        m = r["confusion"]
+        shown = [t for t, row in enumerate(m["rows"]) if sum(row)]
+        cols = [p for p in range(len(m["columns"])) if any(m["rows"][t][p] for t in shown)]
+        short = lambda name: (name.replace("cylinder", "cyl").replace("-convex", "+")
+                              .replace("-concave", "-").replace("sphere", "sph")
+                              .replace("torus", "tor"))
+        print("  truth \\ labeled as " + " ".join(f"{short(m['columns'][p]):>7s}" for p in cols))
+        for t in shown:
+            n = sum(m["rows"][t])
+            print(f"  {m['columns'][t]:18s} " +
+                  " ".join(f"{100 * m['rows'][t][p] / n:7.2f}" for p in cols))
 PYEOF

@@ -113,9 +113,20 @@ json::Json confusion_classes_json(const crf::ConfusionMatrix& m) {
                                              {"precision", json::rounded(s.precision, "%.6f")},
                                              {"support", s.support}};
   }
+  // The matrix itself (rows truth, columns predicted, then "other": a prediction outside the
+  // classes), so reports over several files can be summed exactly and errors traced.
+  json::Json names = json::Json::array(), rows = json::Json::array();
+  for (int t = 0; t < m.num_classes(); ++t) {
+    names.push_back(class_name(m.class_ids()[t]));
+    json::Json row = json::Json::array();
+    for (int p = 0; p <= m.num_classes(); ++p) row.push_back(m.count(t, p));
+    rows.push_back(std::move(row));
+  }
+  names.push_back("other");
   return {{"points", m.total()},
           {"accuracy", json::rounded(m.accuracy(), "%.6f")},
-          {"classes", std::move(classes)}};
+          {"classes", std::move(classes)},
+          {"confusion", {{"columns", std::move(names)}, {"rows", std::move(rows)}}}};
 }
 
 std::string truth_check_json(const TruthCheck& check) {

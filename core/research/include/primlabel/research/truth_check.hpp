@@ -43,7 +43,8 @@ TruthCheck check_truth_on_synthetic(const TruthCheckOptions& options,
 std::string truth_check_text(const TruthCheck& check);
 std::string truth_check_json(const TruthCheck& check);
 
-// JSON of the per-class precision / recall / support and the accuracy of a confusion matrix.
+// JSON of the per-class precision / recall / support, the accuracy and the counts themselves
+// ("confusion": columns, then rows of counts, truth by predicted) of a confusion matrix.
 json::Json confusion_classes_json(const crf::ConfusionMatrix& confusion);
 
 }  // namespace primlabel::research
