@@ -35,7 +35,21 @@ struct Arguments {
   double keep = 1.0, range_scale = 1.0, elevation = 0.0;
   int lines = 0, min_objects = 0, max_objects = 0;
   bool list_classes = false, quiet = false;
+  bool segment_labels = false;  // --segment-labels: `label` holds instances, as in mOSD
 };
+
+// mOSD's convention (its README): 0 no point, 1-9 the table, 10 m + part for object m >= 2, so
+// object k of the scene (k >= 1) is 10 (k + 1).
+void to_segment_labels(PointCloud& cloud) {
+  const FloatField* object = cloud.find_field("object");
+  if (!object) throw std::runtime_error("the scan has no object field");
+  cloud.labels.assign(cloud.size(), 0);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const float k = object->values[i];
+    if (!is_finite(cloud.xyz[i]) || !(k >= 0)) continue;
+    cloud.labels[i] = k == 0 ? 1u : 10u * (static_cast<std::uint32_t>(k) + 1u);
+  }
+}
 
 GenerateOptions options_from(const Arguments& args, std::uint64_t seed) {
   GenerateOptions options;
@@ -104,13 +118,17 @@ void write_true_primitives(const std::string& path, const Generated& scan, doubl
 
 int write_one(const Arguments& args) {
   const auto start = std::chrono::steady_clock::now();
-  const Generated scan = generate(options_from(args, args.seed));
+  Generated scan = generate(options_from(args, args.seed));
   const double generate_seconds = seconds_since(start);
+  std::size_t valid, on_objects;
+  const std::string summary = class_summary(scan.cloud, valid, on_objects);
+  if (args.segment_labels) {
+    to_segment_labels(scan.cloud);
+    scan.tags["labels"] = "segments: 1 table, 10 (k + 1) object k (mOSD)";
+  }
   write_tagged_cloud(args.output, scan.cloud, scan.tags);
   if (!args.primitives.empty()) write_true_primitives(args.primitives, scan, args.noise_scale);
   if (!args.quiet) {
-    std::size_t valid, on_objects;
-    const std::string summary = class_summary(scan.cloud, valid, on_objects);
     std::fprintf(stderr,
                  "%s scene (seed %llu, %s, label radius %g m): %zu points (%zu on %zu objects: %s) "
                  "in %.2f s; labels: %s; wrote %s\n",
@@ -132,7 +150,11 @@ int write_set(const Arguments& args) {
     const std::uint64_t seed = set_seed(set, i);
     char file[64];
     std::snprintf(file, sizeof file, "%s_%04d.pcd", args.set.c_str(), i);
-    const Generated scan = generate(options_from(args, seed));
+    Generated scan = generate(options_from(args, seed));
+    if (args.segment_labels) {
+      to_segment_labels(scan.cloud);
+      scan.tags["labels"] = "segments: 1 table, 10 (k + 1) object k (mOSD)";
+    }
     write_tagged_cloud((dir / file).string(), scan.cloud, scan.tags);
     const std::string truth_file = std::filesystem::path(file).stem().string() + "_primitives.json";
     write_true_primitives((dir / truth_file).string(), scan, args.noise_scale);
@@ -179,8 +201,12 @@ int main(int argc, char** argv) {
   Arguments args;
   app.add_option("--scene", args.scene,
                  "table (random kitchen objects), primitives (one of each "
-                 "shape) or empty (bare table)")
-      ->check(CLI::IsMember({"table", "primitives", "empty"}));
+                 "shape), empty (bare table) or clutter (8-14 objects close together, books, "
+                 "stacked boxes: for the table-top stage)")
+      ->check(CLI::IsMember({"table", "primitives", "empty", "clutter"}));
+  app.add_flag("--segment-labels", args.segment_labels,
+               "write instances, not classes, in `label`: 1 the table, 10 (k + 1) object k, as "
+               "mOSD scenes do (primlabel-bench-tabletop and primlabel-tabletop score them)");
   app.add_option("--sensor", args.sensor, "lms400 (tilting line laser) or kinect (640x480 depth)")
       ->check(CLI::IsMember({"lms400", "kinect"}));
   app.add_option("--seed", args.seed, "scene and noise seed (same seed, same cloud)");

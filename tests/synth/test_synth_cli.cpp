@@ -51,6 +51,35 @@ TEST(SynthCli, WritesALabeledScene) {
   for (std::uint32_t label : cloud.labels) ASSERT_LT(label, kPrimitiveClassCount);
 }
 
+// The crowded table for the table-top stage, its instances in `label` as mOSD writes them.
+TEST(SynthCli, ClutterSceneWithSegmentLabels) {
+  test::TempDir dir;
+  const std::string out = dir.file("clutter.pcd");
+  const Result r = run("--scene clutter --sensor kinect --seed 8 --segment-labels -q -o " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const PointCloud cloud = read_pcd(out);
+  ASSERT_TRUE(cloud.has_labels());
+  const FloatField* object = cloud.find_field("object");
+  ASSERT_NE(object, nullptr);
+  std::map<std::uint32_t, std::size_t> points;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const std::uint32_t label = cloud.labels[i];
+    if (!is_finite(cloud.xyz[i])) {
+      ASSERT_EQ(label, 0u) << i;
+      continue;
+    }
+    const int k = static_cast<int>(object->values[i]);
+    ASSERT_EQ(label, k == 0 ? 1u : 10u * std::uint32_t(k + 1)) << i;
+    ++points[label];
+  }
+  // Seed 8: the table and at least 8 seen objects, more than 10 when stacked boxes count.
+  EXPECT_GT(points[1], 50000u);
+  EXPECT_GE(points.size(), 1u + 8u);
+  const CloudTags tags = read_cloud_tags(out);
+  EXPECT_EQ(tags.at("scene"), "clutter");
+  EXPECT_NE(tags.at("labels").find("segments"), std::string::npos);
+}
+
 TEST(SynthCli, KinectPrimitivesWithRadiusToPly) {
   test::TempDir dir;
   const std::string out = dir.file("prims.ply");

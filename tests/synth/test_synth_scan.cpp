@@ -280,6 +280,42 @@ TEST(Scanners, BadOptionsAreRejected) {
   EXPECT_THROW(generate(options), std::invalid_argument);
 }
 
+// The crowded table: 8-14 objects a few millimetres apart, some boxes with a box on top, the
+// same scene for the same seed.
+TEST(SceneKinds, ClutterIsCrowdedStackedAndRepeatable) {
+  int stacked = 0;
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    const Scene scene = make_scene(SceneKind::kClutter, seed);
+    const Scene again = make_scene(SceneKind::kClutter, seed);
+    ASSERT_EQ(scene.objects.size(), again.objects.size());
+    int on_table = 0;
+    for (std::size_t i = 1; i < scene.objects.size(); ++i) {
+      const SceneObject& object = scene.objects[i];
+      EXPECT_TRUE(object.world_from_local.isApprox(again.objects[i].world_from_local));
+      const double base = object.world_from_local.translation().z();
+      if (base > 0.01) {
+        ++stacked;
+        continue;
+      }
+      ++on_table;
+      for (std::size_t j = 1; j < i; ++j) {  // footprints of table objects never overlap
+        const SceneObject& other = scene.objects[j];
+        if (other.world_from_local.translation().z() > 0.01) continue;
+        const double apart =
+            (object.world_from_local.translation() - other.world_from_local.translation())
+                .head<2>()
+                .norm();
+        EXPECT_GE(apart,
+                  object.shape->footprint_radius() + other.shape->footprint_radius() + 0.003 - 1e-9)
+            << seed << ": " << i << " and " << j;
+      }
+    }
+    EXPECT_GE(on_table, 8) << seed;
+    EXPECT_LE(on_table, 14) << seed;
+  }
+  EXPECT_GT(stacked, 3) << "about a third of the boxes carry another";
+}
+
 TEST(SceneSets, SeedRangesAreDisjoint) {
   EXPECT_EQ(set_seed(SceneSet::kTrain, 0), 1000u);
   EXPECT_EQ(set_seed(SceneSet::kVal, 0), 2000u);

@@ -117,12 +117,15 @@ std::string_view scene_name(SceneKind scene) {
       return "primitives";
     case SceneKind::kEmptyTable:
       return "empty";
+    case SceneKind::kClutter:
+      return "clutter";
   }
   return "table";
 }
 
 std::optional<SceneKind> scene_from_name(std::string_view name) {
-  for (SceneKind kind : {SceneKind::kTable, SceneKind::kPrimitives, SceneKind::kEmptyTable})
+  for (SceneKind kind :
+       {SceneKind::kTable, SceneKind::kPrimitives, SceneKind::kEmptyTable, SceneKind::kClutter})
     if (name == scene_name(kind)) return kind;
   return std::nullopt;
 }

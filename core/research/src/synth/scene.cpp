@@ -112,6 +112,54 @@ Scene random_table_scene(std::uint64_t seed, const TableSceneOptions& options) {
   return scene;
 }
 
+// A crowded table: objects 3-10 mm apart over the front of the table, a third of the picks
+// books (flat boxes), and a box on top of about a third of the boxes, as in the cluttered
+// scenes of the Object Segmentation Database.
+Scene clutter_scene(std::uint64_t seed) {
+  Rng rng(mix_seed(seed, 4));
+  Scene scene = table_only(rng, true);
+  const int wanted = 8 + rng.below(7);
+  const double half_x = std::min(0.35, 0.5 * scene.table_size.x() - 0.08);
+  const double y_lo = -0.5 * scene.table_size.y() + 0.08;
+  const double y_hi = std::min(y_lo + 0.5, 0.5 * scene.table_size.y() - 0.08);
+  struct Placed {
+    double x, y, r;
+  };
+  std::vector<Placed> placed;
+  for (int attempt = 0; attempt < 2000 && static_cast<int>(placed.size()) < wanted; ++attempt) {
+    Candidate candidate =
+        rng.chance(0.33)
+            ? Candidate{std::make_shared<BoxShape>(Vec3d(rng.uniform(0.14, 0.24),
+                                                         rng.uniform(0.10, 0.17),
+                                                         rng.uniform(0.015, 0.05))),
+                        pick_color(rng, {0x8B0000, 0x1F3A93, 0x2E8B57, 0xF0E68C, 0x4B0082})}
+            : random_object(rng);
+    const double r = candidate.shape->footprint_radius();
+    if (2 * r > 2 * half_x || 2 * r > y_hi - y_lo) continue;
+    const double x = rng.uniform(-half_x + r, half_x - r);
+    const double y = rng.uniform(y_lo + r, y_hi - r);
+    const double yaw = rng.uniform(0.0, 2.0 * M_PI);
+    const double gap = rng.uniform(0.003, 0.01);
+    bool free = true;
+    for (const Placed& other : placed)
+      free = free && std::hypot(x - other.x, y - other.y) >= r + other.r + gap;
+    if (!free) continue;
+    placed.push_back({x, y, r});
+    const auto* box = dynamic_cast<const BoxShape*>(candidate.shape.get());
+    scene.objects.emplace_back(candidate.shape, pose_on_table(x, y, yaw), candidate.rgb, true);
+    if (box && rng.chance(0.35)) {  // a smaller box on top, turned a little
+      const Vec3d below = box->size();
+      const Vec3d size(rng.uniform(0.5, 0.9) * below.x(), rng.uniform(0.5, 0.9) * below.y(),
+                       rng.uniform(0.03, 0.12));
+      Eigen::Isometry3d pose = pose_on_table(x, y, yaw + rng.uniform(-0.3, 0.3));
+      pose.pretranslate(Vec3d(0, 0, below.z()));
+      scene.objects.emplace_back(std::make_shared<BoxShape>(size), pose,
+                                 pick_color(rng, {0xD9482B, 0x2B6CD9, 0xE8C547, 0x6A3D9A}), true);
+    }
+  }
+  return scene;
+}
+
 Scene primitives_scene(std::uint64_t seed) {
   Rng rng(mix_seed(seed, 2));
   Scene scene = table_only(rng, false);
@@ -185,6 +233,8 @@ Scene make_scene(SceneKind kind, std::uint64_t seed, const TableSceneOptions& op
       Rng rng(mix_seed(seed, 3));
       return table_only(rng, false);
     }
+    case SceneKind::kClutter:
+      return clutter_scene(seed);
     case SceneKind::kTable:
       break;
   }
