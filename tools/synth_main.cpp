@@ -39,7 +39,9 @@ struct Arguments {
 };
 
 // mOSD's convention (its README): 0 no point, 1-9 the table, 10 m + part for object m >= 2, so
-// object k of the scene (k >= 1) is 10 (k + 1).
+// object k of the scene (k >= 1) is 10 (k + 1). The table is its top: the slab's sides (world z
+// more than 15 mm below the top, beyond the depth noise) are 0, neither table nor object, as the
+// table-top stage is to find the supporting surface.
 void to_segment_labels(PointCloud& cloud) {
   const FloatField* object = cloud.find_field("object");
   if (!object) throw std::runtime_error("the scan has no object field");
@@ -47,6 +49,7 @@ void to_segment_labels(PointCloud& cloud) {
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const float k = object->values[i];
     if (!is_finite(cloud.xyz[i]) || !(k >= 0)) continue;
+    if (k == 0 && cloud.xyz[i].z() < -0.015f) continue;  // the scanners write world coordinates
     cloud.labels[i] = k == 0 ? 1u : 10u * (static_cast<std::uint32_t>(k) + 1u);
   }
 }
@@ -124,7 +127,7 @@ int write_one(const Arguments& args) {
   const std::string summary = class_summary(scan.cloud, valid, on_objects);
   if (args.segment_labels) {
     to_segment_labels(scan.cloud);
-    scan.tags["labels"] = "segments: 1 table, 10 (k + 1) object k (mOSD)";
+    scan.tags["labels"] = "segments: 1 table top, 10 (k + 1) object k (mOSD)";
   }
   write_tagged_cloud(args.output, scan.cloud, scan.tags);
   if (!args.primitives.empty()) write_true_primitives(args.primitives, scan, args.noise_scale);
@@ -153,7 +156,7 @@ int write_set(const Arguments& args) {
     Generated scan = generate(options_from(args, seed));
     if (args.segment_labels) {
       to_segment_labels(scan.cloud);
-      scan.tags["labels"] = "segments: 1 table, 10 (k + 1) object k (mOSD)";
+      scan.tags["labels"] = "segments: 1 table top, 10 (k + 1) object k (mOSD)";
     }
     write_tagged_cloud((dir / file).string(), scan.cloud, scan.tags);
     const std::string truth_file = std::filesystem::path(file).stem().string() + "_primitives.json";
