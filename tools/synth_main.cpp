@@ -42,7 +42,8 @@ struct Arguments {
 // object k of the scene (k >= 1) is 10 (k + 1). The table is its top: the slab's sides (world z
 // more than 15 mm below the top, beyond the depth noise) are 0, neither table nor object, as the
 // table-top stage is to find the supporting surface.
-void to_segment_labels(PointCloud& cloud) {
+void to_segment_labels(Generated& scan) {
+  PointCloud& cloud = scan.cloud;
   const FloatField* object = cloud.find_field("object");
   if (!object) throw std::runtime_error("the scan has no object field");
   cloud.labels.assign(cloud.size(), 0);
@@ -52,6 +53,7 @@ void to_segment_labels(PointCloud& cloud) {
     if (k == 0 && cloud.xyz[i].z() < -0.015f) continue;  // the scanners write world coordinates
     cloud.labels[i] = k == 0 ? 1u : 10u * (static_cast<std::uint32_t>(k) + 1u);
   }
+  scan.tags["labels"] = "segments: 1 table top, 10 (k + 1) object k (mOSD)";
 }
 
 GenerateOptions options_from(const Arguments& args, std::uint64_t seed) {
@@ -125,10 +127,7 @@ int write_one(const Arguments& args) {
   const double generate_seconds = seconds_since(start);
   std::size_t valid, on_objects;
   const std::string summary = class_summary(scan.cloud, valid, on_objects);
-  if (args.segment_labels) {
-    to_segment_labels(scan.cloud);
-    scan.tags["labels"] = "segments: 1 table top, 10 (k + 1) object k (mOSD)";
-  }
+  if (args.segment_labels) to_segment_labels(scan);
   write_tagged_cloud(args.output, scan.cloud, scan.tags);
   if (!args.primitives.empty()) write_true_primitives(args.primitives, scan, args.noise_scale);
   if (!args.quiet) {
@@ -154,10 +153,7 @@ int write_set(const Arguments& args) {
     char file[64];
     std::snprintf(file, sizeof file, "%s_%04d.pcd", args.set.c_str(), i);
     Generated scan = generate(options_from(args, seed));
-    if (args.segment_labels) {
-      to_segment_labels(scan.cloud);
-      scan.tags["labels"] = "segments: 1 table top, 10 (k + 1) object k (mOSD)";
-    }
+    if (args.segment_labels) to_segment_labels(scan);
     write_tagged_cloud((dir / file).string(), scan.cloud, scan.tags);
     const std::string truth_file = std::filesystem::path(file).stem().string() + "_primitives.json";
     write_true_primitives((dir / truth_file).string(), scan, args.noise_scale);

@@ -8,6 +8,7 @@
 
 #include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/geometry/parallel.hpp"
+#include "primlabel/geometry/point_moments.hpp"
 
 namespace primlabel {
 
@@ -15,32 +16,13 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-// Plane normal and surface variation of one neighbourhood. The covariance is accumulated in
-// double around the query point (shifting keeps the sums small and the result accurate).
+// Plane normal and surface variation of one neighbourhood.
 bool fit_normal(const std::vector<Vec3f>& xyz, const Vec3f& query, const NeighborList& neighbors,
                 Vec3f& normal, float& curvature) {
-  const std::size_t n = neighbors.size();
-  if (n < 3) return false;
-  double sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
-  for (std::uint32_t index : neighbors.indices) {
-    const Vec3f& p = xyz[index];
-    const double x = double(p.x()) - query.x(), y = double(p.y()) - query.y(),
-                 z = double(p.z()) - query.z();
-    sx += x, sy += y, sz += z;
-    sxx += x * x, sxy += x * y, sxz += x * z, syy += y * y, syz += y * z, szz += z * z;
-  }
-  const double inv_n = 1.0 / double(n);
-  const double mx = sx * inv_n, my = sy * inv_n, mz = sz * inv_n;
-  Eigen::Matrix3d cov;
-  cov(0, 0) = sxx * inv_n - mx * mx;
-  cov(0, 1) = sxy * inv_n - mx * my;
-  cov(0, 2) = sxz * inv_n - mx * mz;
-  cov(1, 1) = syy * inv_n - my * my;
-  cov(1, 2) = syz * inv_n - my * mz;
-  cov(2, 2) = szz * inv_n - mz * mz;
-  cov(1, 0) = cov(0, 1);
-  cov(2, 0) = cov(0, 2);
-  cov(2, 1) = cov(1, 2);
+  if (neighbors.size() < 3) return false;
+  PointMoments moments;
+  for (std::uint32_t index : neighbors.indices) moments.add(xyz[index], query);
+  const Eigen::Matrix3d cov = moments.covariance();
 
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(cov);

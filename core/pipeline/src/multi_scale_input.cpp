@@ -11,6 +11,7 @@
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/neighbor_lists.hpp"
 #include "primlabel/geometry/parallel.hpp"
+#include "primlabel/geometry/point_moments.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 
 namespace primlabel::pipeline {
@@ -23,7 +24,7 @@ constexpr std::size_t kBlock = 512;  // points per parallel block
 // Surface variation of every point at each of `radii` (ascending), scaled, from one neighbour
 // list a point at the largest: each smaller neighbourhood is the part of it within its radius
 // (the same set a search at that radius finds, the nearest 1024 when capped). The covariance is
-// accumulated in double around the point, as estimate_normals does; 0 where it is undefined.
+// that of estimate_normals (PointMoments); 0 where it is undefined.
 std::vector<std::vector<float>> scaled_variations(const std::vector<Vec3f>& xyz,
                                                   const std::vector<float>& radii,
                                                   const NeighborLists& lists,
@@ -33,42 +34,23 @@ std::vector<std::vector<float>> scaled_variations(const std::vector<Vec3f>& xyz,
   if (scales == 0) return out;
   const Neighborhood widest = capped(Neighborhood::Radius(radii.back()));
   const std::ptrdiff_t blocks = std::ptrdiff_t((n + kBlock - 1) / kBlock);
-  struct Moments {
-    double count = 0, s[3] = {0, 0, 0}, ss[6] = {0, 0, 0, 0, 0, 0};
-  };
   detail::for_each_block(
       blocks, context, [] { return NeighborList{}; },
       [&](NeighborList& list, std::ptrdiff_t block) {
-        std::vector<Moments> moments(scales);
+        std::vector<PointMoments> moments(scales);
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
         for (std::size_t i = first; i < last; ++i) {
           if (!is_finite(xyz[i])) continue;
           lists.find(i, widest, list);
-          std::fill(moments.begin(), moments.end(), Moments{});
-          for (std::size_t j = 0; j < list.size(); ++j) {
-            const Vec3f& p = xyz[list.indices[j]];
-            const double x = double(p.x()) - xyz[i].x(), y = double(p.y()) - xyz[i].y(),
-                         z = double(p.z()) - xyz[i].z();
+          std::fill(moments.begin(), moments.end(), PointMoments{});
+          for (std::size_t j = 0; j < list.size(); ++j)
             for (std::size_t r = scales; r-- > 0;) {
               if (list.sq_dists[j] > radii[r] * radii[r]) break;  // nor within any smaller radius
-              Moments& m = moments[r];
-              m.count += 1, m.s[0] += x, m.s[1] += y, m.s[2] += z;
-              m.ss[0] += x * x, m.ss[1] += x * y, m.ss[2] += x * z;
-              m.ss[3] += y * y, m.ss[4] += y * z, m.ss[5] += z * z;
+              moments[r].add(xyz[list.indices[j]], xyz[i]);
             }
-          }
           for (std::size_t r = 0; r < scales; ++r) {
-            const Moments& m = moments[r];
-            if (m.count < 3) continue;
-            const double inv = 1.0 / m.count;
-            const double mx = m.s[0] * inv, my = m.s[1] * inv, mz = m.s[2] * inv;
-            Eigen::Matrix3d cov;
-            cov(0, 0) = m.ss[0] * inv - mx * mx;
-            cov(0, 1) = cov(1, 0) = m.ss[1] * inv - mx * my;
-            cov(0, 2) = cov(2, 0) = m.ss[2] * inv - mx * mz;
-            cov(1, 1) = m.ss[3] * inv - my * my;
-            cov(1, 2) = cov(2, 1) = m.ss[4] * inv - my * mz;
-            cov(2, 2) = m.ss[5] * inv - mz * mz;
+            if (moments[r].count < 3) continue;
+            const Eigen::Matrix3d cov = moments[r].covariance();
             const double trace = cov.trace();
             if (!(trace > 0.0)) continue;
             Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
@@ -110,11 +92,10 @@ Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
   std::vector<std::vector<float>> measured;
   std::vector<float> at_normal_radius;
   if (settings.surface_variation_features) {
-    std::vector<float> radii = {settings.features.radius};
-    radii.insert(radii.end(), settings.extra_feature_radii.begin(),
-                 settings.extra_feature_radii.end());
-    if (!curvature_at_normal_radius) radii.push_back(settings.normals.radius);
-    std::vector<float> ascending = radii;
+    std::vector<float> ascending = {settings.features.radius};
+    ascending.insert(ascending.end(), settings.extra_feature_radii.begin(),
+                     settings.extra_feature_radii.end());
+    if (!curvature_at_normal_radius) ascending.push_back(settings.normals.radius);
     std::sort(ascending.begin(), ascending.end());
     ascending.erase(std::unique(ascending.begin(), ascending.end()), ascending.end());
     measured = scaled_variations(cloud.xyz, ascending, lists, context);
@@ -155,10 +136,7 @@ Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
 }
 
 Descriptors leading_values(Descriptors descriptors, int dim) {
-  if (descriptors.dim <= dim || descriptors.empty()) {
-    if (descriptors.dim > dim) descriptors.dim = dim;
-    return descriptors;
-  }
+  if (descriptors.dim <= dim) return descriptors;
   const std::size_t n = descriptors.size();
   Descriptors out(dim, std::vector<float>(n * std::size_t(dim)));
   for (std::size_t i = 0; i < n; ++i) {

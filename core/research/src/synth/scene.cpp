@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include "primlabel/synth/random.hpp"
 
@@ -80,6 +81,29 @@ Scene table_only(Rng& rng, bool random_size) {
   return scene;
 }
 
+// The front part of a table where objects stand (x in [-half_x, half_x], y in [y_lo, y_hi]) and
+// the footprints placed on it so far.
+struct StandingArea {
+  struct Footprint {
+    double x, y, r;
+  };
+  double half_x, y_lo, y_hi;
+  std::vector<Footprint> placed;
+
+  // A random spot and turn for a footprint of radius r, at least `gap` from every placed one; it
+  // is then placed. Nothing when the draw lands too close or r does not fit.
+  std::optional<Eigen::Isometry3d> place(Rng& rng, double r, double gap) {
+    const double x = rng.uniform(-half_x + r, half_x - r);
+    const double y = rng.uniform(y_lo + r, y_hi - r);
+    const double yaw = rng.uniform(0.0, 2.0 * M_PI);
+    if (2 * r > 2 * half_x || 2 * r > y_hi - y_lo) return std::nullopt;
+    for (const Footprint& other : placed)
+      if (std::hypot(x - other.x, y - other.y) < r + other.r + gap) return std::nullopt;
+    placed.push_back({x, y, r});
+    return pose_on_table(x, y, yaw);
+  }
+};
+
 Scene random_table_scene(std::uint64_t seed, const TableSceneOptions& options) {
   Rng rng(mix_seed(seed, 1));
   Scene scene = table_only(rng, true);
@@ -87,27 +111,17 @@ Scene random_table_scene(std::uint64_t seed, const TableSceneOptions& options) {
       options.min_objects + rng.below(std::max(options.max_objects - options.min_objects + 1, 1));
   // Objects stand together on the front part of the table, as in the paper's scenes, where
   // both sensors see them at 0.7-1.2 m.
-  const double half_x = std::min(0.3, 0.5 * scene.table_size.x() - 0.08);
   const double y_lo = -0.5 * scene.table_size.y() + 0.1;
-  const double y_hi = std::min(y_lo + 0.45, 0.5 * scene.table_size.y() - 0.1);
-  struct Placed {
-    double x, y, r;
-  };
-  std::vector<Placed> placed;
-  for (int attempt = 0; attempt < 1000 && static_cast<int>(placed.size()) < wanted; ++attempt) {
+  StandingArea area{std::min(0.3, 0.5 * scene.table_size.x() - 0.08),
+                    y_lo,
+                    std::min(y_lo + 0.45, 0.5 * scene.table_size.y() - 0.1),
+                    {}};
+  for (int attempt = 0; attempt < 1000 && static_cast<int>(area.placed.size()) < wanted;
+       ++attempt) {
     Candidate candidate = random_object(rng);
     const double r = candidate.shape->footprint_radius();
-    const double x = rng.uniform(-half_x + r, half_x - r);
-    const double y = rng.uniform(y_lo + r, y_hi - r);
-    const double yaw = rng.uniform(0.0, 2.0 * M_PI);
-    if (2 * r > 2 * half_x || 2 * r > y_hi - y_lo) continue;
-    bool free = true;
-    for (const Placed& other : placed)
-      free = free && std::hypot(x - other.x, y - other.y) >= r + other.r + options.min_gap;
-    if (!free) continue;
-    placed.push_back({x, y, r});
-    scene.objects.emplace_back(std::move(candidate.shape), pose_on_table(x, y, yaw), candidate.rgb,
-                               true);
+    if (const auto pose = area.place(rng, r, options.min_gap))
+      scene.objects.emplace_back(std::move(candidate.shape), *pose, candidate.rgb, true);
   }
   return scene;
 }
@@ -119,14 +133,13 @@ Scene clutter_scene(std::uint64_t seed) {
   Rng rng(mix_seed(seed, 4));
   Scene scene = table_only(rng, true);
   const int wanted = 8 + rng.below(7);
-  const double half_x = std::min(0.35, 0.5 * scene.table_size.x() - 0.08);
   const double y_lo = -0.5 * scene.table_size.y() + 0.08;
-  const double y_hi = std::min(y_lo + 0.5, 0.5 * scene.table_size.y() - 0.08);
-  struct Placed {
-    double x, y, r;
-  };
-  std::vector<Placed> placed;
-  for (int attempt = 0; attempt < 2000 && static_cast<int>(placed.size()) < wanted; ++attempt) {
+  StandingArea area{std::min(0.35, 0.5 * scene.table_size.x() - 0.08),
+                    y_lo,
+                    std::min(y_lo + 0.5, 0.5 * scene.table_size.y() - 0.08),
+                    {}};
+  for (int attempt = 0; attempt < 2000 && static_cast<int>(area.placed.size()) < wanted;
+       ++attempt) {
     Candidate candidate =
         rng.chance(0.33)
             ? Candidate{std::make_shared<BoxShape>(Vec3d(rng.uniform(0.14, 0.24),
@@ -134,26 +147,19 @@ Scene clutter_scene(std::uint64_t seed) {
                                                          rng.uniform(0.015, 0.05))),
                         pick_color(rng, {0x8B0000, 0x1F3A93, 0x2E8B57, 0xF0E68C, 0x4B0082})}
             : random_object(rng);
-    const double r = candidate.shape->footprint_radius();
-    if (2 * r > 2 * half_x || 2 * r > y_hi - y_lo) continue;
-    const double x = rng.uniform(-half_x + r, half_x - r);
-    const double y = rng.uniform(y_lo + r, y_hi - r);
-    const double yaw = rng.uniform(0.0, 2.0 * M_PI);
     const double gap = rng.uniform(0.003, 0.01);
-    bool free = true;
-    for (const Placed& other : placed)
-      free = free && std::hypot(x - other.x, y - other.y) >= r + other.r + gap;
-    if (!free) continue;
-    placed.push_back({x, y, r});
+    const auto pose = area.place(rng, candidate.shape->footprint_radius(), gap);
+    if (!pose) continue;
     const auto* box = dynamic_cast<const BoxShape*>(candidate.shape.get());
-    scene.objects.emplace_back(candidate.shape, pose_on_table(x, y, yaw), candidate.rgb, true);
+    scene.objects.emplace_back(candidate.shape, *pose, candidate.rgb, true);
     if (box && rng.chance(0.35)) {  // a smaller box on top, turned a little
       const Vec3d below = box->size();
       const Vec3d size(rng.uniform(0.5, 0.9) * below.x(), rng.uniform(0.5, 0.9) * below.y(),
                        rng.uniform(0.03, 0.12));
-      Eigen::Isometry3d pose = pose_on_table(x, y, yaw + rng.uniform(-0.3, 0.3));
-      pose.pretranslate(Vec3d(0, 0, below.z()));
-      scene.objects.emplace_back(std::make_shared<BoxShape>(size), pose,
+      Eigen::Isometry3d on_top = *pose;
+      on_top.rotate(Eigen::AngleAxisd(rng.uniform(-0.3, 0.3), Vec3d::UnitZ()));
+      on_top.pretranslate(Vec3d(0, 0, below.z()));
+      scene.objects.emplace_back(std::make_shared<BoxShape>(size), on_top,
                                  pick_color(rng, {0xD9482B, 0x2B6CD9, 0xE8C547, 0x6A3D9A}), true);
     }
   }
