@@ -146,7 +146,8 @@ int run(const Arguments& args) {
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "Find the table (largest horizontal plane) and the objects on it in a scan; "
+      "Find the table (the horizontal surface holding up the scene) and the objects on it in a "
+      "scan; "
       "score against mOSD labels; render to PNG."};
   // Every option with a default shows it in --help ("[0.025]").
   app.option_defaults()->always_capture_default();

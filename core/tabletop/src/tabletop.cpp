@@ -14,6 +14,7 @@
 #include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/tabletop/convex_hull.hpp"
 #include "primlabel/tabletop/plane_grid.hpp"
+#include "primlabel/tabletop/support_surface.hpp"
 #include "primlabel/tabletop/voxel_grid.hpp"
 
 namespace primlabel::tabletop {
@@ -48,6 +49,7 @@ void TabletopOptions::validate() const {
   if (!std::isfinite(hull_margin)) fail("hull margin must be finite");
   plane.validate();
   clusters.validate();
+  support.validate();
   table_noise.validate();
   creases.validate();
   split.validate();
@@ -176,28 +178,21 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   result.tilt_deg = angle_between_deg(plane.head<3>(), prior);
 
   context.throw_if_stopped(kWhat);
-  // 3. The table: points in the band around the plane, in the pieces connected to its bulk.
+  // 3. The table: the band around the plane, in the pieces connected to its bulk - or, when the
+  // dominant plane stands on a lower one that holds up more of the scene, that one.
   const auto table_start = Clock::now();
-  std::vector<float> height(xyz.size(), std::numeric_limits<float>::quiet_NaN());
-  std::vector<std::uint32_t> band;
-  for (std::uint32_t i : valid) {
-    height[i] = signed_distance(plane, xyz[i]);
-    if (std::abs(height[i]) <= options.table_band) band.push_back(i);
-  }
-  const PlaneGrid band_grid(xyz, band, plane, options.table_connectivity);
-  std::vector<std::vector<std::uint32_t>> parts = band_grid.connected_parts();
-  // The table's bulk must be a surface lying in the plane: not a strip where the plane cuts a
-  // surface at a steep angle (e.g. a plane through the sensor along an image row), nor a plane
-  // slicing through walls or object sides (their points in the band face sideways). Otherwise
-  // there is no table within the allowed angle; say how far off the dominant plane is.
-  const char* not_a_table = nullptr;
-  if (parts.empty() ||
-      estimate_plane(xyz, parts.front()).narrow_spread < 3.0 * options.plane.distance_threshold)
-    not_a_table = "a thin strip";
-  else if (band_grid.fraction_parallel(parts.front(), options.table_normal_angle_deg) <
-           options.min_table_parallel)
-    not_a_table = "a slice through surfaces that are not parallel to it";
+  const SurfaceRules rules{options.table_band,
+                           options.table_connectivity,
+                           options.table_min_part,
+                           options.min_table_parallel,
+                           options.table_normal_angle_deg,
+                           3.0f * options.plane.distance_threshold,
+                           options.min_object_height.value_or(-options.table_band),
+                           options.max_object_height};
+  TableSurface surface = table_surface(xyz, valid, plane, rules);
+  const char* not_a_table = surface.not_a_table;
   if (not_a_table) {
+    // Otherwise there is no table within the allowed angle; say how far off the dominant plane is.
     PlaneFitOptions free = plane_options;
     free.axis.reset();
     PlaneFit dominant = fit_plane(fit_points, fit_indices, free, context);
@@ -220,19 +215,33 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
     }
     return fail(failed);
   }
-  std::vector<std::uint8_t> is_table(xyz.size(), 0);
   {
-    const double min_part = options.table_min_part * double(parts.front().size());
-    for (const auto& part : parts)
-      if (double(part.size()) >= min_part)
-        for (std::uint32_t i : part) is_table[i] = 1;
+    PlaneFit oriented = fit;
+    oriented.plane = plane;
+    std::size_t best_support = support_count(xyz, valid, surface, rules, options.support);
+    for (const Eigen::Vector4f& candidate : further_horizontal_planes(
+             fit_points, fit_indices, oriented, plane_options, options.support, context)) {
+      context.throw_if_stopped(kWhat);
+      TableSurface other = table_surface(xyz, valid, candidate, rules);
+      const std::size_t support = support_count(xyz, valid, other, rules, options.support);
+      if (support > best_support) {
+        best_support = support;
+        surface = std::move(other);
+      }
+    }
   }
-  for (std::uint32_t i : band)
-    if (is_table[i]) result.table_inliers.push_back(i);
+  plane = surface.plane;
+  result.plane = plane;
+  result.up = plane.head<3>();
+  result.tilt_deg = angle_between_deg(plane.head<3>(), prior);
+  const std::vector<float>& height = surface.height;
+  const PlaneGrid& band_grid = *surface.band_grid;
+  std::vector<std::uint8_t>& is_table = surface.is_table;
+  result.table_inliers = surface.inliers;
 
   Vec3f u, v;
   plane_basis(plane.head<3>(), u, v);
-  const std::vector<Vec2f> hull = convex_hull(band_grid.hull_candidates(result.table_inliers));
+  const std::vector<Vec2f>& hull = surface.hull;
   const Vec3f on_plane = -plane[3] * plane.head<3>();
   for (const Vec2f& q : hull) result.hull.push_back(on_plane + q.x() * u + q.y() * v);
   result.timings.table_ms = ms_since(table_start);

@@ -1,6 +1,7 @@
 #pragma once
-// The table-top pre-filter of Rusu et al. (2009): the largest horizontal plane is the table; its
-// convex hull bounds the table; the points above the table inside the hull, grouped by Euclidean
+// The table-top pre-filter of Rusu et al. (2009): a horizontal plane is the table - the dominant
+// one, unless it stands on one that holds up more of the scene (support_surface.hpp); its convex
+// hull bounds the table; the points above the table inside the hull, grouped by Euclidean
 // clustering, are the objects. Only the table and the objects are then labeled.
 //
 // Euclidean clusters are then refined (convexity_split.hpp, stacked_split.hpp,
@@ -25,6 +26,7 @@
 #include "primlabel/tabletop/occlusion_merge.hpp"
 #include "primlabel/tabletop/plane_fit.hpp"
 #include "primlabel/tabletop/stacked_split.hpp"
+#include "primlabel/tabletop/support_surface.hpp"
 #include "primlabel/tabletop/table_noise.hpp"
 
 namespace primlabel::tabletop {
@@ -65,6 +67,7 @@ struct TabletopOptions {
   float max_object_height = 0.5f;
   float hull_margin = 0.0f;  // grow (> 0) or shrink (< 0) the table hull (m)
   ClusterOptions clusters{0.02f, 100, 200000};
+  SupportOptions support;         // the table among several horizontal surfaces
   TableNoiseOptions table_noise;  // flat clusters within the depth noise of the table: table
   ConvexitySplitOptions creases;  // touching objects, cut at concave creases
   StackSplitOptions split;        // objects standing on objects
