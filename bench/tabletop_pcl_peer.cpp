@@ -52,11 +52,17 @@ std::vector<pcl::PointIndices> lccp_clusters(const PointCloud& input, const Clou
   using PointT = pcl::PointXYZRGBA;
   pcl::PointCloud<PointT>::Ptr points(new pcl::PointCloud<PointT>);
   points->reserve(objects.size());
+  // In the sensor's frame, which the single-camera transform assumes (a scan saved in a world
+  // frame would otherwise be distorted, and can trip the octree's bounds assertion).
+  const Eigen::Matrix3f to_sensor =
+      input.viewpoint.orientation.normalized().toRotationMatrix().transpose();
   for (pcl::index_t i : objects) {
     PointT p;
-    p.x = finite[i].x;
-    p.y = finite[i].y;
-    p.z = finite[i].z;
+    const Vec3f q =
+        to_sensor * (Vec3f(finite[i].x, finite[i].y, finite[i].z) - input.viewpoint.origin);
+    p.x = q.x();
+    p.y = q.y();
+    p.z = q.z();
     const std::uint32_t rgb = input.has_rgba() ? input.rgba[to_input[i]] : 0x808080u;
     p.r = (rgb >> 16) & 0xFF;
     p.g = (rgb >> 8) & 0xFF;
@@ -65,7 +71,7 @@ std::vector<pcl::PointIndices> lccp_clusters(const PointCloud& input, const Clou
     points->push_back(p);
   }
   pcl::SupervoxelClustering<PointT> supervoxels(0.0075f, 0.03f);
-  supervoxels.setUseSingleCameraTransform(true);  // camera-frame Kinect clouds
+  supervoxels.setUseSingleCameraTransform(true);  // a Kinect's depth-dependent voxels
   supervoxels.setInputCloud(points);
   supervoxels.setColorImportance(0.0f);
   supervoxels.setSpatialImportance(1.0f);
@@ -119,7 +125,10 @@ PclTabletopResult run_pipeline(const PointCloud& input, const PclTabletopOptions
   pcl::SACSegmentation<pcl::PointXYZ> sac;
   sac.setOptimizeCoefficients(true);
   sac.setModelType(pcl::SACMODEL_PERPENDICULAR_PLANE);
-  sac.setMethodType(pcl::SAC_MSAC);
+  // RANSAC, as PCL's table-top tutorials: PCL 1.13's MSAC keeps a first hypothesis outside the
+  // angle (empty distances, zero penalty; msac.hpp skips those only once k > 1) and then fails
+  // with "Estimated distances (0) differs ...", so it finds no table on many tilted frames.
+  sac.setMethodType(pcl::SAC_RANSAC);
   sac.setDistanceThreshold(options.distance_threshold);
   sac.setAxis(options.axis.normalized());
   sac.setEpsAngle(options.max_angle_deg * M_PI / 180.0);
@@ -156,7 +165,9 @@ PclTabletopResult run_pipeline(const PointCloud& input, const PclTabletopOptions
   prism.setInputCloud(finite);
   prism.setInputPlanarHull(hull_points);
   prism.setHeightLimits(options.table_band, options.max_height);
-  prism.setViewPoint(0, 0, 0);  // heights are counted toward the sensor side of the plane
+  // Heights are counted toward the sensor side of the plane.
+  prism.setViewPoint(input.viewpoint.origin.x(), input.viewpoint.origin.y(),
+                     input.viewpoint.origin.z());
   pcl::PointIndices::Ptr objects(new pcl::PointIndices);
   prism.segment(*objects);
 
