@@ -74,6 +74,46 @@ TEST(TabletopStackedSplit, ThreeStackedObjectsGiveThreeClusters) {
   EXPECT_EQ(clusters.size(), 3u);
 }
 
+// A box [x0, x1] x [y0, y1] x [z0, z1] as seen from above: its top every `step` except the part
+// under [0, hx] x [0, hy] (hidden under what stands on it), its sides three times sparser.
+void add_box(std::vector<Vec3f>& points, float x0, float x1, float y0, float y1, float z0, float z1,
+             float hx = 0.0f, float hy = 0.0f, float step = 0.003f) {
+  const float side = 3 * step;
+  for (float z = z0; z < z1; z += side) {
+    for (float x = x0; x <= x1; x += side) {
+      points.emplace_back(x, y0, z);
+      points.emplace_back(x, y1, z);
+    }
+    for (float y = y0 + side; y < y1; y += side) {
+      points.emplace_back(x0, y, z);
+      points.emplace_back(x1, y, z);
+    }
+  }
+  for (float x = x0; x <= x1; x += step)
+    for (float y = y0; y <= y1; y += step)
+      if (!(x < hx && y < hy)) points.emplace_back(x, y, z1);
+}
+
+TEST(TabletopStackedSplit, BoxOnABoxOfNearlyTheSameSizeIsSplit) {
+  // The upper box covers 72% of the lower one's top, flush with two of its sides: the lower top
+  // is seen only as a 3 cm strip, all of it outside the upper footprint.
+  std::vector<Vec3f> points;
+  add_box(points, 0.0f, 0.2f, 0.0f, 0.2f, 0.0f, 0.1f, 0.17f, 0.17f);
+  const std::size_t lower = points.size();
+  add_box(points, 0.0f, 0.17f, 0.0f, 0.17f, 0.1f, 0.2f);
+  const auto clusters =
+      split_stacked(points, heights(points), kTable, {all(points.size())}, StackSplitOptions{});
+  ASSERT_EQ(clusters.size(), 2u);
+  // The lower box's part (its flush sides' top rows go with the upper box).
+  std::size_t in_first = 0;
+  for (std::uint32_t i : clusters[0]) in_first += i < lower;
+  const auto& lower_part = 2 * in_first > clusters[0].size() ? clusters[0] : clusters[1];
+  std::size_t lower_points = 0;
+  for (std::uint32_t i : lower_part) lower_points += i < lower;
+  EXPECT_GT(double(lower_points), 0.95 * double(lower));
+  EXPECT_GT(double(lower_points), 0.95 * double(lower_part.size()));
+}
+
 TEST(TabletopStackedSplit, ContainersBoxesAndLowSurfacesStayWhole) {
   StackSplitOptions options;
   // A pot with a raised floor: its walls rise around the floor, not on a part of it.

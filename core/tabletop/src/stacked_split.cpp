@@ -18,8 +18,8 @@ void StackSplitOptions::validate() const {
   if (!(peak_factor >= 1.0f) || !std::isfinite(peak_factor))
     fail("stack split peak factor must be >= 1, got " + std::to_string(peak_factor));
   if (!(min_rise >= 0.0f) || !std::isfinite(min_rise)) fail("stack split min rise must be >= 0");
-  if (!(max_footprint_ratio > 0.0f && max_footprint_ratio <= 1.0f))
-    fail("stack split max footprint ratio must be in (0, 1]");
+  if (!(min_free_share > 0.0f && min_free_share <= 1.0f))
+    fail("stack split min free share must be in (0, 1]");
   if (!(min_on_surface >= 0.0f && min_on_surface <= 1.0f))
     fail("stack split min on-surface fraction must be in [0, 1]");
   if (!(footprint_margin >= 0.0f) || !std::isfinite(footprint_margin))
@@ -27,16 +27,6 @@ void StackSplitOptions::validate() const {
 }
 
 namespace {
-
-double polygon_area(const std::vector<Vec2f>& polygon) {
-  double twice = 0.0;
-  for (std::size_t k = 0, n = polygon.size(); k < n; ++k) {
-    const Vec2f& a = polygon[k];
-    const Vec2f& b = polygon[(k + 1) % n];
-    twice += double(a.x()) * b.y() - double(a.y()) * b.x();
-  }
-  return std::abs(twice) / 2.0;
-}
 
 class Splitter {
  public:
@@ -102,8 +92,11 @@ class Splitter {
     const std::vector<Vec2f> surface_hull = convex_hull(surface);
     const std::vector<Vec2f> above_hull = convex_hull(above);
     if (surface_hull.size() < 3 || above_hull.size() < 3) return false;
-    if (polygon_area(above_hull) > options_.max_footprint_ratio * polygon_area(surface_hull))
-      return false;
+    // The support's visible part lies outside the upper object's footprint (the rest is hidden
+    // under it); a container's floor lies inside its walls' footprint.
+    std::size_t free = 0;
+    for (const Vec2f& q : surface) free += !hull_contains(above_hull, q, options_.footprint_margin);
+    if (double(free) < options_.min_free_share * double(surface.size())) return false;
     std::size_t on_surface = 0;
     for (const Vec2f& q : above)
       on_surface += hull_contains(surface_hull, q, options_.footprint_margin);

@@ -7,11 +7,12 @@
 // in a thin band of heights (a peak of the height histogram; walls spread evenly over heights).
 // The cluster is split at h when what rises above the band (1) is a real object (enough points,
 // rising clearly above h), (2) stands on the surface (its footprint in the table plane lies over
-// the surface's) and (3) covers clearly less of it than the surface's own footprint (the rest of
-// the surface is seen free around it). (3) keeps one object whole when its horizontal band is
-// its floor or its top: a container's walls rise around its floor, so their footprint is not
-// smaller; a box's top face has nothing standing on it. A bottle's shoulder is sloped, so it does
-// not concentrate points in one thin band.
+// the surface's) and (3) leaves the surface seen free outside its own footprint: most of the
+// band's points lie outside the upper object's footprint, since the part under it is hidden. So
+// a box on a box of nearly the same size splits at the strip of the lower top seen beside it.
+// (3) keeps one object whole when its horizontal band is its floor: a container's walls rise
+// around its floor, which lies inside their footprint; a box's top face has nothing on it. A
+// bottle's shoulder is sloped, so it does not concentrate points in one thin band.
 //
 // Heights are distances above the table plane. Splits repeat on the parts (three stacked objects
 // give three clusters).
@@ -32,7 +33,7 @@ struct StackSplitOptions {
   float peak_factor = 5.0f;          // a surface's bins hold >= this times the median bin
   float min_rise = 0.02f;            // the upper object rises at least this above the surface (m)
   std::size_t min_points = 100;      // and has at least this many points
-  float max_footprint_ratio = 0.5f;  // upper footprint area <= this times the surface's
+  float min_free_share = 0.5f;       // of the surface's points outside the upper footprint
   float min_on_surface = 0.9f;       // fraction of the upper points above the surface's footprint
   float footprint_margin = 0.01f;    // (m) of slack for that test
 
