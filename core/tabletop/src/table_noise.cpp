@@ -17,6 +17,10 @@ void TableNoiseOptions::validate() const {
     fail("table noise share must be in (0, 1], got " + std::to_string(min_share_in_band));
 }
 
+float table_noise_band(const TableNoiseOptions& options, float floor_band, float range) {
+  return std::max(floor_band, options.noise_sigmas * options.depth_noise_per_m2 * range * range);
+}
+
 TableNoiseSplit separate_table_noise(const std::vector<Vec3f>& points,
                                      const std::vector<float>& height, const Vec3f& sensor,
                                      std::vector<std::vector<std::uint32_t>> clusters,
@@ -30,10 +34,8 @@ TableNoiseSplit separate_table_noise(const std::vector<Vec3f>& points,
   for (auto& cluster : clusters) {
     std::size_t in_band = 0;
     for (std::uint32_t i : cluster) {
-      const float range = (points[i] - sensor).norm();
-      const float band =
-          std::max(floor_band, options.noise_sigmas * options.depth_noise_per_m2 * range * range);
-      in_band += std::abs(height[i]) <= band;
+      in_band +=
+          std::abs(height[i]) <= table_noise_band(options, floor_band, (points[i] - sensor).norm());
     }
     if (!cluster.empty() &&
         double(in_band) >= double(options.min_share_in_band) * double(cluster.size()))

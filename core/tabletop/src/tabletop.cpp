@@ -90,18 +90,15 @@ float angle_between_deg(const Vec3f& a, const Vec3f& b) {
   return std::acos(c) * 180.0f / static_cast<float>(M_PI);
 }
 
-// Expands clusters of voxels into clusters of the voxels' input points, with the size limits
-// applied to input points.
+// Expands clusters of voxels into clusters of the voxels' input points.
 std::vector<std::vector<std::uint32_t>> expand_voxel_clusters(
-    const std::vector<std::vector<std::uint32_t>>& voxel_clusters, const VoxelGrid& grid,
-    const ClusterOptions& limits) {
+    const std::vector<std::vector<std::uint32_t>>& voxel_clusters, const VoxelGrid& grid) {
   std::vector<std::vector<std::uint32_t>> clusters;
   for (const auto& voxels : voxel_clusters) {
     std::vector<std::uint32_t> members;
     for (std::uint32_t v : voxels)
       members.insert(members.end(), grid.members.begin() + grid.member_offsets[v],
                      grid.members.begin() + grid.member_offsets[v + 1]);
-    if (members.size() < limits.min_size || members.size() > limits.max_size) continue;
     std::sort(members.begin(), members.end());
     clusters.push_back(std::move(members));
   }
@@ -250,31 +247,45 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   // 4. Objects: what stands on the table, inside its boundary, grouped by proximity.
   const auto objects_start = Clock::now();
   const float min_height = options.min_object_height.value_or(-options.table_band);
-  std::vector<std::uint32_t> candidates;
+  // Below the table inside its boundary is only the table seen through depth noise.
+  std::vector<std::uint32_t> candidates, below_table;
   for (std::uint32_t i : valid) {
-    if (is_table[i] || height[i] < min_height || height[i] > options.max_object_height) continue;
+    if (is_table[i] || height[i] > options.max_object_height) continue;
+    const bool below = height[i] < min_height;
+    if (below && (!options.table_noise.enabled ||
+                  -height[i] > table_noise_band(options.table_noise, options.table_band,
+                                                (xyz[i] - cloud.viewpoint.origin).norm())))
+      continue;
     if (hull_contains(hull, band_grid.project(xyz[i]), options.hull_margin))
-      candidates.push_back(i);
+      (below ? below_table : candidates).push_back(i);
   }
+  // Every cluster, whatever its size: the size limits apply after the table's noise is told apart.
+  ClusterOptions unlimited = options.clusters;
+  unlimited.min_size = 1;
+  unlimited.max_size = SIZE_MAX;
   if (voxelized) {
     // Cluster the voxels holding candidates, at their candidates' centroid.
     VoxelGrid object_grid = voxel_downsample(xyz, candidates, options.voxel_leaf, context);
     std::vector<std::uint32_t> voxels(object_grid.centroids.size());
     std::iota(voxels.begin(), voxels.end(), 0u);
-    ClusterOptions unlimited = options.clusters;
-    unlimited.min_size = 1;
-    unlimited.max_size = SIZE_MAX;
-    result.clusters =
-        expand_voxel_clusters(euclidean_clusters(object_grid.centroids, voxels, unlimited),
-                              object_grid, options.clusters);
+    result.clusters = expand_voxel_clusters(
+        euclidean_clusters(object_grid.centroids, voxels, unlimited), object_grid);
   } else {
-    result.clusters = euclidean_clusters(xyz, candidates, options.clusters);
+    result.clusters = euclidean_clusters(xyz, candidates, unlimited);
   }
   {
     TableNoiseSplit noise =
         separate_table_noise(xyz, height, cloud.viewpoint.origin, std::move(result.clusters),
                              options.table_band, options.table_noise);
-    result.clusters = std::move(noise.objects);
+    // Clusters too small or too large to be objects are dropped only now: small flat patches of
+    // the table's noise are table.
+    result.clusters.clear();
+    for (auto& cluster : noise.objects)
+      if (cluster.size() >= options.clusters.min_size &&
+          cluster.size() <= options.clusters.max_size)
+        result.clusters.push_back(std::move(cluster));
+    noise.table_points.insert(noise.table_points.end(), below_table.begin(), below_table.end());
+    std::sort(noise.table_points.begin(), noise.table_points.end());
     if (!noise.table_points.empty()) {
       std::vector<std::uint32_t> table;
       std::merge(result.table_inliers.begin(), result.table_inliers.end(),

@@ -1,10 +1,11 @@
 #pragma once
 // Clusters that are only the table seen through depth noise. A Kinect's depth error grows with
-// the square of the range (docs/results.md "Kinect calibration": sigma = 2.82e-3 z^2 m to the frame's
-// plane, levels z^2 / 345 m apart), so at 1.5 m the table's far end scatters beyond any fixed
-// table band and leaves flat patches that Euclidean clustering counts as objects. A cluster is
-// table noise when nearly all of its points lie within the noise band of their own range; such
-// points cannot be told from the table and are given to it.
+// the square of the range (docs/results.md "Kinect calibration": sigma = 2.82e-3 z^2 m to the
+// frame's plane, levels z^2 / 345 m apart), so at 1.5 m the table's far end scatters beyond any
+// fixed table band and leaves flat patches that Euclidean clustering counts as objects. A cluster
+// is table noise when nearly all of its points lie within the noise band of their own range; such
+// points cannot be told from the table and are given to it. So are points below the table within
+// that band (nothing stands below the table).
 
 #include <cstddef>
 #include <cstdint>
@@ -22,6 +23,10 @@ struct TableNoiseOptions {
 
   void validate() const;  // throws std::invalid_argument naming the bad option
 };
+
+// The band of heights around the table that its depth noise fills at `range` (m), never
+// narrower than `floor_band`.
+float table_noise_band(const TableNoiseOptions& options, float floor_band, float range);
 
 struct TableNoiseSplit {
   std::vector<std::vector<std::uint32_t>> objects;  // the clusters kept, in their order
