@@ -1,5 +1,6 @@
 #include "admin_service.hpp"
 
+#include "auth.hpp"
 #include "grpc_status.hpp"
 #include "labeler_service.hpp"
 #include "registry_error.hpp"
@@ -13,7 +14,7 @@ grpc::Status AdminService::LoadModel(grpc::ServerContext* context,
   RequestRecord record("LoadModel", *env_.metrics);
   record.model = request->model();
   if (auto refused = env_.auth->check(*context, true))
-    return record.finish(to_grpc_status(*refused));
+    return finish_request(record, to_grpc_status(*refused));
   try {
     const auto entry = env_.registry->load(request->model(), request->version());
     record.version = entry->version;
@@ -21,11 +22,11 @@ grpc::Status AdminService::LoadModel(grpc::ServerContext* context,
     env_.metrics->reloads(1, 0);
   } catch (const RegistryError& error) {
     if (error.kind() == RegistryError::Kind::kLoadFailed) env_.metrics->reloads(0, 1);
-    return record.finish(to_grpc_status(registry_error(error)));
+    return finish_request(record, to_grpc_status(registry_error(error)));
   }
   for (const ServedModel& model : env_.registry->list())
     if (model.name == request->model()) fill_model_info(model, *response->mutable_model());
-  return record.finish(grpc::Status::OK);
+  return finish_request(record, grpc::Status::OK);
 }
 
 grpc::Status AdminService::UnloadModel(grpc::ServerContext* context,
@@ -35,13 +36,13 @@ grpc::Status AdminService::UnloadModel(grpc::ServerContext* context,
   record.model = request->model();
   record.version = request->version();
   if (auto refused = env_.auth->check(*context, true))
-    return record.finish(to_grpc_status(*refused));
+    return finish_request(record, to_grpc_status(*refused));
   try {
     response->set_unloaded_versions(env_.registry->unload(request->model(), request->version()));
   } catch (const RegistryError& error) {
-    return record.finish(to_grpc_status(registry_error(error)));
+    return finish_request(record, to_grpc_status(registry_error(error)));
   }
-  return record.finish(grpc::Status::OK);
+  return finish_request(record, grpc::Status::OK);
 }
 
 grpc::Status AdminService::ReloadModels(grpc::ServerContext* context,
@@ -49,7 +50,7 @@ grpc::Status AdminService::ReloadModels(grpc::ServerContext* context,
                                         v1::ReloadModelsResponse* response) {
   RequestRecord record("ReloadModels", *env_.metrics);
   if (auto refused = env_.auth->check(*context, true))
-    return record.finish(to_grpc_status(*refused));
+    return finish_request(record, to_grpc_status(*refused));
   try {
     // Unloads last until this explicit reload, which brings their versions back.
     const ReloadReport report = env_.registry->reload();
@@ -58,11 +59,11 @@ grpc::Status AdminService::ReloadModels(grpc::ServerContext* context,
     response->set_failed(report.failed);
     for (const std::string& error : report.errors) response->add_errors(error);
   } catch (const RegistryError& error) {
-    return record.finish(to_grpc_status(registry_error(error)));
+    return finish_request(record, to_grpc_status(registry_error(error)));
   }
   for (const ServedModel& model : env_.registry->list())
     fill_model_info(model, *response->add_models());
-  return record.finish(grpc::Status::OK);
+  return finish_request(record, grpc::Status::OK);
 }
 
 }  // namespace primlabel::server

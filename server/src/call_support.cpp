@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "auth.hpp"
 #include "label_job.hpp"
 
 namespace primlabel::server {

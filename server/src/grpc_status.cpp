@@ -1,5 +1,7 @@
 #include "grpc_status.hpp"
 
+#include "primlabel/wire/status_names.hpp"
+
 namespace primlabel::server {
 
 namespace {
@@ -44,6 +46,11 @@ grpc::StatusCode grpc_code(ErrorCode code) {
 
 grpc::Status to_grpc_status(const ServiceError& error) {
   return {grpc_code(error.code), error.message};
+}
+
+grpc::Status finish_request(RequestRecord& record, const grpc::Status& status) {
+  record.finish(::primlabel::wire::status_code_name(status.error_code()), status.error_message());
+  return status;
 }
 
 }  // namespace primlabel::server

@@ -3,10 +3,14 @@
 
 #include <grpcpp/support/status.h>
 
+#include "request_record.hpp"
 #include "service_error.hpp"
 
 namespace primlabel::server {
 
 grpc::Status to_grpc_status(const ServiceError& error);
+
+// Finishes the request's record with `status`; returns it, for `return finish_request(...)`.
+grpc::Status finish_request(RequestRecord& record, const grpc::Status& status);
 
 }  // namespace primlabel::server

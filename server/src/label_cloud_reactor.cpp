@@ -125,7 +125,7 @@ class LabelCloudReactor final : public grpc::ServerUnaryReactor,
     finished_ = true;
     if (timer_) env_.timers->cancel(std::exchange(timer_, 0));
     try {
-      record_.finish(status);
+      finish_request(record_, status);
     } catch (...) {  // logging must not keep the call from finishing
     }
     Finish(status);

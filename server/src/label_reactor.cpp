@@ -208,7 +208,7 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
     phase_ = Phase::kFinished;
     cancel_timer();
     release_memory();
-    record_.finish(grpc::Status::OK);
+    finish_request(record_, grpc::Status::OK);
     Finish(grpc::Status::OK);
   }
 
@@ -224,7 +224,7 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
     release_memory();
     const grpc::Status status = to_grpc_status(error);
     try {
-      record_.finish(status);
+      finish_request(record_, status);
     } catch (...) {  // logging must not keep the call from finishing
     }
     // A client that does not read would hold a pending write, and with it the call, forever.

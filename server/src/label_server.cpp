@@ -6,6 +6,7 @@
 
 #include <stdexcept>
 
+#include "auth.hpp"
 #include "logging.hpp"
 #include "user_text.hpp"
 

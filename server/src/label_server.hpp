@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "admin_service.hpp"
+#include "auth.hpp"
 #include "labeler_service.hpp"
 #include "metrics_endpoint.hpp"
 #include "server_config.hpp"

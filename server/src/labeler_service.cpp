@@ -1,5 +1,6 @@
 #include "labeler_service.hpp"
 
+#include "auth.hpp"
 #include "grpc_status.hpp"
 #include "label_reactors.hpp"
 #include "registry_error.hpp"
@@ -37,10 +38,10 @@ grpc::Status LabelerService::ListModels(grpc::ServerContext* context, const v1::
                                         v1::ListModelsResponse* response) {
   RequestRecord record("ListModels", *env_.metrics);
   if (auto refused = env_.auth->check(*context, false))
-    return record.finish(to_grpc_status(*refused));
+    return finish_request(record, to_grpc_status(*refused));
   for (const ServedModel& model : env_.registry->list())
     fill_model_info(model, *response->add_models());
-  return record.finish(grpc::Status::OK);
+  return finish_request(record, grpc::Status::OK);
 }
 
 grpc::Status LabelerService::GetModelMetadata(grpc::ServerContext* context,
@@ -49,7 +50,7 @@ grpc::Status LabelerService::GetModelMetadata(grpc::ServerContext* context,
   RequestRecord record("GetModelMetadata", *env_.metrics);
   record.model = request->model();
   if (auto refused = env_.auth->check(*context, false))
-    return record.finish(to_grpc_status(*refused));
+    return finish_request(record, to_grpc_status(*refused));
   try {
     const auto entry = env_.registry->resolve(request->model(), request->version());
     record.model = entry->name;
@@ -57,9 +58,9 @@ grpc::Status LabelerService::GetModelMetadata(grpc::ServerContext* context,
     record.model_resolved = true;
     *response = entry->metadata;
   } catch (const RegistryError& error) {
-    return record.finish(to_grpc_status(registry_error(error)));
+    return finish_request(record, to_grpc_status(registry_error(error)));
   }
-  return record.finish(grpc::Status::OK);
+  return finish_request(record, grpc::Status::OK);
 }
 
 }  // namespace primlabel::server

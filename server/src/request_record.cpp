@@ -5,7 +5,6 @@
 #include <random>
 
 #include "logging.hpp"
-#include "primlabel/wire/status_names.hpp"
 #include "user_text.hpp"
 
 namespace primlabel::server {
@@ -29,17 +28,18 @@ double RequestRecord::elapsed_seconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
-grpc::Status RequestRecord::finish(const grpc::Status& status) {
-  if (finished_) return status;
+void RequestRecord::finish(std::string_view code_name, std::string_view message) {
+  if (finished_) return;
   finished_ = true;
   const double seconds = elapsed_seconds();
-  const std::string code = ::primlabel::wire::status_code_name(status.error_code());
+  const std::string code(code_name);
+  const bool ok = code == "OK";
   const std::string metric_model = model_resolved ? user_text(model) : std::string();
   metrics_.request_finished(method_, metric_model, code, seconds);
-  if (status.ok() && points > 0) metrics_.points_labeled(metric_model, double(points));
-  if (status.ok() && !model_choice.empty()) metrics_.model_chosen(metric_model, model_choice);
+  if (ok && points > 0) metrics_.points_labeled(metric_model, double(points));
+  if (ok && !model_choice.empty()) metrics_.model_chosen(metric_model, model_choice);
   if (dropped_non_finite > 0) metrics_.points_dropped("non_finite", double(dropped_non_finite));
-  LogLine line(status.ok() ? LogLevel::kInfo : LogLevel::kWarn, "request");
+  LogLine line(ok ? LogLevel::kInfo : LogLevel::kWarn, "request");
   line.kv("method", method_)
       .kv("request_id", id_)
       .kv("scan_id", user_text(scan_id))
@@ -56,8 +56,7 @@ grpc::Status RequestRecord::finish(const grpc::Status& status) {
     metrics_.stage(name, value);
     line.kv(std::string(name) + "_ms", value * 1e3);
   }
-  if (!status.ok()) line.kv("message", user_text(status.error_message(), 2000));
-  return status;
+  if (!ok) line.kv("message", user_text(std::string(message), 2000));
 }
 
 }  // namespace primlabel::server

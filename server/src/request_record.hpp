@@ -2,11 +2,10 @@
 // One RPC's id, what it labeled and how long each stage took; on finish() it writes the
 // request's log line and its metrics.
 
-#include <grpcpp/support/status.h>
-
 #include <chrono>
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "server_metrics.hpp"
 #include "stage_times.hpp"
@@ -36,8 +35,10 @@ class RequestRecord {
   std::uint64_t points = 0, dropped_non_finite = 0;
   StageTimes stages;
 
-  // Logs and counts the request once; returns `status` for `return record.finish(...)`.
-  grpc::Status finish(const grpc::Status& status);
+  // Logs and counts the request once, with its outcome: the status code's name ("OK",
+  // "INVALID_ARGUMENT", ...) and, when it failed, the message. The RPC edge calls it
+  // (finish_request in grpc_status.hpp).
+  void finish(std::string_view code, std::string_view message);
 
  private:
   std::string method_;

@@ -1,13 +1,12 @@
 #pragma once
 // What the RPC handlers share: configuration, the model registry, admission (compute slots),
 // the receiving-stream budget, the request gauge, the timer thread and the idle memory trim,
-// metrics, auth and whether
-// the server is draining. Owned by LabelServer, which outlives every handler.
+// metrics, the RPC edge's authenticator (declared only: the service layer never calls it) and
+// whether the server is draining. Owned by LabelServer, which outlives every handler.
 
 #include <atomic>
 
 #include "admission.hpp"
-#include "auth.hpp"
 #include "free_memory.hpp"
 #include "model_registry.hpp"
 #include "request_gauge.hpp"
@@ -17,6 +16,8 @@
 #include "timer_service.hpp"
 
 namespace primlabel::server {
+
+class TokenAuth;  // auth.hpp, at the RPC edge
 
 struct ServiceEnvironment {
   const ServerConfig* config = nullptr;
