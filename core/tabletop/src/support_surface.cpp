@@ -72,24 +72,22 @@ std::size_t support_count(const std::vector<Vec3f>& points, const std::vector<st
   return held;
 }
 
-std::vector<Eigen::Vector4f> further_horizontal_planes(const std::vector<Vec3f>& points,
-                                                       const std::vector<std::uint32_t>& indices,
-                                                       const PlaneFit& dominant,
-                                                       const PlaneFitOptions& fit_options,
-                                                       const SupportOptions& options,
-                                                       const RunContext& context) {
+std::vector<Eigen::Vector4f> further_horizontal_planes(
+    const std::vector<Vec3f>& points, const std::vector<std::uint32_t>& indices,
+    const Eigen::Vector4f& dominant, const std::vector<std::uint32_t>& inliers,
+    const PlaneFitOptions& fit_options, const SupportOptions& options, const RunContext& context) {
   std::vector<Eigen::Vector4f> planes;
   if (!options.enabled) return planes;
   PlaneFitOptions further = fit_options;
-  further.axis = dominant.plane.head<3>();
+  further.axis = dominant.head<3>();
   further.max_angle_deg = options.parallel_deg;
   further.max_scoring_points = options.scoring_points;
-  further.min_inliers = std::max(fit_options.min_inliers,
-                                 static_cast<std::size_t>(std::ceil(
-                                     options.min_point_share * double(dominant.inliers.size()))));
+  further.min_inliers = std::max(
+      fit_options.min_inliers,
+      static_cast<std::size_t>(std::ceil(options.min_point_share * double(inliers.size()))));
   std::vector<std::uint32_t> remaining;
-  std::set_difference(indices.begin(), indices.end(), dominant.inliers.begin(),
-                      dominant.inliers.end(), std::back_inserter(remaining));
+  std::set_difference(indices.begin(), indices.end(), inliers.begin(), inliers.end(),
+                      std::back_inserter(remaining));
   for (int k = 1; k < options.max_candidates && remaining.size() >= further.min_inliers; ++k) {
     const PlaneFit fit = fit_plane(points, remaining, further, context);
     if (fit.status != PlaneFitStatus::kOk) break;

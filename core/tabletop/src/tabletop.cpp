@@ -213,11 +213,10 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
     return fail(failed);
   }
   {
-    PlaneFit oriented = fit;
-    oriented.plane = plane;
     std::size_t best_support = support_count(xyz, valid, surface, rules, options.support);
-    for (const Eigen::Vector4f& candidate : further_horizontal_planes(
-             fit_points, fit_indices, oriented, plane_options, options.support, context)) {
+    for (const Eigen::Vector4f& candidate :
+         further_horizontal_planes(fit_points, fit_indices, plane, fit.inliers, plane_options,
+                                   options.support, context)) {
       context.throw_if_stopped(kWhat);
       TableSurface other = table_surface(xyz, valid, candidate, rules);
       const std::size_t support = support_count(xyz, valid, other, rules, options.support);
@@ -233,7 +232,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   result.tilt_deg = angle_between_deg(plane.head<3>(), prior);
   const std::vector<float>& height = surface.height;
   const PlaneGrid& band_grid = *surface.band_grid;
-  std::vector<std::uint8_t>& is_table = surface.is_table;
+  const std::vector<std::uint8_t>& is_table = surface.is_table;
   result.table_inliers = surface.inliers;
 
   Vec3f u, v;
@@ -246,7 +245,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   context.throw_if_stopped(kWhat);
   // 4. Objects: what stands on the table, inside its boundary, grouped by proximity.
   const auto objects_start = Clock::now();
-  const float min_height = options.min_object_height.value_or(-options.table_band);
+  const float min_height = rules.min_height;
   // Below the table inside its boundary is only the table seen through depth noise.
   std::vector<std::uint32_t> candidates, below_table;
   for (std::uint32_t i : valid) {

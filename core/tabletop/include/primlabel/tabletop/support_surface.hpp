@@ -69,13 +69,11 @@ std::size_t support_count(const std::vector<Vec3f>& points, const std::vector<st
                           const TableSurface& surface, const SurfaceRules& rules,
                           const SupportOptions& options);
 
-// Further horizontal planes among points[indices] off `dominant` (its inliers excluded), each
-// parallel to it within options.parallel_deg and oriented like it; largest first.
-std::vector<Eigen::Vector4f> further_horizontal_planes(const std::vector<Vec3f>& points,
-                                                       const std::vector<std::uint32_t>& indices,
-                                                       const PlaneFit& dominant,
-                                                       const PlaneFitOptions& fit_options,
-                                                       const SupportOptions& options,
-                                                       const RunContext& context);
+// Further horizontal planes among points[indices] off the dominant plane (its inliers, ascending,
+// excluded), each parallel to it within options.parallel_deg and oriented like it; largest first.
+std::vector<Eigen::Vector4f> further_horizontal_planes(
+    const std::vector<Vec3f>& points, const std::vector<std::uint32_t>& indices,
+    const Eigen::Vector4f& dominant, const std::vector<std::uint32_t>& inliers,
+    const PlaneFitOptions& fit_options, const SupportOptions& options, const RunContext& context);
 
 }  // namespace primlabel::tabletop
