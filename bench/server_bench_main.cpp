@@ -27,14 +27,14 @@
 #include <stop_token>
 #include <thread>
 
-#include "label_server.hpp"
 #include "label_stages.hpp"
-#include "logging.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/json_text.hpp"
+#include "primlabel/ops/logging.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
+#include "primlabel/rpc/label_server.hpp"
 #include "primlabel/scrape/exposition_parser.hpp"
 #include "primlabel/synth/generate.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"

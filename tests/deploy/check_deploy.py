@@ -469,7 +469,7 @@ def check_dockerignore(root):
                      "out/scan_labeled.pcd"):
         problems.check(dockerignored(rules, left_out), ".dockerignore keeps %s" % left_out)
     for needed in ("CMakeLists.txt", "deploy/setup.sh", "deploy/make-default-model.sh",
-                   "deploy/Dockerfile", "core/CMakeLists.txt", "server/src/server_main.cpp",
+                   "deploy/Dockerfile", "core/CMakeLists.txt", "server/server_main.cpp",
                    "client/CMakeLists.txt", "proto/primlabel/v1/model.proto",
                    # the committed real-trained depth-camera model and its checksum
                    "deploy/models/tabletop-kinect.plm", "deploy/models/tabletop-kinect.plm.sha256"):

@@ -1,13 +1,13 @@
 #pragma once
-// The server's request decoding without the transport, as server/src/label_service.cpp does it:
-// check_header, then a ScanAssembler over every chunk, then finish(), stopping at the first
-// refusal. This is the only file that knows what the assembler returns.
+// The server's request decoding without the transport, as server/service/src/labeling_session.cpp
+// does it: check_header, then a ScanAssembler over every chunk, then finish(), stopping at the
+// first refusal. This is the only file that knows what the assembler returns.
 
 #include <optional>
 #include <vector>
 
+#include "primlabel/service/scan_assembler.hpp"
 #include "primlabel/v1/labeling.pb.h"
-#include "scan_assembler.hpp"
 
 namespace primlabel::fuzz {
 

@@ -7,7 +7,7 @@
 #include <future>
 #include <thread>
 
-#include "admission.hpp"
+#include "primlabel/service/admission.hpp"
 
 namespace primlabel::server {
 namespace {

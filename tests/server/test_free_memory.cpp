@@ -5,7 +5,7 @@
 #include <chrono>
 #include <thread>
 
-#include "free_memory.hpp"
+#include "primlabel/service/free_memory.hpp"
 
 namespace primlabel::server {
 namespace {

@@ -10,7 +10,7 @@
 #include <sstream>
 #include <thread>
 
-#include "model_registry.hpp"
+#include "primlabel/service/model_registry.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {

@@ -2,11 +2,14 @@
 // reload of changed files, failed loads keep the old version, removed directories, admin
 // load/unload, and names that would escape the repository.
 
+#include <gtest/gtest.h>
+
 #include <fstream>
 #include <thread>
 
-#include "model_registry.hpp"
-#include "server_test_util.hpp"
+#include "model_repository_util.hpp"
+#include "primlabel/service/model_registry.hpp"
+#include "random_label_model.hpp"
 
 namespace primlabel::servertest {
 namespace {

@@ -6,8 +6,8 @@
 #include <set>
 #include <string>
 
+#include "primlabel/ops/stage_times.hpp"
 #include "primlabel/wire/status_names.hpp"
-#include "stage_times.hpp"
 
 namespace primlabel::server {
 namespace {

@@ -10,10 +10,10 @@
 #include <regex>
 #include <set>
 
-#include "metrics_endpoint.hpp"
-#include "proc_self.hpp"
-#include "process_collector.hpp"
-#include "server_metrics.hpp"
+#include "primlabel/ops/metrics_endpoint.hpp"
+#include "primlabel/ops/proc_self.hpp"
+#include "primlabel/ops/process_collector.hpp"
+#include "primlabel/ops/server_metrics.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {

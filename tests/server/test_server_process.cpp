@@ -13,7 +13,7 @@
 #include <sstream>
 #include <thread>
 
-#include "metrics_endpoint.hpp"
+#include "primlabel/ops/metrics_endpoint.hpp"
 #include "proc_status.hpp"
 #include "server_test_util.hpp"
 

@@ -5,8 +5,8 @@
 
 #include <cmath>
 
-#include "label_job.hpp"
 #include "primitives/primitive_samples.hpp"
+#include "primlabel/service/label_job.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {

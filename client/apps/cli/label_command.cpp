@@ -10,7 +10,7 @@
 #include "common/labeled_output.hpp"
 #include "common/object_json.hpp"
 #include "common/primitive_json.hpp"
-#include "exit_codes.hpp"
+#include "status_exit_codes.hpp"
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"

@@ -6,7 +6,7 @@
 
 #include "commands.hpp"
 #include "common/human_format.hpp"
-#include "exit_codes.hpp"
+#include "status_exit_codes.hpp"
 
 namespace primlabel::client::tools {
 

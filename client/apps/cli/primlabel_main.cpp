@@ -14,7 +14,7 @@
 
 #include "commands.hpp"
 #include "common/client_flags.hpp"
-#include "exit_codes.hpp"
+#include "status_exit_codes.hpp"
 #include "primlabel/build_version.hpp"
 
 using namespace primlabel::client;

@@ -1,0 +1,188 @@
+#include "primlabel/service/label_job.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <new>
+#include <stdexcept>
+
+#include "primlabel/geometry/cloud_signature.hpp"
+#include "primlabel/service/registry_error.hpp"
+#include "primlabel/tabletop/tabletop.hpp"
+
+namespace primlabel::server {
+
+std::vector<const ModelEntry*> LabelPlan::possible_models() const {
+  if (entry) return {entry.get()};
+  std::vector<const ModelEntry*> models;
+  for (const auto& candidate : candidates)
+    for (const pipeline::ModelCandidate& open : chooser->remaining())
+      if (candidate->name == open.name) models.push_back(candidate.get());
+  return models;
+}
+
+namespace {
+
+// Takes the chooser's decision into the plan: the entry it names, or NOT_FOUND.
+std::optional<ServiceError> apply_choice(LabelPlan& plan) {
+  const pipeline::ModelChoice& choice = plan.chooser->choice();
+  if (choice.model.empty())
+    return ServiceError{ErrorCode::kNotFound, "the request names no model and " + choice.why};
+  for (const auto& candidate : plan.candidates)
+    if (candidate->name == choice.model) plan.entry = candidate;
+  if (!plan.entry)  // the chooser only names candidates; a broken invariant, not the client's
+    return ServiceError{ErrorCode::kInternal, "the model chosen is not a candidate"};
+  plan.choice = choice.reason;
+  plan.choice_why = choice.why;
+  plan.candidates.clear();
+  plan.chooser.reset();
+  return std::nullopt;
+}
+
+// Every served model as a candidate of the choice, in the registry's (name) order.
+std::optional<ServiceError> start_choice(const pipeline::CloudShape& shape,
+                                         const ModelRegistry& registry, LabelPlan& plan) {
+  std::vector<pipeline::ModelCandidate> candidates;
+  for (const ServedModel& served : registry.list()) {
+    plan.candidates.push_back(served.served);
+    candidates.push_back({served.name, &served.served->model->training});
+  }
+  if (candidates.empty())
+    return ServiceError{ErrorCode::kNotFound,
+                        "the request names no model and the server has no model loaded"};
+  plan.chooser =
+      std::make_shared<pipeline::ModelChooser>(candidates, registry.default_model(), shape);
+  if (plan.chooser->decided()) return apply_choice(plan);
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelRegistry& registry,
+                                          LabelPlan& plan) {
+  const pipeline::CloudShape shape{header.layout().width(), header.layout().height()};
+  try {
+    if (!header.model().empty() || !header.model_version().empty()) {
+      // A version alone names a version of the default model, as before routing existed.
+      plan.entry = registry.resolve(header.model(), header.model_version());
+      plan.choice = header.model().empty() ? pipeline::ChoiceReason::kDefault
+                                           : pipeline::ChoiceReason::kNamed;
+      plan.choice_why =
+          header.model().empty() ? "a version of the default model" : "named by the request";
+      const pipeline::DomainVerdict verdict =
+          pipeline::judge_shape(plan.entry->model->training, shape);
+      if (verdict.fit == pipeline::DomainFit::kOutside)
+        plan.shape_warning = "the cloud is an organised " + std::to_string(shape.width) + "x" +
+                             std::to_string(shape.height) + " frame and this model was " +
+                             verdict.why + ": labels are unreliable; use a model for this sensor";
+    } else if (auto refused = start_choice(shape, registry, plan)) {
+      return refused;
+    }
+  } catch (const RegistryError& error) {
+    return registry_error(error);
+  }
+  const v1::LabelOptions& options = header.options();
+  for (const ModelEntry* entry : plan.possible_models()) {
+    const std::string which = "model '" + entry->name + "' version '" + entry->version + "'";
+    if ((options.normal_radius() > 0.0f || options.feature_radius() > 0.0f) &&
+        !entry->model->features.radii_overridable)
+      return ServiceError{ErrorCode::kInvalidArgument,
+                          which +
+                              " does not allow radius overrides (options.normal_radius / "
+                              "feature_radius)" +
+                              (plan.entry ? "" : "; name a model that does")};
+  }
+  if (options.return_objects() && !options.tabletop_only())
+    return ServiceError{ErrorCode::kInvalidArgument,
+                        "options.return_objects needs options.tabletop_only (the objects are "
+                        "those of the table-top stage)"};
+  plan.options.want_descriptors = options.return_descriptors();
+  plan.options.want_probabilities = options.return_probabilities();
+  plan.options.tabletop_only = options.tabletop_only();
+  plan.options.voxel_size = options.voxel_size();
+  plan.options.normal_radius = options.normal_radius();
+  plan.options.feature_radius = options.feature_radius();
+  plan.options.use_cloud_normals = header.layout().normals();
+  plan.options.want_primitives = options.return_primitives();
+  plan.options.want_objects = options.return_objects();
+  return std::nullopt;
+}
+
+std::optional<ServiceError> finish_model_choice(LabelPlan& plan, const PointCloud& cloud,
+                                                const RunContext& context) {
+  if (plan.entry) return std::nullopt;
+  const auto start = std::chrono::steady_clock::now();
+  plan.chooser->consider(measure_signature(cloud.xyz, cloud.viewpoint.origin, context));
+  plan.choice_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return apply_choice(plan);
+}
+
+std::uint64_t answer_bytes_per_point(const LabelPlan& plan) {
+  // Until the choice is made, the largest answer any candidate would give.
+  std::uint64_t model_bytes = 0;
+  for (const ModelEntry* entry : plan.possible_models()) {
+    const LabelModel& model = *entry->model;
+    std::uint64_t bytes = 0;
+    if (plan.options.want_descriptors)
+      bytes += sizeof(float) * std::uint64_t(model.features.descriptor_dim());
+    if (plan.options.want_probabilities) bytes += sizeof(float) * model.class_ids().size();
+    model_bytes = std::max(model_bytes, bytes);
+  }
+  std::uint64_t bytes = sizeof(std::uint32_t) + model_bytes;
+  if (plan.options.want_primitives) bytes += sizeof(std::uint32_t);  // LabelChunk.segments
+  if (plan.options.want_objects) {
+    bytes += sizeof(std::uint32_t);  // LabelChunk.objects
+    // Every object holds at least min_size points of the cloud (clusters smaller are dropped
+    // and the refinements only split off parts at least as large).
+    const std::uint64_t min_points =
+        std::max<std::size_t>(1, tabletop::TabletopOptions{}.clusters.min_size);
+    bytes += (kMaxObjectMessageBytes + min_points - 1) / min_points;
+  }
+  return bytes;
+}
+
+std::uint64_t answer_summary_bytes(const LabelPlan& plan) {
+  std::uint64_t bytes = 0;
+  const std::uint64_t segments = plan.options.primitives.segments.max_segments;
+  if (plan.options.want_primitives) bytes += segments * kMaxPrimitiveMessageBytes;
+  // The table, and each segment's id listed by at most one object (5 bytes a varint).
+  if (plan.options.want_objects)
+    bytes += kMaxTableMessageBytes + (plan.options.want_primitives ? 5 * segments : 0);
+  return bytes;
+}
+
+std::optional<ServiceError> run_label_job(LabelPlan& plan, PointCloud& cloud,
+                                          const RunContext& context,
+                                          pipeline::LabelingResult& result) {
+  try {
+    if (auto refused = finish_model_choice(plan, cloud, context)) return refused;
+    result = pipeline::label_cloud(*plan.entry->model, cloud, plan.options, context);
+    if (!plan.shape_warning.empty())
+      result.domain_warning = result.domain_warning.empty()
+                                  ? plan.shape_warning
+                                  : plan.shape_warning + "; " + result.domain_warning;
+    return std::nullopt;
+  } catch (const pipeline::Cancelled&) {
+    return ServiceError{ErrorCode::kCancelled, "labeling was cancelled"};
+  } catch (const std::invalid_argument& e) {
+    return ServiceError{ErrorCode::kInvalidArgument, e.what()};
+  } catch (const std::bad_alloc&) {
+    return ServiceError{ErrorCode::kResourceExhausted, "out of memory while labeling"};
+  } catch (const std::exception& e) {
+    return ServiceError{ErrorCode::kInternal, std::string("labeling failed: ") + e.what()};
+  } catch (...) {
+    return ServiceError{ErrorCode::kInternal, "labeling failed: an unknown exception"};
+  }
+}
+
+ServiceError server_busy(const Admission& admission) {
+  return {ErrorCode::kResourceExhausted,
+          "the server is busy: " + std::to_string(admission.admitted()) + " requests labeling (" +
+              std::to_string(admission.workers()) + " workers, " +
+              std::to_string(admission.capacity() - admission.workers()) +
+              " queued at most; --workers, --queue); retry later"};
+}
+
+ServiceError shutting_down() { return {ErrorCode::kUnavailable, "the server is shutting down"}; }
+
+}  // namespace primlabel::server
