@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "../test_util.hpp"
+#include "test_util.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 

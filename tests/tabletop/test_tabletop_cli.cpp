@@ -8,7 +8,7 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "../test_util.hpp"
+#include "test_util.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel {
