@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "labeling_options.hpp"
 #include "multi_scale_input.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
@@ -27,24 +28,6 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-// The model's feature settings with the request's radius overrides applied (a radius keeps the
-// model's neighbour cap when the model already used a radius).
-FeatureSettings effective_features(const LabelModel& model, const LabelingOptions& options) {
-  FeatureSettings settings = model.features;
-  settings.voxel_size = 0.0f;  // label_cloud downsamples itself
-  const bool overrides = options.normal_radius > 0.0f || options.feature_radius > 0.0f;
-  if (overrides && !model.features.radii_overridable)
-    throw std::invalid_argument("model '" + model.name + "' does not allow radius overrides");
-  auto override_radius = [](Neighborhood& neighborhood, float radius) {
-    if (!(radius > 0.0f)) return;
-    const int cap = neighborhood.radius > 0.0f ? neighborhood.max_neighbors : 0;
-    neighborhood = Neighborhood{radius, 0, cap};
-  };
-  override_radius(settings.normals, options.normal_radius);
-  override_radius(settings.features, options.feature_radius);
-  return settings;
 }
 
 // The primitives of the labeled input cloud, reusing the neighbour index, shared lists and point
@@ -296,14 +279,9 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
     throw std::invalid_argument("use_cloud_normals: the cloud has " +
                                 std::to_string(cloud.normals.size()) + " normals for " +
                                 std::to_string(cloud.size()) + " points");
-  if (!(options.voxel_size >= 0.0f) || !std::isfinite(options.voxel_size))
-    throw std::invalid_argument("voxel size must be finite and >= 0");
-  if (options.want_primitives) options.primitives.validate();  // before the costly part
-  if (options.want_objects && !options.tabletop_only)
-    throw std::invalid_argument("objects need the table-top stage (tabletop_only)");
+  validate(model, options);
   const FeatureSettings features = effective_features(model, options);
-  const float voxel_size =
-      options.voxel_size > 0.0f ? options.voxel_size : model.features.voxel_size;
+  const float voxel_size = effective_voxel_size(model, options);
   context.throw_if_stopped("labeling");
   LabelingResult result = voxel_size > 0.0f
                               ? label_voxels(model, features, cloud, voxel_size, options, context)
