@@ -6,6 +6,7 @@
 #include <cfloat>
 #include <chrono>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <stop_token>
 #include <string>
@@ -175,6 +176,24 @@ TEST(PipelineHostile, DuplicatesGetTheirFirstCopysResultsAndChangeNothingElse) {
     ASSERT_EQ(cloud.normals[n + c], cloud.normals[original[c]]);
   }
   EXPECT_EQ(map.representatives[map.slot_of[cloud.size() - 1]], 1u);
+}
+
+TEST(PipelineHostile, DuplicatesAmongSomePointsAreThoseOfThosePointsGathered) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  // Point 5 is point 2 with -0 (equal); points 0 and 6 are not among `some`.
+  const std::vector<Vec3f> xyz = {Vec3f(0, 0, 0),   Vec3f(1, 0, 0), Vec3f(0, 0, 0),
+                                  Vec3f(nan, 0, 0), Vec3f(1, 0, 0), Vec3f(-0.0f, 0, 0),
+                                  Vec3f(2, 0, 0)};
+  const std::vector<std::uint32_t> some = {1, 2, 3, 4, 5};
+  std::vector<Vec3f> gathered;
+  for (std::uint32_t i : some) gathered.push_back(xyz[i]);
+  const pipeline::DuplicateMap among = pipeline::find_duplicates(xyz, some);
+  const pipeline::DuplicateMap alone = pipeline::find_duplicates(gathered);
+  EXPECT_EQ(among.representatives, alone.representatives);
+  EXPECT_EQ(among.slot_of, alone.slot_of);
+  // Positions in `some`: the first copy of each position, the NaN point its own.
+  EXPECT_EQ(among.representatives, (std::vector<std::uint32_t>{0, 1, 2}));
+  EXPECT_EQ(among.slot_of, (std::vector<std::uint32_t>{0, 1, 2, 0, 1}));
 }
 
 TEST(PipelineHostile, HostileMixIsTheSameForOneAndTwoThreads) {

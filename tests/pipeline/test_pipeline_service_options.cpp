@@ -157,6 +157,36 @@ TEST(PipelineServiceOptions, RadiusOverridesOnlyWhenTheModelAllowsThem) {
   EXPECT_NE(wider.descriptors, own.descriptors);
 }
 
+// One check of the options, before any work, that a service can also run before the cloud comes.
+TEST(PipelineServiceOptions, ValidateRefusesWhatLabelCloudRefuses) {
+  LabelModel model = random_label_model();
+  const auto refused = [&](const pipeline::LabelingOptions& options) {
+    EXPECT_THROW(pipeline::validate(model, options), std::invalid_argument);
+    PointCloud cloud = table_with_box_cloud();
+    EXPECT_THROW(pipeline::label_cloud(model, cloud, options), std::invalid_argument);
+  };
+  pipeline::LabelingOptions options;
+  EXPECT_NO_THROW(pipeline::validate(model, options));
+  options.voxel_size = -0.01f;
+  refused(options);
+  options.voxel_size = std::numeric_limits<float>::infinity();
+  refused(options);
+  options = {};
+  options.want_primitives = true;
+  options.primitives.segments.min_points = 0;
+  refused(options);
+  options = {};
+  options.want_objects = true;
+  refused(options);
+  options.tabletop_only = true;
+  EXPECT_NO_THROW(pipeline::validate(model, options));
+  options = {};
+  options.normal_radius = 0.02f;
+  refused(options);
+  model.features.radii_overridable = true;
+  EXPECT_NO_THROW(pipeline::validate(model, options));
+}
+
 // feature_sample_size: every point keeps its own descriptor, computed against one point per
 // voxel, so descriptors change but stay close to the full ones; the same for any thread count.
 TEST(PipelineServiceOptions, SampledFpfhDescribesEveryPointAgainstOnePointPerVoxel) {

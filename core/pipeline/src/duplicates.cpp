@@ -26,10 +26,9 @@ std::uint64_t mix(std::uint64_t h) {
   return h ^ (h >> 31);
 }
 
-}  // namespace
-
-DuplicateMap find_duplicates(const std::vector<Vec3f>& xyz, const std::stop_token& stop) {
-  const std::size_t n = xyz.size();
+// The duplicate map of the points point(0) .. point(n - 1).
+template <typename PointAt>
+DuplicateMap find_duplicates_of(std::size_t n, const PointAt& point, const std::stop_token& stop) {
   if (n >= kEmpty) throw std::invalid_argument("find_duplicates: more than 2^32-2 points");
   DuplicateMap map;
   map.slot_of.resize(n);
@@ -39,7 +38,7 @@ DuplicateMap find_duplicates(const std::vector<Vec3f>& xyz, const std::stop_toke
   const std::uint64_t seed = (std::uint64_t(std::random_device{}()) << 32) ^ std::random_device{}();
   for (std::size_t i = 0; i < n; ++i) {
     if (i % kCheckEvery == 0) throw_if_stopped(stop, "finding duplicate points");
-    const Vec3f& p = xyz[i];
+    const Vec3f& p = point(i);
     if (!is_finite(p)) {  // never equal to anything: its own representative
       map.slot_of[i] = static_cast<std::uint32_t>(map.representatives.size());
       map.representatives.push_back(static_cast<std::uint32_t>(i));
@@ -51,7 +50,7 @@ DuplicateMap find_duplicates(const std::vector<Vec3f>& xyz, const std::stop_toke
     std::size_t slot = h & (slots - 1);
     while (table[slot] != kEmpty) {
       const std::uint32_t j = table[slot];
-      if (xyz[j] == p) break;  // float equality: -0 == +0
+      if (point(j) == p) break;  // float equality: -0 == +0
       slot = (slot + 1) & (slots - 1);
     }
     if (table[slot] == kEmpty) {
@@ -65,6 +64,19 @@ DuplicateMap find_duplicates(const std::vector<Vec3f>& xyz, const std::stop_toke
     }
   }
   return map;
+}
+
+}  // namespace
+
+DuplicateMap find_duplicates(const std::vector<Vec3f>& xyz, const std::stop_token& stop) {
+  return find_duplicates_of(
+      xyz.size(), [&](std::size_t i) -> const Vec3f& { return xyz[i]; }, stop);
+}
+
+DuplicateMap find_duplicates(const std::vector<Vec3f>& xyz, std::span<const std::uint32_t> indices,
+                             const std::stop_token& stop) {
+  return find_duplicates_of(
+      indices.size(), [&](std::size_t k) -> const Vec3f& { return xyz[indices[k]]; }, stop);
 }
 
 }  // namespace primlabel::pipeline

@@ -5,6 +5,7 @@
 // representative per position, the lowest index, and gives every copy its results.
 
 #include <cstdint>
+#include <span>
 #include <stop_token>
 #include <vector>
 
@@ -24,5 +25,11 @@ struct DuplicateMap {
 // input can force its collisions; the result does not depend on the seed). Checks `stop` every
 // 64k points and throws Cancelled.
 DuplicateMap find_duplicates(const std::vector<Vec3f>& xyz, const std::stop_token& stop = {});
+
+// The same among the points xyz[indices[k]] only, without copying them out: `representatives`
+// and `slot_of` then hold positions k in `indices` (with ascending indices a representative is
+// still the copy of lowest index).
+DuplicateMap find_duplicates(const std::vector<Vec3f>& xyz, std::span<const std::uint32_t> indices,
+                             const std::stop_token& stop = {});
 
 }  // namespace primlabel::pipeline

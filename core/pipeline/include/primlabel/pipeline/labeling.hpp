@@ -133,12 +133,18 @@ struct LabelingResult {
   std::optional<tabletop::TabletopObjects> objects;
 };
 
+// Throws std::invalid_argument, naming the option, when label_cloud cannot honour `options` with
+// `model`: a voxel size below 0 or not finite, invalid primitive options, objects without the
+// table-top stage, radius overrides the model does not allow. label_cloud checks it before any
+// work; a caller can check it before it has the cloud.
+void validate(const LabelModel& model, const LabelingOptions& options);
+
 // Labels every point with the model's own feature, graph and inference settings (and the
 // overrides in `options`). Points with non-finite coordinates or no descriptor get class 0.
 // Exact duplicates are described once (duplicates.hpp): every copy gets the labels,
 // probabilities, descriptor and normal of its lowest-index copy.
 // Throws ModelError when an SVM model's libsvm text does not load, std::invalid_argument for
-// overrides the model does not allow, missing normals or want_objects without tabletop_only, and
+// options validate() refuses or a missing normal per point with use_cloud_normals, and
 // Cancelled when context.stop is requested (checked between stages and per point inside them, the
 // table-top stage, the voxel filter and the index builds included: within milliseconds). The labels
 // (and primitives) do not depend on context.threads.

@@ -1,0 +1,160 @@
+// The plan of label_cloud: voxels, the table-top stage and exact duplicates composed into one slot
+// per input point, and the one cloud of slots to describe.
+
+#include "labeling_plan.hpp"
+
+#include <chrono>
+#include <limits>
+#include <numeric>
+#include <optional>
+
+#include "primlabel/pipeline/duplicates.hpp"
+#include "primlabel/tabletop/tabletop.hpp"
+
+namespace primlabel::pipeline {
+
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Voxel centroids, with the mean of the members' normals (normalised) when the cloud's own
+// normals are used.
+PointCloud voxel_cloud(const PointCloud& cloud, const tabletop::VoxelGrid& grid,
+                       bool with_normals) {
+  PointCloud voxels;
+  voxels.resize_unorganized(grid.centroids.size());
+  voxels.xyz = grid.centroids;
+  voxels.viewpoint = cloud.viewpoint;
+  if (!with_normals) return voxels;
+  voxels.normals.assign(grid.centroids.size(), Vec3f::Constant(kNaN));
+  for (std::size_t v = 0; v < grid.centroids.size(); ++v) {
+    Vec3f sum = Vec3f::Zero();
+    for (std::uint32_t m = grid.member_offsets[v]; m < grid.member_offsets[v + 1]; ++m) {
+      const Vec3f& n = cloud.normals[grid.members[m]];
+      if (is_finite(n)) sum += n;
+    }
+    if (sum.norm() > 0.0f) voxels.normals[v] = sum.normalized();
+  }
+  return voxels;
+}
+
+// The points `indices` of `cloud` as a cloud of their own (unorganised, same viewpoint), with
+// their normals when the cloud's own normals are used.
+PointCloud gather(const PointCloud& cloud, const std::vector<std::uint32_t>& indices,
+                  bool with_normals) {
+  PointCloud part;
+  part.resize_unorganized(indices.size());
+  part.viewpoint = cloud.viewpoint;
+  for (std::size_t j = 0; j < indices.size(); ++j) part.xyz[j] = cloud.xyz[indices[j]];
+  if (with_normals) {
+    part.normals.resize(indices.size());
+    for (std::size_t j = 0; j < indices.size(); ++j) part.normals[j] = cloud.normals[indices[j]];
+  }
+  return part;
+}
+
+// The points a table-top mask keeps, ascending, and per point its position among them.
+struct Kept {
+  std::vector<std::uint32_t> points;
+  std::vector<std::uint32_t> position_of;  // kNoSlot: not kept
+};
+
+Kept kept_points(const std::vector<std::uint8_t>& mask) {
+  Kept kept;
+  kept.position_of.assign(mask.size(), kNoSlot);
+  for (std::size_t i = 0; i < mask.size(); ++i)
+    if (mask[i]) {
+      kept.position_of[i] = static_cast<std::uint32_t>(kept.points.size());
+      kept.points.push_back(static_cast<std::uint32_t>(i));
+    }
+  return kept;
+}
+
+// The object ids of the table-top stage's points carried to the input points they stand for
+// (`voxel_of_point`: per input point its voxel; null when the stage saw the input itself).
+tabletop::TabletopObjects objects_of_input(tabletop::TabletopObjects objects,
+                                           const std::vector<std::uint32_t>* voxel_of_point) {
+  if (!voxel_of_point) return objects;
+  std::vector<std::uint32_t> ids(voxel_of_point->size(), tabletop::kNoObject);
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if ((*voxel_of_point)[i] != kNoSlot) ids[i] = objects.point_object[(*voxel_of_point)[i]];
+  objects.point_object = std::move(ids);
+  return objects;
+}
+
+// Sends every slot through the next map (kNoSlot stays).
+void compose(std::vector<std::uint32_t>& slot_of, const std::vector<std::uint32_t>& next) {
+  for (std::uint32_t& slot : slot_of)
+    if (slot != kNoSlot) slot = next[slot];
+}
+
+std::vector<std::uint32_t> identity(std::size_t n) {
+  std::vector<std::uint32_t> map(n);
+  std::iota(map.begin(), map.end(), 0u);
+  return map;
+}
+
+}  // namespace
+
+LabelingPlan plan_labeling(const PointCloud& cloud, float voxel_size,
+                           const LabelingOptions& options, const RunContext& context) {
+  LabelingPlan plan;
+  const bool with_normals = options.use_cloud_normals;
+  const auto start = std::chrono::steady_clock::now();
+
+  // 1. Voxels: a centroid stands for its voxel's members (non-finite points are in none).
+  std::optional<PointCloud> voxels;
+  std::vector<std::uint32_t> voxel_of_point;
+  if (voxel_size > 0.0f) {
+    tabletop::VoxelGrid grid = tabletop::voxel_downsample(
+        cloud.xyz, tabletop::finite_indices(cloud.xyz), voxel_size, context);
+    voxels = voxel_cloud(cloud, grid, with_normals);
+    voxel_of_point = std::move(grid.voxel_of_point);
+    plan.voxel_seconds = seconds_since(start);
+    context.throw_if_stopped("labeling");
+  }
+  const PointCloud& base = voxels ? *voxels : cloud;
+
+  // 2. The table-top stage, on the voxels when there are: only its table and objects are kept.
+  std::optional<Kept> kept;
+  if (options.tabletop_only) {
+    const tabletop::TabletopResult segmented =
+        tabletop::segment_tabletop(base, tabletop::TabletopOptions{}, context);
+    kept = kept_points(tabletop::tabletop_mask(segmented, base.size()));
+    if (options.want_objects)
+      plan.objects = objects_of_input(tabletop::object_ids(segmented, base.size()),
+                                      voxels ? &voxel_of_point : nullptr);
+  }
+  plan.prefilter_seconds = seconds_since(start);
+  context.throw_if_stopped("labeling");
+
+  // 3. Exact duplicates among the kept points: one slot per position.
+  const DuplicateMap duplicates = kept ? find_duplicates(base.xyz, kept->points, context.stop)
+                                       : find_duplicates(base.xyz, context.stop);
+  plan.merges_points = voxels || duplicates.any();
+  if (!voxels && !kept && !duplicates.any()) {
+    plan.in_place = true;
+    return plan;
+  }
+
+  // 4. Per input point its slot: input -> voxel -> kept point -> distinct position.
+  plan.slot_of = voxels ? std::move(voxel_of_point) : identity(cloud.size());
+  if (kept) compose(plan.slot_of, kept->position_of);
+  compose(plan.slot_of, duplicates.slot_of);
+
+  // 5. The one cloud to describe: every slot's representative.
+  if (voxels && !kept && !duplicates.any()) {
+    plan.described = std::move(*voxels);  // every voxel is its own slot
+    return plan;
+  }
+  std::vector<std::uint32_t> representatives = duplicates.representatives;
+  if (kept) compose(representatives, kept->points);
+  plan.described = gather(base, representatives, with_normals);
+  return plan;
+}
+
+}  // namespace primlabel::pipeline
