@@ -1,4 +1,4 @@
-// primlabel-bench-can-radii: on real mOSD scenes, the radius of each can as the labeling service
+// primlabel-bench can-radii: on real mOSD scenes, the radius of each can as the labeling service
 // would report it against the fitted ground truth (research/mosd_truth.hpp). Each scene is
 // labeled table-top only with objects and primitives (what a robot asks for); each object segment
 // the truth fits as a cylinder is matched to the table-top object holding most of its points,
@@ -7,7 +7,7 @@
 // radius across scenes for cans that look alike (truth radius within 3 mm and length within
 // 1 cm: most likely the same can seen again), and the summary. Last line: JSON.
 //
-//   primlabel-bench-can-radii --model build/models/tabletop-kinect/1/model.plm \
+//   primlabel-bench can-radii --model build/models/tabletop-kinect/1/model.plm \
 //       ../shared/data/mosd/learn*.pcd
 
 #include <CLI/CLI.hpp>
@@ -16,10 +16,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 
-#include "primlabel/build_version.hpp"
-#include "primlabel/cli/exit_codes.hpp"
+#include "bench_commands.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/model/label_model.hpp"
@@ -134,7 +134,7 @@ std::vector<CanRow> scene_cans(const LabelModel& model, const std::string& path,
   return rows;
 }
 
-int run(const Arguments& args) {
+int run_can_radii_bench(const Arguments& args) {
   const LabelModel model = load_model(args.model);
   const RunContext context{args.threads, {}, {}};
   std::vector<CanRow> rows;
@@ -238,26 +238,17 @@ int run(const Arguments& args) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  CLI::App app{
-      "Can radii on real mOSD scenes: the service's fitted cylinders vs the fitted truth."};
-  app.set_version_flag("--version", primlabel::version_line("primlabel-bench-can-radii"));
-  app.name("primlabel-bench-can-radii");
-  Arguments args;
-  app.add_option("--model", args.model, "Kinect model file (tabletop-kinect)")->required();
-  app.add_option("SCENE", args.scenes, "mOSD scenes (.pcd with the label field)")->required();
-  app.add_option("--threads", args.threads, "worker threads")->check(CLI::PositiveNumber);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "primlabel-bench-can-radii: usage error: %s\n", e.what());
-    return primlabel::kExitUsage;
-  }
-  try {
-    return run(args);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "primlabel-bench-can-radii: error: %s\n", e.what());
-    return primlabel::kExitFailure;
-  }
+namespace primlabel::bench {
+
+BenchCommand add_can_radii_command(CLI::App& parent) {
+  auto args = std::make_shared<Arguments>();
+  CLI::App* cmd = parent.add_subcommand(
+      "can-radii",
+      "Can radii on real mOSD scenes: the service's fitted cylinders vs the fitted truth.");
+  cmd->add_option("--model", args->model, "Kinect model file (tabletop-kinect)")->required();
+  cmd->add_option("SCENE", args->scenes, "mOSD scenes (.pcd with the label field)")->required();
+  cmd->add_option("--threads", args->threads, "worker threads")->check(CLI::PositiveNumber);
+  return {cmd, [args] { return run_can_radii_bench(*args); }};
 }
+
+}  // namespace primlabel::bench

@@ -1,11 +1,11 @@
-// primlabel-bench-crf: points/s of crf::infer on a synthetic scene shaped like a real scan's CRF
+// primlabel-bench crf: points/s of crf::infer on a synthetic scene shaped like a real scan's CRF
 // (Rusu et al. 2009 report 76,997 points/s): points on a jittered grid, descriptors = one of K
 // class prototypes + noise (d = 33), kNN-8 graph, and a hand-made model (nearest-prototype node
 // weights, edge weights with random feature terms) or one trained by pseudo-likelihood on a
 // smaller scene of the same family. Prints, never asserts; the last line is JSON. On a busy
 // machine compare cpu_ms at 1 thread (OMP_WAIT_POLICY=passive keeps spinning out of cpu_ms).
 //
-//   primlabel-bench-crf --points 70225 --threads 1,2 --repeat 5
+//   primlabel-bench crf --points 70225 --threads 1,2 --repeat 5
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -13,13 +13,13 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <memory>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "primlabel/build_version.hpp"
-#include "primlabel/cli/exit_codes.hpp"
+#include "bench_commands.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
 #include "primlabel/geometry/json_text.hpp"
@@ -79,33 +79,7 @@ double accuracy(const InferenceResult& r, const LabeledGraph& scene) {
   return r.labels.empty() ? 0.0 : double(correct) / double(r.labels.size());
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  Arguments args;
-  CLI::App app{"CRF inference throughput (points/s) on a synthetic kNN scene"};
-  app.set_version_flag("--version", primlabel::version_line("primlabel-bench-crf"));
-  // Every option with a default shows it in --help ("[0.025]").
-  app.option_defaults()->always_capture_default();
-  app.add_option("--points", args.points, "points in the test scene (a square grid)");
-  app.add_option("--classes", args.classes, "classes K");
-  app.add_option("--neighbors", args.neighbors, "k of the kNN graph");
-  app.add_option("--noise", args.noise, "descriptor noise (prototype values are in [0, 100])");
-  app.add_option("--threads", args.threads, "thread counts to measure")->delimiter(',');
-  app.add_option("--repeat", args.repeat, "timed runs per case (the median is reported)");
-  app.add_option("--model", args.model,
-                 "prototype (hand-made, feature-dependent couplings), potts (one coupling, as "
-                 "piecewise training makes) or trained (pseudo-likelihood)")
-      ->check(CLI::IsMember({"prototype", "potts", "trained"}));
-  app.add_option("--methods", args.methods, "bp-sum,bp-max,mean-field,node-only")->delimiter(',');
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "primlabel-bench-crf: usage error: %s (see --help)\n", e.what());
-    return primlabel::kExitUsage;
-  }
-
+int run_crf_bench(const Arguments& args) {
   testing::SceneSpec spec;
   spec.width = std::max(4, static_cast<int>(std::lround(std::sqrt(double(args.points)))));
   spec.height = spec.width;
@@ -233,3 +207,27 @@ int main(int argc, char** argv) {
   std::printf("%s\n", json::dump(line).c_str());
   return 0;
 }
+
+}  // namespace
+
+namespace primlabel::bench {
+
+BenchCommand add_crf_command(CLI::App& parent) {
+  auto args = std::make_shared<Arguments>();
+  CLI::App* cmd =
+      parent.add_subcommand("crf", "CRF inference throughput (points/s) on a synthetic kNN scene");
+  cmd->add_option("--points", args->points, "points in the test scene (a square grid)");
+  cmd->add_option("--classes", args->classes, "classes K");
+  cmd->add_option("--neighbors", args->neighbors, "k of the kNN graph");
+  cmd->add_option("--noise", args->noise, "descriptor noise (prototype values are in [0, 100])");
+  cmd->add_option("--threads", args->threads, "thread counts to measure")->delimiter(',');
+  cmd->add_option("--repeat", args->repeat, "timed runs per case (the median is reported)");
+  cmd->add_option("--model", args->model,
+                  "prototype (hand-made, feature-dependent couplings), potts (one coupling, as "
+                  "piecewise training makes) or trained (pseudo-likelihood)")
+      ->check(CLI::IsMember({"prototype", "potts", "trained"}));
+  cmd->add_option("--methods", args->methods, "bp-sum,bp-max,mean-field,node-only")->delimiter(',');
+  return {cmd, [args] { return run_crf_bench(*args); }};
+}
+
+}  // namespace primlabel::bench

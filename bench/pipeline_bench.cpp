@@ -1,4 +1,4 @@
-// primlabel-bench-pipeline: points/s of pipeline::label_cloud end to end (normals, FPFH, CRF graph
+// primlabel-bench pipeline: points/s of pipeline::label_cloud end to end (normals, FPFH, CRF graph
 // and inference) on one held-out synthetic scene per sensor: an LMS400 table scan (~85k points)
 // and a Kinect frame (640x480, NaN misses included in the point count). The model is --model, or
 // one made here per sensor the way primlabel-train's calibration usually ends: node-only weights
@@ -10,8 +10,8 @@
 // LMS400 scene and on hostile inputs (100k coincident points, 20k points in a 1 mm cube, both on
 // a small table) and prints the p50 / p99 / max time from the stop request to the return.
 //
-//   primlabel-bench-pipeline --threads 1,2 --repeat 3
-//   primlabel-bench-pipeline --stop-latency 20
+//   primlabel-bench pipeline --threads 1,2 --repeat 3
+//   primlabel-bench pipeline --stop-latency 20
 
 #include <sys/resource.h>
 
@@ -20,6 +20,7 @@
 #include <chrono>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <random>
 #include <sstream>
@@ -28,9 +29,8 @@
 #include <thread>
 #include <vector>
 
+#include "bench_commands.hpp"
 #include "label_stages.hpp"
-#include "primlabel/build_version.hpp"
-#include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
@@ -244,7 +244,7 @@ int run_stop_latency(const Arguments& args) {
   return 0;
 }
 
-int run(const Arguments& args) {
+int run_pipeline_bench(const Arguments& args) {
   if (args.stop_latency > 0) return run_stop_latency(args);
   std::optional<LabelModel> given;
   if (!args.model.empty()) given = load_model(args.model);
@@ -306,42 +306,31 @@ int run(const Arguments& args) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  CLI::App app{
-      "End-to-end labeling throughput (label_cloud) on synthetic LMS400 and Kinect scenes."};
-  app.set_version_flag("--version", primlabel::version_line("primlabel-bench-pipeline"));
-  // Every option with a default shows it in --help ("[0.025]").
-  app.option_defaults()->always_capture_default();
-  app.name("primlabel-bench-pipeline");
-  Arguments args;
-  app.add_option("--model", args.model, "model file (default: a quick model per sensor)");
-  app.add_option("--sensors", args.sensors, "lms400 and/or kinect (default both)")
+namespace primlabel::bench {
+
+BenchCommand add_pipeline_command(CLI::App& parent) {
+  auto args = std::make_shared<Arguments>();
+  CLI::App* cmd = parent.add_subcommand(
+      "pipeline",
+      "End-to-end labeling throughput (label_cloud) on synthetic LMS400 and Kinect scenes.");
+  cmd->add_option("--model", args->model, "model file (default: a quick model per sensor)");
+  cmd->add_option("--sensors", args->sensors, "lms400 and/or kinect (default both)")
       ->delimiter(',')
       ->check(CLI::IsMember({"lms400", "kinect"}));
-  app.add_option("--threads", args.threads, "thread counts, e.g. 1,2 (default 2)")
+  cmd->add_option("--threads", args->threads, "thread counts, e.g. 1,2 (default 2)")
       ->delimiter(',')
       ->check(CLI::PositiveNumber);
-  app.add_option("--voxel-size", args.voxel_sizes,
-                 "voxel sizes (m), e.g. 0,0.005; 0 = full resolution (default: the model's own)")
+  cmd->add_option("--voxel-size", args->voxel_sizes,
+                  "voxel sizes (m), e.g. 0,0.005; 0 = full resolution (default: the model's own)")
       ->delimiter(',');
-  app.add_flag("--compare-unshared", args.compare_unshared,
-               "also run every case with each stage searching itself (no shared neighbour lists)");
-  app.add_option("--repeat", args.repeat, "runs per case, the fastest counts (default 1)")
+  cmd->add_flag("--compare-unshared", args->compare_unshared,
+                "also run every case with each stage searching itself (no shared neighbour lists)");
+  cmd->add_option("--repeat", args->repeat, "runs per case, the fastest counts (default 1)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--stop-latency", args.stop_latency,
-                 "instead: stop this many runs per input at random moments, print the latency")
+  cmd->add_option("--stop-latency", args->stop_latency,
+                  "instead: stop this many runs per input at random moments, print the latency")
       ->check(CLI::PositiveNumber);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "primlabel-bench-pipeline: usage error: %s (see --help)\n", e.what());
-    return primlabel::kExitUsage;
-  }
-  try {
-    return run(args);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "primlabel-bench-pipeline: error: %s\n", e.what());
-    return primlabel::kExitFailure;
-  }
+  return {cmd, [args] { return run_pipeline_bench(*args); }};
 }
+
+}  // namespace primlabel::bench

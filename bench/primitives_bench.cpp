@@ -1,4 +1,4 @@
-// primlabel-bench-primitives: fitted primitive instances on held-out synthetic LMS400 scenes
+// primlabel-bench primitives: fitted primitive instances on held-out synthetic LMS400 scenes
 // against the shapes the generator placed. Each scene is labeled by a model, and its primitives
 // are fitted twice: from the predicted labels (what the service returns) and from the true
 // labels (the fit alone). A true surface is an object's curved part (can or mug side, the inside
@@ -13,7 +13,7 @@
 // Recall, precision, radius and axis errors and wall time of each, and the speed ratio. Last
 // line: JSON.
 //
-//   primlabel-bench-primitives --model build/models/tabletop-lms400/1/model.plm --scenes 4
+//   primlabel-bench primitives --model build/models/tabletop-lms400/1/model.plm --scenes 4
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -21,10 +21,11 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <optional>
 
+#include "bench_commands.hpp"
 #include "primitive_matching.hpp"
-#include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
@@ -327,7 +328,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-int run(const Arguments& args) {
+int run_primitives_bench(const Arguments& args) {
   const LabelModel model = load_model(args.model);
   const RunContext context{args.threads, {}, {}};
   Figures predicted, truth;
@@ -451,39 +452,30 @@ int run(const Arguments& args) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  CLI::App app{
-      "Fitted primitive instances on held-out synthetic LMS400 scenes vs the true shapes."};
-  app.set_version_flag("--version", primlabel::version_line("primlabel-bench-primitives"));
-  app.name("primlabel-bench-primitives");
-  Arguments args;
-  app.add_option("--model", args.model, "LMS400 model file (primlabel-train -o)")->required();
-  app.add_option("--scenes", args.scenes, "held-out scenes (seeds 3000..)")
+namespace primlabel::bench {
+
+BenchCommand add_primitives_command(CLI::App& parent) {
+  auto args = std::make_shared<Arguments>();
+  CLI::App* cmd = parent.add_subcommand(
+      "primitives",
+      "Fitted primitive instances on held-out synthetic LMS400 scenes vs the true shapes.");
+  cmd->add_option("--model", args->model, "LMS400 model file (primlabel-train -o)")->required();
+  cmd->add_option("--scenes", args->scenes, "held-out scenes (seeds 3000..)")
       ->check(CLI::Range(1, 100));
-  app.add_option("--first-seed", args.first_seed, "seed of the first scene");
-  app.add_option("--threads", args.threads, "worker threads")->check(CLI::PositiveNumber);
-  app.add_option(
-         "--cgal-probability", args.cgal_probability,
+  cmd->add_option("--first-seed", args->first_seed, "seed of the first scene");
+  cmd->add_option("--threads", args->threads, "worker threads")->check(CLI::PositiveNumber);
+  cmd->add_option(
+         "--cgal-probability", args->cgal_probability,
          "CGAL Efficient RANSAC: chance of missing the largest shape (lower: longer search)")
       ->check(CLI::Range(1e-6, 1.0))
       ->capture_default_str();
-  app.add_option("--cgal-cluster-spacings", args.cgal_cluster_spacings,
-                 "CGAL Efficient RANSAC: cluster epsilon in median point spacings")
+  cmd->add_option("--cgal-cluster-spacings", args->cgal_cluster_spacings,
+                  "CGAL Efficient RANSAC: cluster epsilon in median point spacings")
       ->check(CLI::Range(0.5, 100.0))
       ->capture_default_str();
-  app.add_flag("--explain-misses", args.explain_misses,
-               "print, per unmatched true primitive, the detections with points on it");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "primlabel-bench-primitives: usage error: %s\n", e.what());
-    return primlabel::kExitUsage;
-  }
-  try {
-    return run(args);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "primlabel-bench-primitives: error: %s\n", e.what());
-    return primlabel::kExitFailure;
-  }
+  cmd->add_flag("--explain-misses", args->explain_misses,
+                "print, per unmatched true primitive, the detections with points on it");
+  return {cmd, [args] { return run_primitives_bench(*args); }};
 }
+
+}  // namespace primlabel::bench

@@ -1,4 +1,4 @@
-// The only translation unit of primlabel-bench-tabletop that includes PCL.
+// The only translation unit of `primlabel-bench tabletop` that includes PCL.
 
 #include "tabletop_pcl_peer.hpp"
 

@@ -1,6 +1,6 @@
 #pragma once
-// PCL's classic table-top pipeline as a peer for primlabel-bench-tabletop: SACSegmentation (RANSAC,
-// plane perpendicular to the up axis), ConvexHull of the projected inliers,
+// PCL's classic table-top pipeline as a peer for `primlabel-bench tabletop`: SACSegmentation
+// (RANSAC, plane perpendicular to the up axis), ConvexHull of the projected inliers,
 // ExtractPolygonalPrismData and EuclideanClusterExtraction (or LCCP), with the same thresholds as
 // primlabel's filter. PCL-free interface; tabletop_pcl_peer.cpp is the only file including PCL.
 

@@ -112,7 +112,8 @@ void write_true_primitives(const std::string& path, const Generated& scan, doubl
   for (std::size_t i = 0; i < truth.size(); ++i) {
     json::Json entry = primitives::to_json(truth[i].primitive, i);
     entry["object"] = truth[i].object;
-    entry["own_points"] = truth[i].own_points;  // the visibility rule of bench-primitives
+    // own_points: the visibility rule `primlabel-bench primitives` applies.
+    entry["own_points"] = truth[i].own_points;
     list.push_back(std::move(entry));
   }
   const json::Json out = {{"source", "primlabel-synth ground truth"},
@@ -205,7 +206,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"table", "primitives", "empty", "clutter"}));
   app.add_flag("--segment-labels", args.segment_labels,
                "write instances, not classes, in `label`: 1 the table, 10 (k + 1) object k, as "
-               "mOSD scenes do (primlabel-bench-tabletop and primlabel-tabletop score them)");
+               "mOSD scenes do (primlabel-bench tabletop and primlabel-tabletop score them)");
   app.add_option("--sensor", args.sensor, "lms400 (tilting line laser) or kinect (640x480 depth)")
       ->check(CLI::IsMember({"lms400", "kinect"}));
   app.add_option("--seed", args.seed, "scene and noise seed (same seed, same cloud)");

@@ -1,4 +1,4 @@
-// The instance matching every detector of primlabel-bench-primitives is scored with
+// The instance matching every detector of `primlabel-bench primitives` is scored with
 // (bench/primitive_matching.hpp): a detection counts once, on the true primitive of its kind and
 // object most of its points lie on; duplicates, wrong kinds and detections off every true surface
 // and detections whose parameters are far off the surface they lie on count against precision

@@ -1,6 +1,6 @@
 #pragma once
 // The primitives a synthetic scene is made of, in the world frame: the ground truth for primitive
-// fitting (primlabel-synth --primitives, primlabel-bench-primitives). Box faces and caps are
+// fitting (primlabel-synth --primitives, primlabel-bench primitives). Box faces and caps are
 // planes, can and mug walls cylinders, balls and bowls spheres, rings tori. A mug's handle (a
 // torus arc) and a bowl's lip are left out: no model of the taxonomy describes them whole.
 

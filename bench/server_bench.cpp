@@ -1,4 +1,4 @@
-// primlabel-bench-server: the labeling service end to end over loopback gRPC against label_cloud
+// primlabel-bench server: the labeling service end to end over loopback gRPC against label_cloud
 // in process on the same cloud and model (the server's overhead), and how fast a cancelled
 // large request stops computing.
 //
@@ -23,12 +23,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stop_token>
 #include <thread>
 
+#include "bench_commands.hpp"
 #include "label_stages.hpp"
-#include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/ops/logging.hpp"
@@ -270,9 +271,7 @@ double cancel_latency(server::LabelServer& server, v1::Labeler::Stub& stub,
   return stopped;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+struct Arguments {
   int reps_table = 20, reps_kinect = 5, threads = 2;
   std::size_t cancel_points = 5'000'000;
   bool skip_cancel = false, cancel_only = false;
@@ -280,34 +279,9 @@ int main(int argc, char** argv) {
   int reps_frame = 20;
   // When to stop the cancelled request (ms after it started / after the upload ended).
   std::vector<int> cancel_at = {300, 1500, 4000, 8000};
-  CLI::App app{"End-to-end latency of primlabel-server against label_cloud in process."};
-  app.set_version_flag("--version", primlabel::version_line("primlabel-bench-server"));
-  // Every option with a default shows it in --help ("[0.025]").
-  app.option_defaults()->always_capture_default();
-  app.name("primlabel-bench-server");
-  app.add_option("--reps-table", reps_table, "repetitions on the 22k table scene")
-      ->capture_default_str();
-  app.add_option("--reps-kinect", reps_kinect, "repetitions on the 307k Kinect frame")
-      ->capture_default_str();
-  app.add_option("--threads", threads, "OpenMP threads per job")->capture_default_str();
-  app.add_option("--cancel-points", cancel_points, "points of the cancelled request")
-      ->capture_default_str();
-  app.add_option("--frame", frames,
-                 "SENSOR=MODEL (kinect or lms400; repeatable): the first held-out synthetic scene "
-                 "of that sensor labeled with that model file, instead of table / kinect");
-  app.add_option("--reps-frame", reps_frame, "repetitions per --frame")->capture_default_str();
-  app.add_flag("--skip-cancel", skip_cancel, "no cancellation figures");
-  app.add_flag("--cancel-only", cancel_only, "only the cancellation figures (no table / kinect)");
-  app.add_option("--cancel-at", cancel_at, "moments (ms) at which the 5M request is cancelled")
-      ->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "primlabel-bench-server: usage error: %s (see --help)\n", e.what());
-    return primlabel::kExitUsage;
-  }
+};
 
+int run_server_bench(const Arguments& args) {
   server::set_log_level(server::LogLevel::kWarn);
   const fs::path repo = fs::temp_directory_path() / ("primlabel_bench_" + std::to_string(getpid()));
   const LabelModel model = bench_model();
@@ -320,12 +294,12 @@ int main(int argc, char** argv) {
     LabelModel model;
   };
   std::vector<Frame> frame_cases;
-  for (const std::string& spec : frames) {
+  for (const std::string& spec : args.frames) {
     const std::size_t eq = spec.find('=');
     const auto sensor =
         eq == std::string::npos ? std::nullopt : synth::sensor_from_name(spec.substr(0, eq));
     if (!sensor) {
-      std::fprintf(stderr, "primlabel-bench-server: usage error: --frame %s: want SENSOR=MODEL\n",
+      std::fprintf(stderr, "primlabel-bench server: usage error: --frame %s: want SENSOR=MODEL\n",
                    spec.c_str());
       return primlabel::kExitUsage;
     }
@@ -342,13 +316,14 @@ int main(int argc, char** argv) {
   config.metrics_listen = "";
   config.reload_seconds = 0;
   config.workers = 1;
-  config.threads_per_job = threads;
-  config.max_points = std::max<std::uint64_t>(config.max_points, cancel_points);
+  config.threads_per_job = args.threads;
+  config.max_points = std::max<std::uint64_t>(config.max_points, args.cancel_points);
   server::LabelServer server(config);
-  grpc::ChannelArguments args;
-  args.SetMaxReceiveMessageSize(64 << 20);
-  auto stub = v1::Labeler::NewStub(grpc::CreateCustomChannel(
-      "127.0.0.1:" + std::to_string(server.port()), grpc::InsecureChannelCredentials(), args));
+  grpc::ChannelArguments channel_args;
+  channel_args.SetMaxReceiveMessageSize(64 << 20);
+  auto stub = v1::Labeler::NewStub(
+      grpc::CreateCustomChannel("127.0.0.1:" + std::to_string(server.port()),
+                                grpc::InsecureChannelCredentials(), channel_args));
 
   Latency table, frame;
   PointCloud kinect;
@@ -356,21 +331,21 @@ int main(int argc, char** argv) {
   for (const Frame& f : frame_cases)
     frame_rows.push_back(frame_figures(f.label, f.name, f.model,
                                        synth::synthetic_scene(synth::SceneSet::kTest, 0, f.sensor),
-                                       *stub, reps_frame, threads));
-  if (!cancel_only && frame_cases.empty()) {
-    table = compare("table", model, table_scene(22000), *stub, reps_table, threads);
+                                       *stub, args.reps_frame, args.threads));
+  if (!args.cancel_only && frame_cases.empty()) {
+    table = compare("table", model, table_scene(22000), *stub, args.reps_table, args.threads);
     kinect = synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kKinect);
-    frame = compare("kinect", model, kinect, *stub, reps_kinect, threads);
+    frame = compare("kinect", model, kinect, *stub, args.reps_kinect, args.threads);
   }
 
   std::vector<double> cancel_ms, local_stop_ms;
-  if (!skip_cancel) {
-    const PointCloud big = large_surface(cancel_points);
+  if (!args.skip_cancel) {
+    const PointCloud big = large_surface(args.cancel_points);
     // In process first: stop at several moments, time from request_stop to Cancelled.
-    for (int after_ms : cancel_at) {
+    for (int after_ms : args.cancel_at) {
       PointCloud copy = big;
       std::stop_source stop;
-      const RunContext context{threads, stop.get_token()};
+      const RunContext context{args.threads, stop.get_token()};
       Clock::time_point requested{};
       std::jthread stopper([&] {
         std::this_thread::sleep_for(std::chrono::milliseconds(after_ms));
@@ -388,7 +363,7 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
     }
     const auto requests = requests_for(big, 87381);
-    for (int after_ms : cancel_at) {
+    for (int after_ms : args.cancel_at) {
       cancel_ms.push_back(cancel_latency(server, *stub, requests, after_ms));
       std::printf(
           "cancel  %zu points over gRPC, %5d ms after upload: slot free %6.1f ms after "
@@ -449,3 +424,34 @@ int main(int argc, char** argv) {
   std::printf("%s\n", json::dump(out).c_str());
   return 0;
 }
+
+}  // namespace
+
+namespace primlabel::bench {
+
+BenchCommand add_server_command(CLI::App& parent) {
+  auto args = std::make_shared<Arguments>();
+  CLI::App* cmd = parent.add_subcommand(
+      "server", "End-to-end latency of primlabel-server against label_cloud in process.");
+  cmd->add_option("--reps-table", args->reps_table, "repetitions on the 22k table scene")
+      ->capture_default_str();
+  cmd->add_option("--reps-kinect", args->reps_kinect, "repetitions on the 307k Kinect frame")
+      ->capture_default_str();
+  cmd->add_option("--threads", args->threads, "OpenMP threads per job")->capture_default_str();
+  cmd->add_option("--cancel-points", args->cancel_points, "points of the cancelled request")
+      ->capture_default_str();
+  cmd->add_option("--frame", args->frames,
+                  "SENSOR=MODEL (kinect or lms400; repeatable): the first held-out synthetic "
+                  "scene of that sensor labeled with that model file, instead of table / kinect");
+  cmd->add_option("--reps-frame", args->reps_frame, "repetitions per --frame")
+      ->capture_default_str();
+  cmd->add_flag("--skip-cancel", args->skip_cancel, "no cancellation figures");
+  cmd->add_flag("--cancel-only", args->cancel_only,
+                "only the cancellation figures (no table / kinect)");
+  cmd->add_option("--cancel-at", args->cancel_at,
+                  "moments (ms) at which the 5M request is cancelled")
+      ->capture_default_str();
+  return {cmd, [args] { return run_server_bench(*args); }};
+}
+
+}  // namespace primlabel::bench

@@ -1,4 +1,4 @@
-// primlabel-bench-tabletop: the table-top pre-filter per scene, optionally beside PCL's
+// primlabel-bench tabletop: the table-top pre-filter per scene, optionally beside PCL's
 // SACSegmentation + ConvexHull + ExtractPolygonalPrismData + EuclideanClusterExtraction (and,
 // when PCL has it, LCCP on supervoxels) on the same input and thresholds. On labeled (mOSD)
 // scans every method is scored: table F1, mean object IoU, objects found/true, whether the count
@@ -6,7 +6,7 @@
 // file names carry scene numbers (learn17.pcd), for odd and even numbers separately (develop on
 // one half, hold out the other). Last line: JSON.
 //
-//   primlabel-bench-tabletop ../shared/data/mosd/learn*.pcd --threads 2 --compare-pcl
+//   primlabel-bench tabletop ../shared/data/mosd/learn*.pcd --threads 2 --compare-pcl
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -15,11 +15,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <sstream>
 
+#include "bench_commands.hpp"
 #include "pcl_availability.hpp"
-#include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
@@ -36,7 +37,7 @@ using namespace primlabel::tabletop;
 
 struct Arguments {
   std::vector<std::string> inputs;
-  bool compare_pcl = false, crease_split = true;
+  bool compare_pcl = false, no_crease_split = false;
   int threads = 2, repeat = 5;
 };
 
@@ -201,9 +202,18 @@ json::Json totals_json(const Totals& t) {
   return j;
 }
 
-int run(const Arguments& args) {
+int run_tabletop_bench(const Arguments& args) {
+#ifndef PRIMLABEL_HAVE_PCL
+  if (args.compare_pcl) {
+    std::fprintf(stderr, "primlabel-bench tabletop: error: --compare-pcl needs PCL: %s\n",
+                 primlabel::bench::pcl_unavailable_reason(
+                     "PCL 1.13 with its segmentation and surface components")
+                     .c_str());
+    return primlabel::kExitFailure;
+  }
+#endif
   TabletopOptions options;
-  options.creases.enabled = args.crease_split;
+  options.creases.enabled = !args.no_crease_split;
   const RunContext context{args.threads};
   std::vector<std::string> methods = {"ours"};
   if (args.compare_pcl) {
@@ -294,44 +304,23 @@ int run(const Arguments& args) {
 }
 
 }  // namespace
-int main(int argc, char** argv) {
-  CLI::App app{"Milliseconds per scene of the table-top pre-filter, optionally against PCL."};
-  app.set_version_flag("--version", primlabel::version_line("primlabel-bench-tabletop"));
-  // Every option with a default shows it in --help ("[0.025]").
-  app.option_defaults()->always_capture_default();
-  app.name("primlabel-bench-tabletop");
-  Arguments args;
-  app.add_option("inputs", args.inputs, "scans (.pcd or .ply)")->required();
-  app.add_flag("--compare-pcl", args.compare_pcl,
-               "also time PCL's SACSegmentation + EuclideanClusterExtraction");
-  bool no_crease_split = false;
-  app.add_flag("--no-crease-split", no_crease_split,
-               "ours without the cut at concave creases (the previous pipeline)");
-  app.add_option("--threads", args.threads, "threads for primlabel (PCL's steps are serial)")
+
+namespace primlabel::bench {
+
+BenchCommand add_tabletop_command(CLI::App& parent) {
+  auto args = std::make_shared<Arguments>();
+  CLI::App* cmd = parent.add_subcommand(
+      "tabletop", "Milliseconds per scene of the table-top pre-filter, optionally against PCL.");
+  cmd->add_option("inputs", args->inputs, "scans (.pcd or .ply)")->required();
+  cmd->add_flag("--compare-pcl", args->compare_pcl,
+                "also time PCL's SACSegmentation + EuclideanClusterExtraction");
+  cmd->add_flag("--no-crease-split", args->no_crease_split,
+                "ours without the cut at concave creases (the previous pipeline)");
+  cmd->add_option("--threads", args->threads, "threads for primlabel (PCL's steps are serial)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--repeat", args.repeat, "runs per scene; the fastest counts")
+  cmd->add_option("--repeat", args->repeat, "runs per scene; the fastest counts")
       ->check(CLI::PositiveNumber);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "primlabel-bench-tabletop: usage error: %s (see --help)\n", e.what());
-    return primlabel::kExitUsage;
-  }
-  args.crease_split = !no_crease_split;
-#ifndef PRIMLABEL_HAVE_PCL
-  if (args.compare_pcl) {
-    std::fprintf(stderr, "primlabel-bench-tabletop: error: --compare-pcl needs PCL: %s\n",
-                 primlabel::bench::pcl_unavailable_reason(
-                     "PCL 1.13 with its segmentation and surface components")
-                     .c_str());
-    return primlabel::kExitFailure;
-  }
-#endif
-  try {
-    return run(args);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "primlabel-bench-tabletop: error: %s\n", e.what());
-    return primlabel::kExitFailure;
-  }
+  return {cmd, [args] { return run_tabletop_bench(*args); }};
 }
+
+}  // namespace primlabel::bench

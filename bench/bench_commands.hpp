@@ -1,0 +1,27 @@
+#pragma once
+// The benchmarks of `primlabel-bench`, one subcommand each. Every add_*_command is defined in its
+// benchmark's own file: it binds the subcommand's flags and returns how to run it, so
+// bench_main.cpp only wires them. (`features` keeps its options in features_bench.hpp.)
+
+#include <functional>
+
+namespace CLI {
+class App;
+}
+
+namespace primlabel::bench {
+
+struct BenchCommand {
+  CLI::App* command = nullptr;
+  // Runs the benchmark with the parsed flags; returns the exit code (0 ok, 1 failure, 2 usage).
+  std::function<int()> run;
+};
+
+BenchCommand add_crf_command(CLI::App& parent);         // crf_bench.cpp
+BenchCommand add_pipeline_command(CLI::App& parent);    // pipeline_bench.cpp
+BenchCommand add_server_command(CLI::App& parent);      // server_bench.cpp
+BenchCommand add_tabletop_command(CLI::App& parent);    // tabletop_bench.cpp
+BenchCommand add_primitives_command(CLI::App& parent);  // primitives_bench.cpp
+BenchCommand add_can_radii_command(CLI::App& parent);   // can_radii_bench.cpp
+
+}  // namespace primlabel::bench
