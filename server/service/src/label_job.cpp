@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "primlabel/geometry/cloud_signature.hpp"
+#include "primlabel/service/label_options.hpp"
 #include "primlabel/service/registry_error.hpp"
 #include "primlabel/tabletop/tabletop.hpp"
 
@@ -60,6 +61,8 @@ std::optional<ServiceError> start_choice(const pipeline::CloudShape& shape,
 std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelRegistry& registry,
                                           LabelPlan& plan) {
   const pipeline::CloudShape shape{header.layout().width(), header.layout().height()};
+  plan.options = labeling_options(header);
+  if (auto refused = refuse_options(plan.options)) return refused;
   try {
     if (!header.model().empty() || !header.model_version().empty()) {
       // A version alone names a version of the default model, as before routing existed.
@@ -80,30 +83,8 @@ std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelReg
   } catch (const RegistryError& error) {
     return registry_error(error);
   }
-  const v1::LabelOptions& options = header.options();
-  for (const ModelEntry* entry : plan.possible_models()) {
-    const std::string which = "model '" + entry->name + "' version '" + entry->version + "'";
-    if ((options.normal_radius() > 0.0f || options.feature_radius() > 0.0f) &&
-        !entry->model->features.radii_overridable)
-      return ServiceError{ErrorCode::kInvalidArgument,
-                          which +
-                              " does not allow radius overrides (options.normal_radius / "
-                              "feature_radius)" +
-                              (plan.entry ? "" : "; name a model that does")};
-  }
-  if (options.return_objects() && !options.tabletop_only())
-    return ServiceError{ErrorCode::kInvalidArgument,
-                        "options.return_objects needs options.tabletop_only (the objects are "
-                        "those of the table-top stage)"};
-  plan.options.want_descriptors = options.return_descriptors();
-  plan.options.want_probabilities = options.return_probabilities();
-  plan.options.tabletop_only = options.tabletop_only();
-  plan.options.voxel_size = options.voxel_size();
-  plan.options.normal_radius = options.normal_radius();
-  plan.options.feature_radius = options.feature_radius();
-  plan.options.use_cloud_normals = header.layout().normals();
-  plan.options.want_primitives = options.return_primitives();
-  plan.options.want_objects = options.return_objects();
+  for (const ModelEntry* entry : plan.possible_models())
+    if (auto refused = refuse_options(plan.options, *entry, plan.entry != nullptr)) return refused;
   return std::nullopt;
 }
 
@@ -165,7 +146,10 @@ std::optional<ServiceError> run_label_job(LabelPlan& plan, PointCloud& cloud,
   } catch (const pipeline::Cancelled&) {
     return ServiceError{ErrorCode::kCancelled, "labeling was cancelled"};
   } catch (const std::invalid_argument& e) {
-    return ServiceError{ErrorCode::kInvalidArgument, e.what()};
+    // The options were checked when the request came and the assembler checked the points, so
+    // what label_cloud still refuses is a broken invariant of the server's, not the client's.
+    return ServiceError{ErrorCode::kInternal,
+                        std::string("labeling failed an internal check: ") + e.what()};
   } catch (const std::bad_alloc&) {
     return ServiceError{ErrorCode::kResourceExhausted, "out of memory while labeling"};
   } catch (const std::exception& e) {

@@ -21,8 +21,6 @@ std::string describe_point(const Vec3f& p) {
 
 constexpr std::uint64_t kMaxReservedPoints = 1u << 18;  // 3 MiB of xyz
 
-bool finite_non_negative(float value) { return std::isfinite(value) && value >= 0.0f; }
-
 // Shorter than this (or non-finite), a client's normal gives no direction: used as given, a
 // zero normal makes every pair angle degenerate and the whole scan look like one plane.
 constexpr float kMinNormalLength = 1e-3f;
@@ -38,11 +36,6 @@ std::optional<ServiceError> check_header(const v1::ScanHeader& header, const Sca
     return invalid("the scan announces " + std::to_string(header.expected_points()) +
                    " points; this server takes at most " + std::to_string(limits.max_points));
   const v1::LabelOptions& options = header.options();
-  if (!finite_non_negative(options.voxel_size()))
-    return invalid("options.voxel_size must be finite and >= 0");
-  if (!finite_non_negative(options.normal_radius()) ||
-      !finite_non_negative(options.feature_radius()))
-    return invalid("options.normal_radius and options.feature_radius must be finite and >= 0");
   const v1::Vec3& viewpoint = header.viewpoint();
   if (!std::isfinite(viewpoint.x()) || !std::isfinite(viewpoint.y()) ||
       !std::isfinite(viewpoint.z()))

@@ -133,10 +133,22 @@ struct LabelingResult {
   std::optional<tabletop::TabletopObjects> objects;
 };
 
-// Throws std::invalid_argument, naming the option, when label_cloud cannot honour `options` with
-// `model`: a voxel size below 0 or not finite, invalid primitive options, objects without the
-// table-top stage, radius overrides the model does not allow. label_cloud checks it before any
-// work; a caller can check it before it has the cloud.
+// What label_cloud cannot honour in its options, by option, so that a service can tell its
+// client in the client's own terms: a voxel size or radius below 0 or not finite, invalid
+// primitive options, objects without the table-top stage (whatever the model), and radius
+// overrides the model does not allow (the second form).
+enum class RefusedOption { kVoxelSize, kRadius, kPrimitives, kObjects, kRadiusOverride };
+struct OptionsRefusal {
+  RefusedOption option;
+  std::string reason;  // in LabelingOptions' terms
+};
+std::optional<OptionsRefusal> refusal(const LabelingOptions& options);
+std::optional<OptionsRefusal> refusal(const LabelModel& model, const LabelingOptions& options);
+
+// The same as std::invalid_argument(reason). label_cloud checks it before any work; a service
+// checks refusal() as soon as it has the options, so what label_cloud throws later is never the
+// caller's fault.
+void validate(const LabelingOptions& options);
 void validate(const LabelModel& model, const LabelingOptions& options);
 
 // Labels every point with the model's own feature, graph and inference settings (and the
