@@ -23,7 +23,7 @@
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
 #include "primlabel/geometry/json_text.hpp"
-#include "synthetic.hpp"
+#include "crf_scenes.hpp"
 
 namespace {
 

@@ -11,7 +11,7 @@
 #include "inference/belief_propagation.hpp"
 #include "potentials.hpp"
 #include "primlabel/crf/inference.hpp"
-#include "synthetic.hpp"
+#include "crf_scenes.hpp"
 
 namespace primlabel::crf {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "brute_force.hpp"
 #include "primlabel/crf/inference.hpp"
-#include "synthetic.hpp"
+#include "crf_scenes.hpp"
 
 namespace primlabel::crf {
 namespace {

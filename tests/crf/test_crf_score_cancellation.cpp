@@ -7,7 +7,7 @@
 
 #include "potentials.hpp"
 #include "primlabel/geometry/cancellation.hpp"
-#include "synthetic.hpp"
+#include "crf_scenes.hpp"
 
 namespace primlabel::crf {
 namespace {

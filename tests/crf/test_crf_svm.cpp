@@ -7,7 +7,7 @@
 
 #include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/model/svm_baseline.hpp"
-#include "synthetic.hpp"
+#include "crf_scenes.hpp"
 #include "test_util.hpp"
 
 namespace primlabel::crf {

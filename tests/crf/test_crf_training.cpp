@@ -10,7 +10,7 @@
 #include "learning/objectives.hpp"  // white-box: the objectives behind train_crf
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
-#include "synthetic.hpp"
+#include "crf_scenes.hpp"
 
 namespace primlabel::crf {
 namespace {

@@ -10,7 +10,7 @@
 #include <limits>
 #include <random>
 
-#include "crf/synthetic.hpp"
+#include "crf_scenes.hpp"
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Synthetic labelled scenes for the CRF tests: points on a jittered grid whose labels form square
+// Synthetic labelled scenes for the CRF tests and `primlabel-bench crf`: points on a jittered grid whose labels form square
 // regions (spatially smooth), with descriptors = a class prototype + Gaussian noise (so a
 // node-only classifier makes clear mistakes that neighbours can correct).
 
