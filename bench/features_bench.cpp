@@ -27,6 +27,7 @@
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/normals.hpp"
+#include "primlabel/geometry/parallel.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/tabletop/voxel_grid.hpp"
 
@@ -280,16 +281,13 @@ std::vector<char> near_missing_normals(const PointCloud& cloud, const NeighborSe
   const auto count = static_cast<std::ptrdiff_t>(cloud.size());
   const auto spread = [&](const std::vector<char>& seeds) {
     std::vector<char> reached(cloud.size(), 0);
-#pragma omp parallel num_threads(threads)
-    {
-      NeighborList neighbors;
-#pragma omp for schedule(dynamic, 256)
-      for (std::ptrdiff_t i = 0; i < count; ++i) {
-        search.find(cloud.xyz[i], hood, neighbors, /*sorted=*/false);
-        reached[i] = std::any_of(neighbors.indices.begin(), neighbors.indices.end(),
-                                 [&](std::uint32_t j) { return seeds[j] != 0; });
-      }
-    }
+    detail::parallel_for(
+        count, threads, detail::Schedule::Dynamic(256), [] { return NeighborList{}; },
+        [&](NeighborList& neighbors, std::ptrdiff_t i) {
+          search.find(cloud.xyz[i], hood, neighbors, /*sorted=*/false);
+          reached[i] = std::any_of(neighbors.indices.begin(), neighbors.indices.end(),
+                                   [&](std::uint32_t j) { return seeds[j] != 0; });
+        });
     return reached;
   };
   return spread(spread(missing));  // SPFH touched, then FPFH touched

@@ -3,10 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/normals.hpp"
@@ -45,6 +47,36 @@ TEST(Parallel, TheBarrierKeepsTheFirstException) {
     barrier.run([&] { throw std::invalid_argument("item " + std::to_string(i)); });
   EXPECT_TRUE(barrier.failed());
   EXPECT_THROW(barrier.rethrow(), std::invalid_argument);
+}
+
+// Every index once, whatever the schedule and the threads; each thread's scratch is merged once.
+TEST(Parallel, ParallelForVisitsEveryIndexOnceAndMergesEveryScratch) {
+  for (const detail::Schedule schedule : {detail::Schedule::Static(), detail::Schedule::Dynamic(7)})
+    for (int threads : {1, 2, 3}) {
+      std::vector<int> visits(1000, 0);
+      long long merged_sum = 0, merged_count = 0;
+      detail::parallel_for(
+          1000, threads, schedule, [] { return 0LL; },
+          [&](long long& sum, std::ptrdiff_t i) {
+            ++visits[std::size_t(i)];
+            sum += i;
+          },
+          [&](const long long& sum) {
+            merged_sum += sum;
+            ++merged_count;
+          });
+      EXPECT_EQ(std::count(visits.begin(), visits.end(), 1), 1000);
+      EXPECT_EQ(merged_sum, 999LL * 1000 / 2);
+      EXPECT_GE(merged_count, 1);  // one per thread OpenMP started
+      EXPECT_LE(merged_count, threads);
+    }
+}
+
+TEST(Parallel, AnExceptionInAMergeIsRethrown) {
+  EXPECT_THROW(detail::parallel_for(
+                   10, 2, detail::Schedule::Static(), [] { return 0; }, [](int&, std::ptrdiff_t) {},
+                   [](int&) { throw std::runtime_error("merge"); }),
+               std::runtime_error);
 }
 
 PointCloud grid_cloud() {

@@ -9,6 +9,10 @@
 #include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf {
+
+using primlabel::detail::parallel_for;
+using primlabel::detail::Schedule;
+
 namespace {
 
 constexpr const char* kWhat = "building the graph";
@@ -108,21 +112,15 @@ Graph assemble_symmetric(const BlockLists& lists, std::vector<std::uint8_t> acti
   // The parallel passes skip the rest of their chunk (1024 rows, starting at a multiple of
   // 1024) once stopped, and throw after the region.
   const auto skip = [&stop](long long i) { return i % 1024 == 0 && stop.stop_requested(); };
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads)
-  {
-    bool stopped = false;
-#pragma omp for schedule(dynamic, 1024)
-    for (long long i = 0; i < nn; ++i)
-      barrier.run([&] {
-        if (stopped || (stopped = skip(i))) return;
-        auto first = raw.begin() + bound[i];
-        auto last = raw.begin() + bound[i + 1];
-        std::sort(first, last);
-        unique_count[i] = static_cast<std::uint32_t>(std::unique(first, last) - first);
-      });
-  }
-  barrier.rethrow();
+  const auto not_stopped = [] { return false; };  // each thread's "stopped" flag
+  parallel_for(nn, threads, Schedule::Dynamic(1024), not_stopped,
+               [&](bool& stopped, std::ptrdiff_t i) {
+                 if (stopped || (stopped = skip(i))) return;
+                 auto first = raw.begin() + bound[i];
+                 auto last = raw.begin() + bound[i + 1];
+                 std::sort(first, last);
+                 unique_count[i] = static_cast<std::uint32_t>(std::unique(first, last) - first);
+               });
   throw_if_stopped(stop, kWhat);
 
   g.offsets.assign(n + 1, 0);
@@ -130,31 +128,22 @@ Graph assemble_symmetric(const BlockLists& lists, std::vector<std::uint8_t> acti
   g.neighbors.resize(g.offsets[n]);
   g.reverse.resize(g.offsets[n]);
   throw_if_stopped(stop, kWhat);
-#pragma omp parallel for schedule(dynamic, 1024) num_threads(threads)
-  for (long long i = 0; i < nn; ++i)
-    barrier.run([&] {
-      std::copy_n(raw.begin() + bound[i], unique_count[i], g.neighbors.begin() + g.offsets[i]);
-    });
-  barrier.rethrow();
+  parallel_for(nn, threads, Schedule::Dynamic(1024), [&](std::ptrdiff_t i) {
+    std::copy_n(raw.begin() + bound[i], unique_count[i], g.neighbors.begin() + g.offsets[i]);
+  });
   throw_if_stopped(stop, kWhat);
-#pragma omp parallel num_threads(threads)
-  {
-    bool stopped = false;
-#pragma omp for schedule(dynamic, 1024)
-    for (long long i = 0; i < nn; ++i)
-      barrier.run([&] {
-        if (stopped || (stopped = skip(i))) return;
-        for (std::uint32_t p = g.offsets[i]; p < g.offsets[i + 1]; ++p) {
-          const std::uint32_t j = g.neighbors[p];
-          const auto row_begin = g.neighbors.begin() + g.offsets[j];
-          const auto row_end = g.neighbors.begin() + g.offsets[j + 1];
-          g.reverse[p] = static_cast<std::uint32_t>(
-              std::lower_bound(row_begin, row_end, static_cast<std::uint32_t>(i)) -
-              g.neighbors.begin());
-        }
-      });
-  }
-  barrier.rethrow();
+  parallel_for(nn, threads, Schedule::Dynamic(1024), not_stopped,
+               [&](bool& stopped, std::ptrdiff_t i) {
+                 if (stopped || (stopped = skip(i))) return;
+                 for (std::uint32_t p = g.offsets[i]; p < g.offsets[i + 1]; ++p) {
+                   const std::uint32_t j = g.neighbors[p];
+                   const auto row_begin = g.neighbors.begin() + g.offsets[j];
+                   const auto row_end = g.neighbors.begin() + g.offsets[j + 1];
+                   g.reverse[p] = static_cast<std::uint32_t>(
+                       std::lower_bound(row_begin, row_end, static_cast<std::uint32_t>(i)) -
+                       g.neighbors.begin());
+                 }
+               });
   throw_if_stopped(stop, kWhat);
   return g;
 }

@@ -9,6 +9,10 @@
 #include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf::detail {
+
+using primlabel::detail::parallel_for;
+using primlabel::detail::Schedule;
+
 namespace {
 
 // Blocks are fixed in size and a product never exceeds Eigen's 50k-flop threshold for going
@@ -50,37 +54,31 @@ std::size_t number_edges(const Graph& graph, int threads, ScratchBuffer<std::uin
   const std::uint32_t* offsets = graph.offsets.data();
   const std::uint32_t* neighbors = graph.neighbors.data();
   const std::uint32_t* reverse = graph.reverse.data();
-  // Fixed node blocks and a serial prefix sum: the numbering never depends on the threads.
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (long long b = 0; b < blocks; ++b)
-    barrier.run([&] {
-      if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
-      std::uint32_t count = 0;
-      const long long last = std::min(n, (b + 1) * kNodeBlock);
-      for (long long i = b * kNodeBlock; i < last; ++i)
-        for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p) count += neighbors[p] > i;
-      first[b + 1] = count;
-    });
-  barrier.rethrow();
+  // Fixed node blocks and a serial prefix sum: the numbering never depends on the threads. Once
+  // cancelled, the remaining blocks are skipped.
+  parallel_for(blocks, threads, Schedule::Static(), [&](std::ptrdiff_t b) {
+    if (stop.stop_requested()) return;
+    std::uint32_t count = 0;
+    const long long last = std::min(n, (b + 1) * kNodeBlock);
+    for (long long i = b * kNodeBlock; i < last; ++i)
+      for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p) count += neighbors[p] > i;
+    first[b + 1] = count;
+  });
   throw_if_stopped(stop, kWhat);
   first[0] = 0;
   for (long long b = 0; b < blocks; ++b) first[b + 1] += first[b];
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (long long b = 0; b < blocks; ++b)
-    barrier.run([&] {
-      if (stop.stop_requested()) return;
-      std::uint32_t e = first[b];
-      const long long last = std::min(n, (b + 1) * kNodeBlock);
-      for (long long i = b * kNodeBlock; i < last; ++i)
-        for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p)
-          if (neighbors[p] > i) {
-            of[p] = e;
-            of[reverse[p]] = e;  // each slot is written once, by the owner of its edge
-            ++e;
-          }
-    });
-  barrier.rethrow();
+  parallel_for(blocks, threads, Schedule::Static(), [&](std::ptrdiff_t b) {
+    if (stop.stop_requested()) return;
+    std::uint32_t e = first[b];
+    const long long last = std::min(n, (b + 1) * kNodeBlock);
+    for (long long i = b * kNodeBlock; i < last; ++i)
+      for (std::uint32_t p = offsets[i]; p < offsets[i + 1]; ++p)
+        if (neighbors[p] > i) {
+          of[p] = e;
+          of[reverse[p]] = e;  // each slot is written once, by the owner of its edge
+          ++e;
+        }
+  });
   throw_if_stopped(stop, kWhat);
   return first[blocks];
 }
@@ -99,59 +97,54 @@ void node_scores_padded(const CrfModel& model, std::span<const float> descriptor
     RowMatrixXf table = RowMatrixXf::Zero(dim, kp);  // node_feature_dim x padded K
     table.leftCols(k_count) = model.node_weights.transpose();
     const float* bias = table.row(dim - 1).data();
-    primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (long long b = 0; b < blocks; ++b)
-      barrier.run([&] {
-        if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
-        const long long last = std::min(n, (b + 1) * kNodeBlock);
-        for (long long i = b * kNodeBlock; i < last; ++i) {
-          float* row = out + i * kp;
-          if (!graph.active[i]) {
-            std::fill_n(row, kp, 0.0f);
-            continue;
-          }
-          std::copy_n(bias, kp, row);
-          const float* descriptor = descriptors.data() + i * d;
-          for (int f = 0; f < d; ++f) {
-            const TentPair p = tent_pair(model.feature_scale * descriptor[f], f, model.node_knots);
-            const float* lo = table.data() + std::size_t(p.column) * kp;
-            for (int k = 0; k < kp; ++k) row[k] += p.lower * lo[k] + p.upper * lo[k + kp];
-          }
+    parallel_for(blocks, threads, Schedule::Static(), [&](std::ptrdiff_t b) {
+      if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
+      const long long last = std::min(n, (b + 1) * kNodeBlock);
+      for (long long i = b * kNodeBlock; i < last; ++i) {
+        float* row = out + i * kp;
+        if (!graph.active[i]) {
+          std::fill_n(row, kp, 0.0f);
+          continue;
         }
-      });
-    barrier.rethrow();
+        std::copy_n(bias, kp, row);
+        const float* descriptor = descriptors.data() + i * d;
+        for (int f = 0; f < d; ++f) {
+          const TentPair p = tent_pair(model.feature_scale * descriptor[f], f, model.node_knots);
+          const float* lo = table.data() + std::size_t(p.column) * kp;
+          for (int k = 0; k < kp; ++k) row[k] += p.lower * lo[k] + p.upper * lo[k + kp];
+        }
+      }
+    });
     throw_if_stopped(stop, kWhat);
     return;
   }
   const Eigen::MatrixXf weights_t = model.node_weights.transpose();  // node_feature_dim x K
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads)
-  {
-    RowMatrixXf features(kNodeBlock, dim);
-    RowMatrixXf scores(kNodeBlock, k_count);
-#pragma omp for schedule(static)
-    for (long long b = 0; b < blocks; ++b)
-      barrier.run([&] {
+  struct BlockScratch {
+    RowMatrixXf features, scores;
+  };
+  parallel_for(
+      blocks, threads, Schedule::Static(),
+      [&] {
+        return BlockScratch{RowMatrixXf(kNodeBlock, dim), RowMatrixXf(kNodeBlock, k_count)};
+      },
+      [&](BlockScratch& scratch, std::ptrdiff_t b) {
         if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
         const long long first = b * kNodeBlock;
         const long long count = std::min(kNodeBlock, n - first);
         for (long long r = 0; r < count; ++r) {
           const long long i = first + r;
           if (graph.active[i])
-            node_features(model, descriptors.data() + i * d, features.row(r).data());
+            node_features(model, descriptors.data() + i * d, scratch.features.row(r).data());
           else
-            features.row(r).setZero();
+            scratch.features.row(r).setZero();
         }
-        scores.topRows(count).noalias() = features.topRows(count) * weights_t;
+        scratch.scores.topRows(count).noalias() = scratch.features.topRows(count) * weights_t;
         for (long long r = 0; r < count; ++r) {
           float* row = out + (first + r) * kp;
-          std::copy_n(scores.row(r).data(), k_count, row);
+          std::copy_n(scratch.scores.row(r).data(), k_count, row);
           std::fill(row + k_count, row + kp, 0.0f);
         }
       });
-  }
-  barrier.rethrow();
   throw_if_stopped(stop, kWhat);
 }
 
@@ -175,63 +168,60 @@ void edge_terms_padded(const CrfModel& model, std::span<const float> descriptors
     }
     const long long edges = static_cast<long long>(block_first_edge[blocks]);
     const long long edge_blocks = (edges + kEdgeBlock - 1) / kEdgeBlock;
-    primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (long long eb = 0; eb < edge_blocks; ++eb)
-      barrier.run([&] {
-        if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
-        const long long last = std::min(edges, (eb + 1) * kEdgeBlock);
-        for (long long e = eb * kEdgeBlock; e < last; ++e)
-          std::copy(row.begin(), row.end(), out + std::size_t(e) * kp);
-      });
-    barrier.rethrow();
+    parallel_for(edge_blocks, threads, Schedule::Static(), [&](std::ptrdiff_t eb) {
+      if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
+      const long long last = std::min(edges, (eb + 1) * kEdgeBlock);
+      for (long long e = eb * kEdgeBlock; e < last; ++e)
+        std::copy(row.begin(), row.end(), out + std::size_t(e) * kp);
+    });
     throw_if_stopped(stop, kWhat);
     return;
   }
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads)
-  {
-    RowMatrixXf features(kEdgeBatch, d + 1);
-    RowMatrixXf batch(kEdgeBatch, k_count);
-    std::size_t batch_first = 0;  // edge number of the batch's first row
-    int m = 0;
-    const auto flush = [&] {
-      if (m == 0) return;
-      batch.topRows(m).noalias() = features.topRows(m) * weights_t;
-      if (potentials_minus_one) {
-        // One vectorised exp over the whole batch while it is in cache.
-        Eigen::Map<Eigen::ArrayXf> flat(batch.data(), Eigen::Index(m) * k_count);
-        flat = flat.min(kMaxEdgeScore).exp() - 1.0f;
-      }
-      for (int r = 0; r < m; ++r) {
-        float* row = out + (batch_first + r) * kp;
-        std::copy_n(batch.row(r).data(), k_count, row);
-        std::fill(row + k_count, row + kp, 0.0f);
-      }
-      batch_first += m;
-      m = 0;
-    };
-#pragma omp for schedule(static)
-    for (long long b = 0; b < blocks; ++b)
-      barrier.run([&] {
+  // Edge feature rows gathered per thread and scored kEdgeBatch at a time.
+  struct EdgeBatch {
+    RowMatrixXf features, scores;
+    std::size_t first = 0;  // edge number of the batch's first row
+    int rows = 0;
+  };
+  const auto flush = [&](EdgeBatch& batch) {
+    const int m = batch.rows;
+    if (m == 0) return;
+    batch.scores.topRows(m).noalias() = batch.features.topRows(m) * weights_t;
+    if (potentials_minus_one) {
+      // One vectorised exp over the whole batch while it is in cache.
+      Eigen::Map<Eigen::ArrayXf> flat(batch.scores.data(), Eigen::Index(m) * k_count);
+      flat = flat.min(kMaxEdgeScore).exp() - 1.0f;
+    }
+    for (int r = 0; r < m; ++r) {
+      float* row = out + (batch.first + r) * kp;
+      std::copy_n(batch.scores.row(r).data(), k_count, row);
+      std::fill(row + k_count, row + kp, 0.0f);
+    }
+    batch.first += m;
+    batch.rows = 0;
+  };
+  parallel_for(
+      blocks, threads, Schedule::Static(),
+      [&] {
+        return EdgeBatch{RowMatrixXf(kEdgeBatch, d + 1), RowMatrixXf(kEdgeBatch, k_count)};
+      },
+      [&](EdgeBatch& batch, std::ptrdiff_t b) {
         if (stop.stop_requested()) return;  // cancelled: skip the remaining blocks
-        batch_first = block_first_edge[b];
+        batch.first = block_first_edge[b];
         const long long last = std::min(n, (b + 1) * kNodeBlock);
         for (long long i = b * kNodeBlock; i < last; ++i) {
           const ConstRowMap xi(descriptors.data() + i * d, d);
           for (std::uint32_t p = graph.offsets[i]; p < graph.offsets[i + 1]; ++p) {
             const std::uint32_t j = graph.neighbors[p];
             if (j < i) continue;  // edges in the order number_edges gives them
-            features.row(m).head(d) =
+            batch.features.row(batch.rows).head(d) =
                 scale2 * xi.cwiseProduct(ConstRowMap(descriptors.data() + std::size_t(j) * d, d));
-            features(m, d) = 1.0f;
-            if (++m == kEdgeBatch) flush();
+            batch.features(batch.rows, d) = 1.0f;
+            if (++batch.rows == kEdgeBatch) flush(batch);
           }
         }
-        flush();  // batches never span blocks, so they do not depend on the schedule
+        flush(batch);  // batches never span blocks, so they do not depend on the schedule
       });
-  }
-  barrier.rethrow();
   throw_if_stopped(stop, kWhat);
 }
 
@@ -239,16 +229,12 @@ void node_potentials_padded(const float* theta, std::size_t n, int k_count, int 
                             float* phi) {
   const int kp = padded_classes(k_count);
   const long long count = static_cast<long long>(n);
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel for schedule(static) num_threads(threads)
-  for (long long i = 0; i < count; ++i)
-    barrier.run([&] {
-      const Eigen::Map<const Eigen::ArrayXf> t(theta + i * kp, k_count);
-      Eigen::Map<Eigen::ArrayXf> out(phi + i * kp, kp);
-      out.head(k_count) = (t - t.maxCoeff()).exp();
-      out.tail(kp - k_count).setZero();
-    });
-  barrier.rethrow();
+  parallel_for(count, threads, Schedule::Static(), [&](std::ptrdiff_t i) {
+    const Eigen::Map<const Eigen::ArrayXf> t(theta + i * kp, k_count);
+    Eigen::Map<Eigen::ArrayXf> out(phi + i * kp, kp);
+    out.head(k_count) = (t - t.maxCoeff()).exp();
+    out.tail(kp - k_count).setZero();
+  });
 }
 
 }  // namespace primlabel::crf::detail

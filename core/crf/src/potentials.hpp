@@ -9,6 +9,7 @@
 #include <memory>
 #include <span>
 #include <stop_token>
+#include <utility>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -94,14 +95,19 @@ class FlushSubnormals {
   }
   ~FlushSubnormals() {
 #if defined(__SSE2__)
-    _mm_setcsr(saved_);
+    if (armed_) _mm_setcsr(saved_);
 #endif
   }
+  // Movable into a thread's scratch (parallel_for): only the last owner restores the mode.
+  FlushSubnormals(FlushSubnormals&& other) noexcept
+      : saved_(other.saved_), armed_(std::exchange(other.armed_, false)) {}
   FlushSubnormals(const FlushSubnormals&) = delete;
   FlushSubnormals& operator=(const FlushSubnormals&) = delete;
+  FlushSubnormals& operator=(FlushSubnormals&&) = delete;
 
  private:
   unsigned saved_ = 0;
+  bool armed_ = true;
 };
 
 // Threads worth starting for `nodes` nodes: small graphs run on one thread, since a parallel

@@ -1,7 +1,5 @@
 #include "primlabel/tabletop/plane_fit.hpp"
 
-#include <omp.h>
-
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -12,6 +10,9 @@
 #include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::tabletop {
+
+using primlabel::detail::parallel_for;
+using primlabel::detail::Schedule;
 
 void PlaneFitOptions::validate() const {
   const auto fail = [](const std::string& what) { throw std::invalid_argument(what); };
@@ -148,7 +149,7 @@ PlaneFit fit_plane(const std::vector<Vec3f>& points, const std::vector<std::uint
 
   Random random(options.seed);
   constexpr int kBlock = 32;  // hypotheses per parallel round; fixed, so results ignore threads
-  const int threads = context.threads > 0 ? context.threads : omp_get_max_threads();
+  const int threads = primlabel::detail::resolve_threads(context.threads);
   Hypothesis best;
   best.cost = std::numeric_limits<double>::infinity();
   double needed = options.max_iterations;
@@ -165,28 +166,24 @@ PlaneFit fit_plane(const std::vector<Vec3f>& points, const std::vector<std::uint
       if (block[h].usable && axis && std::abs(block[h].plane.head<3>().dot(*axis)) < min_cos)
         block[h].usable = false;  // outside the allowed tilt: not even scored
     }
-    primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel for num_threads(threads) schedule(static, 1)
-    for (int h = 0; h < count; ++h)
-      barrier.run([&] {
-        Hypothesis& hyp = block[h];
-        if (!hyp.usable) return;
-        double cost = 0.0;
-        std::size_t inliers = 0;
-        for (const Vec3f& p : subset) {
-          const double d = signed_distance(hyp.plane, p);
-          const double sq = d * d;
-          if (sq <= sq_t) {
-            cost += sq;
-            ++inliers;
-          } else {
-            cost += sq_t;
-          }
+    parallel_for(count, threads, Schedule::Dynamic(1), [&](std::ptrdiff_t h) {
+      Hypothesis& hyp = block[h];
+      if (!hyp.usable) return;
+      double cost = 0.0;
+      std::size_t inliers = 0;
+      for (const Vec3f& p : subset) {
+        const double d = signed_distance(hyp.plane, p);
+        const double sq = d * d;
+        if (sq <= sq_t) {
+          cost += sq;
+          ++inliers;
+        } else {
+          cost += sq_t;
         }
-        hyp.cost = cost;
-        hyp.inliers = inliers;
-      });
-    barrier.rethrow();
+      }
+      hyp.cost = cost;
+      hyp.inliers = inliers;
+    });
     for (const Hypothesis& hyp : block)
       if (hyp.usable && hyp.cost < best.cost) best = hyp;
     drawn += count;

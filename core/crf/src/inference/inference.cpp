@@ -14,6 +14,9 @@
 
 namespace primlabel::crf {
 
+using primlabel::detail::parallel_for;
+using primlabel::detail::Schedule;
+
 struct InferenceWorkspace::Buffers {
   detail::ScratchBuffer<float> theta;       // node scores, num_nodes x kp
   detail::ScratchBuffer<float> phi;         // node potentials (BP)
@@ -47,13 +50,9 @@ void outputs_from_rows(const float* rows, bool log_scores, const CrfModel& model
   const int k_count = model.num_classes();
   const int kp = detail::padded_classes(k_count);
   float* marginals = outputs.marginals ? result.marginals.data() : nullptr;
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads)
-  {
-    std::vector<double> p(k_count);
-#pragma omp for schedule(static)
-    for (long long i = 0; i < n; ++i)
-      barrier.run([&] {
+  parallel_for(
+      n, threads, Schedule::Static(), [&] { return std::vector<double>(k_count); },
+      [&](std::vector<double>& p, std::ptrdiff_t i) {
         if (!graph.active[i]) {
           result.labels[i] = outputs.unknown_label;
           if (marginals)
@@ -73,8 +72,6 @@ void outputs_from_rows(const float* rows, bool log_scores, const CrfModel& model
         for (int k = 0; k < k_count; ++k)
           marginals[std::size_t(k) * n + i] = static_cast<float>(p[k] / sum);
       });
-  }
-  barrier.rethrow();
 }
 
 }  // namespace

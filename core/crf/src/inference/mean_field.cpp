@@ -7,6 +7,10 @@
 #include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf::detail {
+
+using primlabel::detail::parallel_for;
+using primlabel::detail::Schedule;
+
 namespace {
 
 // Pads get this score, so exp makes them exactly 0 (and -inf would risk inf - inf).
@@ -53,6 +57,16 @@ class MeanFieldUpdater {
   ArrayF a_, fresh_, pad_;
 };
 
+// What each thread keeps through a parallel pass: its subnormal mode, its updater, whether it saw
+// the stop (then it skips its remaining nodes) and the largest change it made.
+template <int KP>
+struct MeanFieldThread {
+  FlushSubnormals flush;  // exp of very negative scores would run into slow subnormals
+  MeanFieldUpdater<KP> updater;
+  bool stopped = false;
+  float max_change = 0.0f;
+};
+
 template <int KP>
 BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, const RunContext& context,
           MeanFieldBuffers& buffers) {
@@ -66,23 +80,18 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, const RunConte
   float* next = next_buf.resize(g.num_nodes() * kp);
   // Start from the node-only posterior, in both buffers: rows without neighbours are never
   // rewritten.
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads)
-  {
-    FlushSubnormals flush;  // exp of very negative scores would run into slow subnormals
-    MeanFieldUpdater<KP> updater(pr.classes, kp);
-#pragma omp for schedule(static)
-    for (long long i = 0; i < n; ++i)
-      barrier.run([&] {
-        if (g.active[i]) {
-          updater.start(pr, i, q);
-        } else {
-          std::fill_n(q + i * kp, kp, 0.0f);
-        }
-        std::copy_n(q + i * kp, kp, next + i * kp);
-      });
-  }
-  barrier.rethrow();
+  const auto make_thread = [&] {
+    return MeanFieldThread<KP>{FlushSubnormals{}, MeanFieldUpdater<KP>(pr.classes, kp)};
+  };
+  parallel_for(n, threads, Schedule::Static(), make_thread,
+               [&](MeanFieldThread<KP>& thread, std::ptrdiff_t i) {
+                 if (g.active[i]) {
+                   thread.updater.start(pr, i, q);
+                 } else {
+                   std::fill_n(q + i * kp, kp, 0.0f);
+                 }
+                 std::copy_n(q + i * kp, kp, next + i * kp);
+               });
   std::uint8_t* moved_before = buffers.moved.resize(g.num_nodes());
   std::uint8_t* moved = buffers.moved_next.resize(g.num_nodes());
   std::uint8_t* same = buffers.same.resize(g.num_nodes());
@@ -91,18 +100,13 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, const RunConte
   BpRun report;
   for (int iteration = 1; iteration <= settings.max_iterations; ++iteration) {
     if (context.stopped()) break;
+    // The largest change of any node: a maximum, so the same whatever the threads.
     float max_change = 0.0f;
-    primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads) reduction(max : max_change)
-    {
-      FlushSubnormals flush;
-      MeanFieldUpdater<KP> updater(pr.classes, kp);
-      bool stopped = false;  // per thread: once cancelled, the remaining nodes are skipped
-#pragma omp for schedule(dynamic, 1024)
-      for (long long i = 0; i < n; ++i)
-        barrier.run([&] {
-          if ((i & 1023) == 0) stopped = stopped || context.stopped();
-          if (stopped) return;
+    parallel_for(
+        n, threads, Schedule::Dynamic(1024), make_thread,
+        [&](MeanFieldThread<KP>& thread, std::ptrdiff_t i) {
+          if ((i & 1023) == 0) thread.stopped = thread.stopped || context.stopped();
+          if (thread.stopped) return;
           if (g.offsets[i] == g.offsets[i + 1]) return;  // no neighbours: q is final
           // Skip a node whose q and neighbours' q all settled last iteration (decided from the
           // previous iteration alone: thread-count independent).
@@ -118,12 +122,13 @@ BpRun run(const MeanFieldProblem& pr, const BpSettings& settings, const RunConte
             return;
           }
           same[i] = 0;
-          const float change = updater.update(pr, q, next, settings.damping, i);
+          const float change = thread.updater.update(pr, q, next, settings.damping, i);
           moved[i] = change >= settings.tolerance;
-          max_change = std::max(max_change, change);
+          thread.max_change = std::max(thread.max_change, change);
+        },
+        [&](const MeanFieldThread<KP>& thread) {
+          max_change = std::max(max_change, thread.max_change);
         });
-    }
-    barrier.rethrow();
     std::swap(q_buf, next_buf);
     std::swap(q, next);
     std::swap(moved_before, moved);

@@ -16,6 +16,10 @@
 #include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf::detail {
+
+using primlabel::detail::parallel_for;
+using primlabel::detail::Schedule;
+
 namespace {
 
 // theta is capped before exp, as in inference (potentials.cpp): psi stays far from float overflow.
@@ -77,13 +81,9 @@ class BetheLikelihood final : public Objective {
       float* phi = state.phi.resize(std::size_t(n) * kp);
       float* psi = state.psi_minus_one.resize(g.num_edges() * kp);
       const std::uint32_t* edge_of = state.edge_of.data();
-      primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads)
-      {
-        Eigen::RowVectorXd e(edge_row);
-#pragma omp for schedule(dynamic, 256)
-        for (long long i = 0; i < n; ++i)
-          barrier.run([&] {
+      parallel_for(
+          n, threads, Schedule::Dynamic(256), [&] { return Eigen::RowVectorXd(edge_row); },
+          [&](Eigen::RowVectorXd& e, std::ptrdiff_t i) {
             node_theta[s].row(i).noalias() = scene.features.row(i) * w.transpose();
             const auto theta = node_theta[s].row(i);
             const double mx = theta.maxCoeff();
@@ -105,8 +105,6 @@ class BetheLikelihood final : public Objective {
                                      : 0.0f;
             }
           });
-      }
-      barrier.rethrow();
       const BpPotentials potentials{&g, k_count, phi, psi, edge_of};
       state.bp.set_potentials(potentials);  // a warm start once a run has converged
       const BpRun run = state.bp.run(bp_, context_);
@@ -125,12 +123,9 @@ class BetheLikelihood final : public Objective {
       const std::span<const float> messages = state.bp.messages();
       state.saved.assign(messages.begin(), messages.end());
       beliefs[s] = RowMatrixXd::Zero(n, k_count);
-#pragma omp parallel for schedule(static) num_threads(threads)
-      for (long long i = 0; i < n; ++i)
-        barrier.run([&] {
-          if (g.active[i]) state.bp.beliefs(i, {beliefs[s].row(i).data(), std::size_t(k_count)});
-        });
-      barrier.rethrow();
+      parallel_for(n, threads, Schedule::Static(), [&](std::ptrdiff_t i) {
+        if (g.active[i]) state.bp.beliefs(i, {beliefs[s].row(i).data(), std::size_t(k_count)});
+      });
     }
 
     const auto block_count = static_cast<std::ptrdiff_t>(blocks_.size());

@@ -16,6 +16,10 @@
 #include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::crf::detail {
+
+using primlabel::detail::parallel_for;
+using primlabel::detail::Schedule;
+
 namespace {
 
 class PseudoLikelihood final : public Objective {
@@ -112,14 +116,14 @@ class PseudoLikelihood final : public Objective {
     const Eigen::Map<const RowMatrixXd> w(x.data(), k_count, row);
     const RowMatrixXd w_t = w.transpose();  // a tent's K weights contiguous (tent_block)
     const long long block_count = static_cast<long long>(blocks_.size());
-    primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads_)
-    {
+    struct Scratch {
       RowMatrixXd residual;  // p - [k == y_i] per node of the block (0 for ignored nodes)
       RowMatrixXd grad_t;    // node_row x K
-#pragma omp for schedule(dynamic, 1)
-      for (long long b = 0; b < block_count; ++b)
-        barrier.run([&] {
+    };
+    parallel_for(
+        block_count, threads_, Schedule::Dynamic(1), [] { return Scratch{}; },
+        [&](Scratch& scratch, std::ptrdiff_t b) {
+          RowMatrixXd& residual = scratch.residual;
           const NodeBlock& block = blocks_[b];
           const PreparedScene& scene = scenes_[block.scene];
           double loss = 0.0;
@@ -131,13 +135,11 @@ class PseudoLikelihood final : public Objective {
               loss += softmax_residual(residual.row(r), scene.labels[block.first + r]);
             grad_w.noalias() = residual.transpose() * features;
           } else {
-            loss = tent_block(block, w_t, residual, grad_t);
-            grad_w = grad_t.transpose();
+            loss = tent_block(block, w_t, residual, scratch.grad_t);
+            grad_w = scratch.grad_t.transpose();
           }
           partial_loss_(b) = loss;
         });
-    }
-    barrier.rethrow();
   }
 
   void evaluate_blocks_with_edges(const Eigen::VectorXd& x) {
@@ -148,56 +150,59 @@ class PseudoLikelihood final : public Objective {
     const Eigen::Map<const RowMatrixXd> w(x.data(), k_count, row);
     const Eigen::Map<const RowMatrixXd> v(x.data() + shape_.node_size(), k_count, edge_row);
     const long long block_count = static_cast<long long>(blocks_.size());
-    primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(threads_)
-    {
-      Eigen::VectorXd scores(k_count), prob(k_count);
-      RowMatrixXd summed(k_count, edge_row);  // A_i(k): edge features summed per neighbour label
-      std::vector<int> present;               // labels among the neighbours
-      present.reserve(k_count);
-#pragma omp for schedule(dynamic, 1)
-      for (long long b = 0; b < block_count; ++b)
-        barrier.run([&] {
-          const NodeBlock& block = blocks_[b];
-          const PreparedScene& scene = scenes_[block.scene];
-          const Graph& g = *scene.graph;
-          Eigen::Map<RowMatrixXd> grad_w(partial_grad_.col(b).data(), k_count, row);
-          Eigen::Map<RowMatrixXd> grad_v(partial_grad_.col(b).data() + shape_.node_size(), k_count,
-                                         edge_row);
-          double loss = 0.0;
-          for (long long i = block.first; i < block.first + block.count; ++i) {
-            const int yi = scene.labels[i];
-            if (yi < 0) continue;
-            const auto xi = scene.features.row(i);
-            const auto ui = scene.edge_features.row(i);
-            scores.noalias() = w * xi.transpose();
-            present.clear();
-            for (std::uint32_t j : g.neighbors_of(i)) {
-              const int yj = scene.labels[j];
-              if (yj < 0) continue;
-              if (std::find(present.begin(), present.end(), yj) == present.end()) {
-                present.push_back(yj);
-                summed.row(yj).setZero();
-              }
-              summed.row(yj).head(d) += ui.head(d).cwiseProduct(scene.edge_features.row(j).head(d));
-              summed(yj, d) += 1.0;
-            }
-            for (int l : present) scores(l) += v.row(l).dot(summed.row(l));
-            const double top = scores.maxCoeff();
-            prob = (scores.array() - top).exp();
-            const double z = prob.sum();
-            prob /= z;
-            const double weight = weights_[std::size_t(yi)];
-            loss -= weight * (scores(yi) - top - std::log(z));
-            prob(yi) -= 1.0;  // d(-log p(y_i)) / d score = p - [k == y_i]
-            prob *= weight;
-            grad_w.noalias() += prob * xi;
-            for (int l : present) grad_v.row(l) += prob(l) * summed.row(l);
-          }
-          partial_loss_(b) = loss;
-        });
-    }
-    barrier.rethrow();
+    struct Scratch {
+      Eigen::VectorXd scores, prob;
+      RowMatrixXd summed;        // A_i(k): edge features summed per neighbour label
+      std::vector<int> present;  // labels among the neighbours
+    };
+    const auto make_scratch = [&] {
+      Scratch scratch{
+          Eigen::VectorXd(k_count), Eigen::VectorXd(k_count), RowMatrixXd(k_count, edge_row), {}};
+      scratch.present.reserve(k_count);
+      return scratch;
+    };
+    parallel_for(block_count, threads_, Schedule::Dynamic(1), make_scratch,
+                 [&](Scratch& scratch, std::ptrdiff_t b) {
+                   auto& [scores, prob, summed, present] = scratch;
+                   const NodeBlock& block = blocks_[b];
+                   const PreparedScene& scene = scenes_[block.scene];
+                   const Graph& g = *scene.graph;
+                   Eigen::Map<RowMatrixXd> grad_w(partial_grad_.col(b).data(), k_count, row);
+                   Eigen::Map<RowMatrixXd> grad_v(partial_grad_.col(b).data() + shape_.node_size(),
+                                                  k_count, edge_row);
+                   double loss = 0.0;
+                   for (long long i = block.first; i < block.first + block.count; ++i) {
+                     const int yi = scene.labels[i];
+                     if (yi < 0) continue;
+                     const auto xi = scene.features.row(i);
+                     const auto ui = scene.edge_features.row(i);
+                     scores.noalias() = w * xi.transpose();
+                     present.clear();
+                     for (std::uint32_t j : g.neighbors_of(i)) {
+                       const int yj = scene.labels[j];
+                       if (yj < 0) continue;
+                       if (std::find(present.begin(), present.end(), yj) == present.end()) {
+                         present.push_back(yj);
+                         summed.row(yj).setZero();
+                       }
+                       summed.row(yj).head(d) +=
+                           ui.head(d).cwiseProduct(scene.edge_features.row(j).head(d));
+                       summed(yj, d) += 1.0;
+                     }
+                     for (int l : present) scores(l) += v.row(l).dot(summed.row(l));
+                     const double top = scores.maxCoeff();
+                     prob = (scores.array() - top).exp();
+                     const double z = prob.sum();
+                     prob /= z;
+                     const double weight = weights_[std::size_t(yi)];
+                     loss -= weight * (scores(yi) - top - std::log(z));
+                     prob(yi) -= 1.0;  // d(-log p(y_i)) / d score = p - [k == y_i]
+                     prob *= weight;
+                     grad_w.noalias() += prob * xi;
+                     for (int l : present) grad_v.row(l) += prob(l) * summed.row(l);
+                   }
+                   partial_loss_(b) = loss;
+                 });
   }
 
   const std::vector<PreparedScene>& scenes_;

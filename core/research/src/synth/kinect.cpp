@@ -94,37 +94,35 @@ PointCloud scan_kinect(const Scene& scene, const KinectOptions& options, double 
   const double field_weight = correlated ? std::sqrt(1.0 - options.independent_noise_share) : 0.0;
 
   std::vector<detail::Return> returns(pixels);
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel for schedule(dynamic, 8)
-  for (int v = 0; v < options.height; ++v)
-    barrier.run([&] {
-      for (int u = 0; u < options.width; ++u) {
-        const std::size_t pixel = std::size_t(v) * options.width + u;
-        const Vec3d camera_ray((u - cx) / focal, (v - cy) / focal, 1.0);  // z = 1: depth units
-        const Ray ray{options.position, (rotation * camera_ray).normalized()};
-        Rng rng(mix_seed(seed, kKinectStream, pixel));
-        const double lost = rng.uniform();
-        const double noise =
-            white_weight * rng.normal() + (correlated ? field_weight * field[pixel] : 0.0);
+  primlabel::detail::parallel_for(
+      options.height, 0, primlabel::detail::Schedule::Dynamic(8), [&](std::ptrdiff_t v) {
+        for (int u = 0; u < options.width; ++u) {
+          const std::size_t pixel = std::size_t(v) * options.width + u;
+          const Vec3d camera_ray((u - cx) / focal, (v - cy) / focal, 1.0);  // z = 1: depth units
+          const Ray ray{options.position, (rotation * camera_ray).normalized()};
+          Rng rng(mix_seed(seed, kKinectStream, pixel));
+          const double lost = rng.uniform();
+          const double noise =
+              white_weight * rng.normal() + (correlated ? field_weight * field[pixel] : 0.0);
 
-        const auto hit = scene.cast(ray, 1e-6, options.max_range * 2.0);
-        if (!hit || lost < options.dropout) continue;
-        if (-ray.dir.dot(hit->normal) < min_cos_incidence) continue;
-        const Vec3d point = ray.at(hit->t);
-        const double depth = hit->t / camera_ray.norm();
-        if (depth < options.min_range || depth > options.max_range) continue;
-        if (options.projector_shadow && scene.occluded(projector, point)) continue;
+          const auto hit = scene.cast(ray, 1e-6, options.max_range * 2.0);
+          if (!hit || lost < options.dropout) continue;
+          if (-ray.dir.dot(hit->normal) < min_cos_incidence) continue;
+          const Vec3d point = ray.at(hit->t);
+          const double depth = hit->t / camera_ray.norm();
+          if (depth < options.min_range || depth > options.max_range) continue;
+          if (options.projector_shadow && scene.occluded(projector, point)) continue;
 
-        double measured = depth + options.depth_noise * depth * depth * noise;
-        if (options.quantize) {
-          const double disparity = focal_baseline / measured;
-          measured = focal_baseline / (std::round(disparity * options.subpixel) / options.subpixel);
+          double measured = depth + options.depth_noise * depth * depth * noise;
+          if (options.quantize) {
+            const double disparity = focal_baseline / measured;
+            measured =
+                focal_baseline / (std::round(disparity * options.subpixel) / options.subpixel);
+          }
+          const Vec3d measured_point = options.position + rotation * (camera_ray * measured);
+          returns[pixel] = detail::make_return(scene, *hit, point, measured_point, label_radius);
         }
-        const Vec3d measured_point = options.position + rotation * (camera_ray * measured);
-        returns[pixel] = detail::make_return(scene, *hit, point, measured_point, label_radius);
-      }
-    });
-  barrier.rethrow();
+      });
 
   PointCloud cloud;
   detail::label_unseen_creases_as_surface(returns, label_radius);

@@ -68,33 +68,30 @@ PointCloud scan_lms400(const Scene& scene, const Lms400Options& options, double 
   const double min_cos_incidence = std::cos(options.max_incidence_deg * kDeg);
 
   std::vector<std::vector<detail::Return>> line_returns(lines);
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel for schedule(dynamic, 4)
-  for (int line = 0; line < lines; ++line)
-    barrier.run([&] {
-      const double fraction = lines > 1 ? double(line) / double(lines - 1) : 0.5;
-      const double pitch =
-          (options.pitch_near_deg + fraction * (options.pitch_far_deg - options.pitch_near_deg)) *
-          kDeg;
-      const Vec3d forward = std::cos(pitch) * level_forward - std::sin(pitch) * Vec3d::UnitZ();
-      std::vector<detail::Return>& out = line_returns[line];
-      for (int k = 0; k < per_line; ++k) {
-        const double theta = (-0.5 * options.fov_deg + k * options.angular_step_deg) * kDeg;
-        const Ray ray{options.position,
-                      (std::cos(theta) * forward + std::sin(theta) * right).normalized()};
-        Rng rng(mix_seed(seed, kLms400Stream, std::uint64_t(line) * per_line + k));
-        const double lost = rng.uniform();
-        const double noise = rng.normal();
+  primlabel::detail::parallel_for(
+      lines, 0, primlabel::detail::Schedule::Dynamic(4), [&](std::ptrdiff_t line) {
+        const double fraction = lines > 1 ? double(line) / double(lines - 1) : 0.5;
+        const double pitch =
+            (options.pitch_near_deg + fraction * (options.pitch_far_deg - options.pitch_near_deg)) *
+            kDeg;
+        const Vec3d forward = std::cos(pitch) * level_forward - std::sin(pitch) * Vec3d::UnitZ();
+        std::vector<detail::Return>& out = line_returns[line];
+        for (int k = 0; k < per_line; ++k) {
+          const double theta = (-0.5 * options.fov_deg + k * options.angular_step_deg) * kDeg;
+          const Ray ray{options.position,
+                        (std::cos(theta) * forward + std::sin(theta) * right).normalized()};
+          Rng rng(mix_seed(seed, kLms400Stream, std::uint64_t(line) * per_line + k));
+          const double lost = rng.uniform();
+          const double noise = rng.normal();
 
-        const auto hit = scene.cast(ray, 1e-6, options.max_range);
-        if (!hit || hit->t < options.min_range || lost < options.dropout) continue;
-        if (-ray.dir.dot(hit->normal) < min_cos_incidence) continue;
-        const Vec3d point = ray.at(hit->t);
-        const Vec3d measured = ray.at(hit->t + options.range_noise * noise);
-        out.push_back(detail::make_return(scene, *hit, point, measured, label_radius));
-      }
-    });
-  barrier.rethrow();
+          const auto hit = scene.cast(ray, 1e-6, options.max_range);
+          if (!hit || hit->t < options.min_range || lost < options.dropout) continue;
+          if (-ray.dir.dot(hit->normal) < min_cos_incidence) continue;
+          const Vec3d point = ray.at(hit->t);
+          const Vec3d measured = ray.at(hit->t + options.range_noise * noise);
+          out.push_back(detail::make_return(scene, *hit, point, measured, label_radius));
+        }
+      });
 
   std::vector<detail::Return> returns;
   for (auto& line : line_returns) returns.insert(returns.end(), line.begin(), line.end());

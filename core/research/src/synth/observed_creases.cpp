@@ -16,13 +16,10 @@ void label_unseen_creases_as_surface(std::vector<Return>& returns, double label_
   const double fraction = kObservedCreaseFraction;
 
   std::vector<std::uint32_t> relabeled(returns.size());
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel
-  {
-    NeighborList neighbors;
-#pragma omp for schedule(dynamic, 256)
-    for (long long i = 0; i < static_cast<long long>(returns.size()); ++i)
-      barrier.run([&] {
+  primlabel::detail::parallel_for(
+      static_cast<std::ptrdiff_t>(returns.size()), 0, primlabel::detail::Schedule::Dynamic(256),
+      [] { return NeighborList{}; },
+      [&](NeighborList& neighbors, std::ptrdiff_t i) {
         const Return& r = returns[i];
         relabeled[i] = r.label;
         if (r.part < 0 || r.label == r.surface_label) return;
@@ -32,8 +29,6 @@ void label_unseen_creases_as_surface(std::vector<Return>& returns, double label_
           across += returns[j].object != r.object || returns[j].part != r.part;
         if (double(across) < fraction * double(neighbors.size())) relabeled[i] = r.surface_label;
       });
-  }
-  barrier.rethrow();
   for (std::size_t i = 0; i < returns.size(); ++i) returns[i].label = relabeled[i];
 }
 

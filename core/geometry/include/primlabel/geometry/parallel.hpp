@@ -1,7 +1,8 @@
 #pragma once
-// Helpers for the OpenMP per-point loops: thread count resolution, an exception barrier (an
-// exception leaving an OpenMP region calls std::terminate), a block loop built on it, and
-// progress reporting that never calls the user's callback from two threads at once.
+// The parallel loops: thread count resolution, an exception barrier (an exception leaving an
+// OpenMP region calls std::terminate), the one parallel loop built on it (parallel_for) and its
+// block form, and progress reporting that never calls the user's callback from two threads at
+// once. Code outside this header writes no OpenMP pragma of its own.
 
 #include <omp.h>
 
@@ -50,28 +51,74 @@ class ExceptionBarrier {
   std::exception_ptr error_;
 };
 
-// body(scratch, block) for every block in [0, blocks), one block at a time per thread (dynamic
-// schedule), on context.threads threads (0 = OpenMP default), with one scratch per thread made by
-// make_scratch(). The blocks are the caller's fixed unit of work, so what a block computes never
-// depends on the thread count. Blocks are skipped once context.stop is requested (the caller then
-// throws Cancelled) or once a block has thrown; the first exception is rethrown here, after the
-// region.
-template <typename MakeScratch, typename Body>
-void for_each_block(std::ptrdiff_t blocks, const RunContext& context, MakeScratch&& make_scratch,
-                    Body&& body) {
+// How a loop's iterations go to the threads: equal contiguous slices (static, the cheapest for
+// uniform work) or chunks of `chunk` iterations on demand (dynamic, for uneven work).
+struct Schedule {
+  int chunk = 0;  // 0: static
+  static constexpr Schedule Static() { return {0}; }
+  static constexpr Schedule Dynamic(int chunk) { return {chunk}; }
+};
+
+// The one parallel loop of the code base (every other loop is built on it): body(scratch, i) for
+// every i in [0, n) on `threads` threads (0 = OpenMP default), with one scratch per thread made
+// by make_scratch(); after its last iteration each thread hands its scratch to merge(scratch),
+// one thread at a time (for reductions: keep them order-independent, like a maximum, so that
+// they do not depend on the thread count). No exception escapes the region: once make_scratch,
+// body or merge has thrown, the remaining iterations are skipped and the first exception is
+// rethrown here.
+template <typename MakeScratch, typename Body, typename Merge>
+void parallel_for(std::ptrdiff_t n, int threads, Schedule schedule, MakeScratch&& make_scratch,
+                  Body&& body, Merge&& merge) {
   ExceptionBarrier barrier;
-  const std::stop_token& stop = context.stop;
-#pragma omp parallel num_threads(resolve_threads(context.threads))
+#pragma omp parallel num_threads(resolve_threads(threads))
   {
     std::optional<decltype(make_scratch())> scratch;
     barrier.run([&] { scratch.emplace(make_scratch()); });
-#pragma omp for schedule(dynamic, 1)
-    for (std::ptrdiff_t block = 0; block < blocks; ++block) {
-      if (!scratch || barrier.failed() || stop.stop_requested()) continue;
-      barrier.run([&] { body(*scratch, block); });
+    if (schedule.chunk <= 0) {
+#pragma omp for schedule(static)
+      for (std::ptrdiff_t i = 0; i < n; ++i)
+        if (scratch) barrier.run([&] { body(*scratch, i); });
+    } else {
+#pragma omp for schedule(dynamic, schedule.chunk)
+      for (std::ptrdiff_t i = 0; i < n; ++i)
+        if (scratch) barrier.run([&] { body(*scratch, i); });
+    }
+    if (scratch) {
+#pragma omp critical(primlabel_parallel_for_merge)
+      barrier.run([&] { merge(*scratch); });
     }
   }
   barrier.rethrow();
+}
+
+template <typename MakeScratch, typename Body>
+void parallel_for(std::ptrdiff_t n, int threads, Schedule schedule, MakeScratch&& make_scratch,
+                  Body&& body) {
+  parallel_for(n, threads, schedule, make_scratch, body, [](auto&) {});
+}
+
+// body(i) for every i in [0, n), without scratch.
+template <typename Body>
+void parallel_for(std::ptrdiff_t n, int threads, Schedule schedule, Body&& body) {
+  struct None {};
+  parallel_for(
+      n, threads, schedule, [] { return None{}; }, [&](None&, std::ptrdiff_t i) { body(i); },
+      [](None&) {});
+}
+
+// body(scratch, block) for every block in [0, blocks), one block at a time per thread (dynamic
+// schedule), on context.threads threads, with one scratch per thread made by make_scratch(). The
+// blocks are the caller's fixed unit of work, so what a block computes never depends on the
+// thread count. Blocks are skipped once context.stop is requested (the caller then throws
+// Cancelled) or once a block has thrown; the first exception is rethrown here, after the region.
+template <typename MakeScratch, typename Body>
+void for_each_block(std::ptrdiff_t blocks, const RunContext& context, MakeScratch&& make_scratch,
+                    Body&& body) {
+  const std::stop_token& stop = context.stop;
+  parallel_for(blocks, context.threads, Schedule::Dynamic(1), make_scratch,
+               [&](auto& scratch, std::ptrdiff_t block) {
+                 if (!stop.stop_requested()) body(scratch, block);
+               });
 }
 
 // v.assign(n, value), filled in slices of 1M elements with a stop check before each: the first

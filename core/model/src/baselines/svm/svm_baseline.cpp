@@ -16,6 +16,10 @@
 #include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::svm {
+
+using primlabel::detail::parallel_for;
+using primlabel::detail::Schedule;
+
 namespace {
 
 void quiet(const char*) {}
@@ -195,14 +199,17 @@ SvmPrediction SvmClassifier::predict(std::span<const float> descriptors,
   out.labels.assign(n, unknown_label);
   out.probabilities.setZero(n, k_count);
   const bool with_probability = svm_check_probability_model(model);
-  primlabel::detail::ExceptionBarrier barrier;
-#pragma omp parallel num_threads(primlabel::detail::resolve_threads(threads))
-  {
+  struct Scratch {
     std::vector<svm_node> row;
-    std::vector<double> estimates(m.column_of_label.size());
-#pragma omp for schedule(dynamic, 64)
-    for (long long i = 0; i < n; ++i)
-      barrier.run([&] {
+    std::vector<double> estimates;
+  };
+  parallel_for(
+      n, threads, Schedule::Dynamic(64),
+      [&] {
+        return Scratch{{}, std::vector<double>(m.column_of_label.size())};
+      },
+      [&](Scratch& scratch, std::ptrdiff_t i) {
+        auto& [row, estimates] = scratch;
         if (stop.stop_requested()) return;  // cancelled: skip the remaining points
         const float* d = descriptors.data() + i * m.dim;
         if (!std::all_of(d, d + m.dim, [](float v) { return std::isfinite(v); })) {
@@ -221,8 +228,6 @@ SvmPrediction SvmClassifier::predict(std::span<const float> descriptors,
         }
         out.labels[i] = m.class_ids[static_cast<int>(label)];
       });
-  }
-  barrier.rethrow();
   throw_if_stopped(stop, "SVM prediction");
   return out;
 }
