@@ -1,28 +1,21 @@
 #pragma once
-// The stages of label_cloud in ms, in pipeline order (voxel and table-top make up prefilter),
-// as the pipeline and server benchmarks print them.
+// label_cloud's stages in ms, as the pipeline and server benchmarks print them: the names and the
+// order are pipeline::kLabelingStages', a column as wide as its name.
 
-#include "primlabel/pipeline/labeling.hpp"
+#include <algorithm>
+#include <cstring>
+
+#include "primlabel/pipeline/stage_seconds.hpp"
 
 namespace primlabel::bench {
 
-struct LabelStage {
-  const char* name;
-  double (*ms)(const pipeline::LabelingResult&);
-};
+inline double stage_ms(const pipeline::StageSeconds& seconds,
+                       const pipeline::LabelingStage& stage) {
+  return 1e3 * (seconds.*stage.seconds);
+}
 
-inline constexpr LabelStage kLabelStages[] = {
-    {"voxel", [](const pipeline::LabelingResult& r) { return 1e3 * r.voxel_seconds; }},
-    {"index", [](const pipeline::LabelingResult& r) { return 1e3 * r.index_seconds; }},
-    {"lists", [](const pipeline::LabelingResult& r) { return 1e3 * r.lists_seconds; }},
-    {"normals", [](const pipeline::LabelingResult& r) { return 1e3 * r.normal_seconds; }},
-    {"fpfh", [](const pipeline::LabelingResult& r) { return 1e3 * r.descriptor_seconds; }},
-    {"graph", [](const pipeline::LabelingResult& r) { return 1e3 * r.graph_seconds; }},
-    {"infer",
-     [](const pipeline::LabelingResult& r) {
-       return 1e3 * (r.inference_seconds - r.graph_seconds);  // inference_seconds holds the graph
-     }},
-    {"fanout", [](const pipeline::LabelingResult& r) { return 1e3 * r.fanout_seconds; }},
-};
+inline int stage_column_width(const pipeline::LabelingStage& stage) {
+  return std::max(7, static_cast<int>(std::strlen(stage.name)));
+}
 
 }  // namespace primlabel::bench

@@ -60,7 +60,7 @@ struct Row {
   double feature_s = 0, inference_s = 0, total_s = 0;
   double p50_ms = 0, p90_ms = 0;
   double cpu_p50_ms = 0;  // process CPU time (all threads) per run: steadier on a busy machine
-  pipeline::LabelingResult stages;  // the p50 run's timings (labels dropped)
+  pipeline::StageSeconds stages;  // the p50 run's
   double points_per_s() const { return double(points) / std::max(total_s, 1e-9); }
 };
 
@@ -113,7 +113,7 @@ Row measure(const LabelModel& model, const PointCloud& scene, int threads, int r
   if (voxel >= 0.0f) options.voxel_size = voxel;
   options.share_neighbor_lists = share_lists;
   std::vector<double> totals, cpu;
-  std::vector<pipeline::LabelingResult> runs;
+  std::vector<pipeline::StageSeconds> runs;
   for (int r = 0; r < repeat; ++r) {
     PointCloud cloud = scene;  // label_cloud writes normals into it
     const double cpu_start = process_cpu_ms();
@@ -126,14 +126,12 @@ Row measure(const LabelModel& model, const PointCloud& scene, int threads, int r
     totals.push_back(total);
     if (total < best.total_s) {
       best.total_s = total;
-      best.feature_s = result.feature_seconds;
-      best.inference_s = result.inference_seconds;
+      best.feature_s = result.seconds.normals + result.seconds.descriptors;
+      best.inference_s = result.seconds.graph + result.seconds.inference;
       best.labeled = result.labeled_points;
       best.described = result.described_points;
     }
-    result.labels = {};
-    result.class_ids = {};
-    runs.push_back(std::move(result));
+    runs.push_back(result.seconds);
   }
   best.p50_ms = 1e3 * percentile(totals, 0.5);
   best.p90_ms = 1e3 * percentile(totals, 0.9);
@@ -143,7 +141,7 @@ Row measure(const LabelModel& model, const PointCloud& scene, int threads, int r
   for (std::size_t r = 0; r < totals.size(); ++r)
     if (std::abs(1e3 * totals[r] - best.p50_ms) < std::abs(1e3 * totals[median] - best.p50_ms))
       median = r;
-  best.stages = std::move(runs[median]);
+  best.stages = runs[median];
   best.threads = threads;
   best.voxel = voxel >= 0.0f ? voxel : model.features.voxel_size;
   best.points = scene.size();
@@ -251,7 +249,8 @@ int run_pipeline_bench(const Arguments& args) {
   std::vector<Row> rows;
   std::printf("%-7s %-10s %3s %6s %8s %8s %8s %8s %7s %8s", "sensor", "model", "thr", "voxel",
               "points", "voxels", "p50 ms", "p90 ms", "frame/s", "cpu ms");
-  for (const bench::LabelStage& c : bench::kLabelStages) std::printf(" %7s", c.name);
+  for (const pipeline::LabelingStage& c : pipeline::kLabelingStages)
+    std::printf(" %*s", bench::stage_column_width(c), c.name);
   std::printf("\n");
   for (const std::string& name : args.sensors) {
     const synth::SensorKind sensor = *synth::sensor_from_name(name);
@@ -269,8 +268,8 @@ int run_pipeline_bench(const Arguments& args) {
           std::printf("%-7s %-10s %3d %6.3f %8zu %8zu %8.1f %8.1f %7.2f %8.1f", row.sensor.c_str(),
                       row.model.c_str(), row.threads, row.voxel, row.points, row.described,
                       row.p50_ms, row.p90_ms, 1e3 / row.p50_ms, row.cpu_p50_ms);
-          for (const bench::LabelStage& c : bench::kLabelStages)
-            std::printf(" %7.1f", c.ms(row.stages));
+          for (const pipeline::LabelingStage& c : pipeline::kLabelingStages)
+            std::printf(" %*.1f", bench::stage_column_width(c), bench::stage_ms(row.stages, c));
           std::printf("\n");
           std::fflush(stdout);
           rows.push_back(std::move(row));
@@ -280,8 +279,8 @@ int run_pipeline_bench(const Arguments& args) {
   json::Json out_rows = json::Json::array();
   for (const Row& r : rows) {
     json::Json stages = json::Json::object();
-    for (const bench::LabelStage& c : bench::kLabelStages)
-      stages[std::string(c.name) + "_ms"] = json::rounded(c.ms(r.stages), "%.2f");
+    for (const pipeline::LabelingStage& c : pipeline::kLabelingStages)
+      stages[std::string(c.name) + "_ms"] = json::rounded(bench::stage_ms(r.stages, c), "%.2f");
     out_rows.push_back({{"sensor", r.sensor},
                         {"model", r.model},
                         {"threads", r.threads},

@@ -360,9 +360,9 @@ int run_primitives_bench(const Arguments& args) {
     const pipeline::LabelingResult result =
         pipeline::label_cloud(model, g.cloud, labeling, context);
     label_seconds += seconds_since(label_start);
-    predicted.seconds += result.primitive_seconds;
+    predicted.seconds += result.seconds.primitives;
     score(*result.primitives, surfaces, true_points, objects, predicted);
-    predicted_instances.seconds += result.primitive_seconds;
+    predicted_instances.seconds += result.seconds.primitives;
     add_match(bench::match_instances(*result.primitives, g.cloud.xyz, objects.values, instances,
                                      match_options),
               instances, match_options, predicted_instances);
@@ -410,7 +410,7 @@ int run_primitives_bench(const Arguments& args) {
         "(segments %.0f ms)\n",
         static_cast<unsigned long long>(options.seed), g.cloud.size(),
         synth::describe_objects(g.scene).c_str(), result.primitives->primitives.size(),
-        1000 * result.primitive_seconds, 1000 * result.primitives->segment_seconds);
+        1000 * result.seconds.primitives, 1000 * result.primitives->segment_seconds);
   }
   print("predicted labels", predicted, args.scenes);
   print("true labels", truth, args.scenes);

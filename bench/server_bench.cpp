@@ -198,7 +198,7 @@ FrameFigures frame_figures(const std::string& label, const std::string& name,
   const RunContext context{threads};
   std::vector<double> server_ms, local_ms;
   std::vector<std::map<std::string, double>> server_stages;
-  std::vector<pipeline::LabelingResult> local_results;
+  std::vector<pipeline::StageSeconds> local_seconds;
   for (int rep = -1; rep < reps; ++rep) {
     PointCloud copy = cloud;
     auto start = Clock::now();
@@ -212,9 +212,8 @@ FrameFigures frame_figures(const std::string& label, const std::string& name,
       std::fprintf(stderr, "%s: labels differ from label_cloud!\n", label.c_str());
     if (rep < 0) continue;
     out.described = result.described_points;
-    result.labels = {};
     local_ms.push_back(local);
-    local_results.push_back(std::move(result));
+    local_seconds.push_back(result.seconds);
     server_ms.push_back(served);
     server_stages.push_back(std::move(stages));
   }
@@ -223,9 +222,9 @@ FrameFigures frame_figures(const std::string& label, const std::string& name,
   out.local_p50 = percentile(local_ms, 0.5);
   out.local_p90 = percentile(local_ms, 0.9);
   out.server_stages = server_stages[nearest_to(server_ms, out.server_p50)];
-  const pipeline::LabelingResult& local = local_results[nearest_to(local_ms, out.local_p50)];
-  for (const bench::LabelStage& stage : bench::kLabelStages)
-    out.local_stages.emplace_back(stage.name, stage.ms(local));
+  const pipeline::StageSeconds& local = local_seconds[nearest_to(local_ms, out.local_p50)];
+  for (const pipeline::LabelingStage& stage : pipeline::kLabelingStages)
+    out.local_stages.emplace_back(stage.name, bench::stage_ms(local, stage));
 
   std::printf(
       "%-24s %7zu points (%6zu described, voxel %.3f m): server p50 %7.1f ms p90 %7.1f ms "

@@ -139,7 +139,7 @@ int evaluate_files(const Arguments& args) {
       atomic_write_file(args.primitives_json, primitives::primitives_json(instances));
       if (!args.quiet)
         std::fprintf(stderr, "%s: %zu primitives in %.3f s, wrote %s\n", path.c_str(),
-                     instances.size(), result.primitive_seconds, args.primitives_json.c_str());
+                     instances.size(), result.seconds.primitives, args.primitives_json.c_str());
     }
     if (result.objects) {
       atomic_write_file(args.objects_json, tabletop::objects_json(*result.objects));
@@ -149,7 +149,8 @@ int evaluate_files(const Arguments& args) {
     }
     if (!args.quiet)
       std::fprintf(stderr, "%s: %zu points, features %.2f s, inference %.2f s\n", path.c_str(),
-                   cloud.size(), result.feature_seconds, result.inference_seconds);
+                   cloud.size(), result.seconds.normals + result.seconds.descriptors,
+                   result.seconds.graph + result.seconds.inference);
     if (!result.domain_warning.empty())
       std::fprintf(stderr, "primlabel-eval: warning: %s: %s\n", path.c_str(),
                    result.domain_warning.c_str());

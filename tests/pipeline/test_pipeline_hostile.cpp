@@ -134,8 +134,8 @@ TEST(PipelineHostile, PointsPackedInAMillimetreCubeLabelInBoundedMemory) {
   std::printf(
       "20k points in a 1 mm cube: %.2f s (normals %.2f, descriptors %.2f, inference %.2f), peak "
       "RSS +%.0f MB\n",
-      seconds, result.normal_seconds, result.descriptor_seconds, result.inference_seconds,
-      growth / 1e6);
+      seconds, result.seconds.normals, result.seconds.descriptors,
+      result.seconds.graph + result.seconds.inference, growth / 1e6);
   EXPECT_LT(growth, std::size_t(400) << 20);
   EXPECT_EQ(result.labels.size(), cloud.size());
 }

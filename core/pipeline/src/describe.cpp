@@ -84,7 +84,7 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   // The index build checks the token itself (a 5M-point k-d tree takes about a second).
   out.search = std::make_unique<NeighborSearch>(cloud.xyz, context.stop);
   out.point_spacing = median_point_spacing(cloud.xyz, *out.search);
-  out.index_seconds = seconds_since(index_start);
+  out.seconds.index = seconds_since(index_start);
   // The stages' own progress counts (points, then twice the points for FPFH) would not add up to
   // one describe call: only threads and stop go down.
   const RunContext stage{context.threads, context.stop, {}};
@@ -103,7 +103,7 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
       sharing_pays(cloud.xyz, *out.search, *shared)) {
     out.lists =
         std::make_unique<NeighborLists>(cloud.xyz, *out.search, *shared, kSharedListBytes, stage);
-    out.lists_seconds = seconds_since(lists_start);
+    out.seconds.lists = seconds_since(lists_start);
   }
 
   if (!options.use_cloud_normals) {
@@ -111,7 +111,7 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
     NormalOptions normal_options;
     normal_options.neighborhood = normal_hood;
     estimate_normals(cloud, normal_options, stage, out.search.get(), out.lists.get());
-    out.normal_seconds = seconds_since(start);
+    out.seconds.normals = seconds_since(start);
     out.surface_variation = median_surface_variation(cloud.curvature);
   } else {
     out.surface_variation = std::numeric_limits<float>::quiet_NaN();  // the client's normals
@@ -133,7 +133,7 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   }
   out.descriptors = multi_scale_input(cloud, std::move(out.descriptors), settings, *out.search,
                                       !options.use_cloud_normals, stage);
-  out.feature_seconds = seconds_since(start);
+  out.seconds.descriptors = seconds_since(start);
   return out;
 }
 

@@ -56,7 +56,7 @@ void fan_out(const LabelingPlan& plan, const PointCloud& described, const Labeli
         cloud.curvature[i] = described.curvature[slot_of[i]];
       }
   }
-  result.fanout_seconds +=
+  result.seconds.fanout +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

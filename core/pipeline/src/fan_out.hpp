@@ -10,7 +10,7 @@ namespace primlabel::pipeline {
 // Turns `result`, one row per slot of `described`, into one row per point of `cloud`: labels
 // (class 0 without a slot), probabilities and descriptors (NaN rows without one) and, unless the
 // cloud's own normals were kept, the slots' normals and curvature written into `cloud`. When a
-// slot stands for several points, labeled_points counts input points. Adds fanout_seconds.
+// slot stands for several points, labeled_points counts input points. Adds seconds.fanout.
 void fan_out(const LabelingPlan& plan, const PointCloud& described, const LabelingOptions& options,
              PointCloud& cloud, LabelingResult& result);
 

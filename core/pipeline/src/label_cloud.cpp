@@ -42,7 +42,7 @@ void fit_primitives_of_input(const PointCloud& cloud, const LabelingOptions& opt
   const auto start = std::chrono::steady_clock::now();
   result.primitives = primitives::fit_primitives(cloud.xyz, cloud.normals, result.labels,
                                                  options.primitives, context, shared);
-  result.primitive_seconds = seconds_since(start);
+  result.seconds.primitives = seconds_since(start);
 }
 
 // Every point of `cloud` described and labeled, one row per point. `is_input`: `cloud` is the
@@ -57,11 +57,7 @@ LabelingResult label_described(const LabelModel& model, const FeatureSettings& f
   describe_options.use_cloud_normals = options.use_cloud_normals;
   describe_options.share_neighbor_lists = options.share_neighbor_lists;
   DescribedCloud described = describe_cloud(cloud, features, describe_options, context);
-  result.normal_seconds = described.normal_seconds;
-  result.descriptor_seconds = described.feature_seconds;
-  result.feature_seconds = described.normal_seconds + described.feature_seconds;
-  result.index_seconds = described.index_seconds;
-  result.lists_seconds = described.lists_seconds;
+  result.seconds = described.seconds;
   result.described_points = cloud.size();
   result.point_spacing = described.point_spacing;
   result.surface_variation = described.surface_variation;
@@ -76,14 +72,15 @@ LabelingResult label_described(const LabelModel& model, const FeatureSettings& f
   // A node-only model ignores edges, so its graph needs none (only the active mask).
   if (model.kind == ModelKind::kNodeOnly) graph_options.neighborhood = Neighborhood::Knn(1);
   const crf::Graph graph = build_scene_graph(cloud, described, graph_options, context);
-  result.graph_seconds = seconds_since(start);
+  result.seconds.graph = seconds_since(start);
   context.throw_if_stopped("labeling");
+  const auto inference_start = std::chrono::steady_clock::now();
   crf::InferenceOutputs outputs;
   outputs.unknown_label = class_id(PrimitiveClass::kUnknown);
   outputs.marginals = options.want_probabilities;
   crf::InferenceResult inferred =
       infer(model.weights, described.descriptors, graph, model.inference, outputs, context);
-  result.inference_seconds = seconds_since(start);
+  result.seconds.inference = seconds_since(inference_start);
 
   result.labels = std::move(inferred.labels);
   if (options.want_probabilities) result.probabilities = std::move(inferred.marginals);
@@ -123,8 +120,9 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
   PointCloud& described = plan.described_cloud(cloud);
   LabelingResult result = label_described(model, features, described, options, context,
                                           /*is_input=*/plan.in_place);
-  result.prefilter_seconds = plan.prefilter_seconds;
-  result.voxel_seconds = plan.voxel_seconds;
+  result.seconds.voxels = plan.seconds.voxels;
+  result.seconds.tabletop = plan.seconds.tabletop;
+  result.seconds.duplicates = plan.seconds.duplicates;
   result.domain_warning =
       domain_warning(model.training, result.point_spacing, result.surface_variation);
 

@@ -104,7 +104,7 @@ LabelingPlan plan_labeling(const PointCloud& cloud, float voxel_size,
                            const LabelingOptions& options, const RunContext& context) {
   LabelingPlan plan;
   const bool with_normals = options.use_cloud_normals;
-  const auto start = std::chrono::steady_clock::now();
+  const auto voxels_start = std::chrono::steady_clock::now();
 
   // 1. Voxels: a centroid stands for its voxel's members (non-finite points are in none).
   std::optional<PointCloud> voxels;
@@ -114,13 +114,14 @@ LabelingPlan plan_labeling(const PointCloud& cloud, float voxel_size,
         cloud.xyz, tabletop::finite_indices(cloud.xyz), voxel_size, context);
     voxels = voxel_cloud(cloud, grid, with_normals);
     voxel_of_point = std::move(grid.voxel_of_point);
-    plan.voxel_seconds = seconds_since(start);
+    plan.seconds.voxels = seconds_since(voxels_start);
     context.throw_if_stopped("labeling");
   }
   const PointCloud& base = voxels ? *voxels : cloud;
 
   // 2. The table-top stage, on the voxels when there are: only its table and objects are kept.
   std::optional<Kept> kept;
+  const auto tabletop_start = std::chrono::steady_clock::now();
   if (options.tabletop_only) {
     const tabletop::TabletopResult segmented =
         tabletop::segment_tabletop(base, tabletop::TabletopOptions{}, context);
@@ -129,15 +130,18 @@ LabelingPlan plan_labeling(const PointCloud& cloud, float voxel_size,
       plan.objects = objects_of_input(tabletop::object_ids(segmented, base.size()),
                                       voxels ? &voxel_of_point : nullptr);
   }
-  plan.prefilter_seconds = seconds_since(start);
+  if (options.tabletop_only) plan.seconds.tabletop = seconds_since(tabletop_start);
   context.throw_if_stopped("labeling");
 
-  // 3. Exact duplicates among the kept points: one slot per position.
+  // 3. Exact duplicates among the kept points: one slot per position. Its time includes the slot
+  // map and the gather below.
+  const auto duplicates_start = std::chrono::steady_clock::now();
   const DuplicateMap duplicates = kept ? find_duplicates(base.xyz, kept->points, context.stop)
                                        : find_duplicates(base.xyz, context.stop);
   plan.merges_points = voxels || duplicates.any();
   if (!voxels && !kept && !duplicates.any()) {
     plan.in_place = true;
+    plan.seconds.duplicates = seconds_since(duplicates_start);
     return plan;
   }
 
@@ -149,11 +153,13 @@ LabelingPlan plan_labeling(const PointCloud& cloud, float voxel_size,
   // 5. The one cloud to describe: every slot's representative.
   if (voxels && !kept && !duplicates.any()) {
     plan.described = std::move(*voxels);  // every voxel is its own slot
+    plan.seconds.duplicates = seconds_since(duplicates_start);
     return plan;
   }
   std::vector<std::uint32_t> representatives = duplicates.representatives;
   if (kept) compose(representatives, kept->points);
   plan.described = gather(base, representatives, with_normals);
+  plan.seconds.duplicates = seconds_since(duplicates_start);
   return plan;
 }
 

@@ -31,8 +31,7 @@ struct LabelingPlan {
   // With want_objects: the table-top stage's object id of every input point (the counts and
   // shapes are left to describe_objects).
   std::optional<tabletop::TabletopObjects> objects;
-  double prefilter_seconds = 0;  // voxels and the table-top stage
-  double voxel_seconds = 0;
+  StageSeconds seconds;  // its voxels, table-top and duplicates stages
 
   PointCloud& described_cloud(PointCloud& input) { return in_place ? input : described; }
 };

@@ -88,7 +88,7 @@ void classify_with_svm(const LabelModel& model, DescribedCloud&& described,
     result.descriptors =
         leading_values(std::move(described.descriptors), model.features.descriptor_dim());
   }
-  result.inference_seconds = seconds_since(start);
+  result.seconds.inference = seconds_since(start);
 }
 
 }  // namespace primlabel::pipeline

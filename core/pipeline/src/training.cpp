@@ -90,8 +90,7 @@ SceneData prepare_scene(PointCloud cloud, std::string source, const FeatureSetti
   scene.source = std::move(source);
   if (cloud.organized()) scene.image_width = cloud.width, scene.image_height = cloud.height;
   DescribedCloud described = describe_cloud(cloud, features, context);
-  scene.normal_seconds = described.normal_seconds;
-  scene.feature_seconds = described.feature_seconds;
+  scene.seconds = described.seconds;
   scene.point_spacing = described.point_spacing;
   scene.surface_variation = described.surface_variation;
   crf::Graph g = build_scene_graph(cloud, described, graph, context);
@@ -260,8 +259,8 @@ ModelTrainingResult train_label_model(std::span<const SceneData> training,
   if (options.kind == ModelKind::kCrf &&
       training_options.objective == crf::TrainingObjective::kPiecewise) {
     // Node factors trained alone; the coupling is the one edge factor, chosen on validation.
-    // With one uniform coupling, mean-field labels like loopy BP (97.92% both on the default test
-    // scenes, linear node basis) at about three times the speed, so such models infer with it.
+    // With one uniform coupling, mean-field labels like loopy BP at a fraction of its time
+    // (docs/development.md, "Figures behind the code"), so such models infer with it.
     m.inference.method = crf::InferenceMethod::kMeanField;
     const Calibration coupling = calibrate_potts_coupling(m, calibration, context);
     out.potts_coupling = coupling.value;

@@ -110,21 +110,21 @@ std::optional<ServiceError> LabelingSession::outcome() {
   if (plan_.entry && !record_.model_resolved) note_model();  // chosen in the job
   if (job_error_) return job_error_;
   StageTimes& stages = record_.stages;
+  const pipeline::StageSeconds& seconds = result_.seconds;
   // The model choice, when it measured the cloud, counts with the work before the description.
-  stages.prefilter = seconds_between(scan_complete_, job_start_) + plan_.choice_seconds +
-                     result_.prefilter_seconds;
+  const double prefilter = seconds.voxels + seconds.tabletop + seconds.duplicates;
+  stages.prefilter = seconds_between(scan_complete_, job_start_) + plan_.choice_seconds + prefilter;
   // The neighbour index and shared search go to the first stage that searches: the normals, or
   // the features when the client sent its own normals (normals then stay 0).
-  const double search = result_.index_seconds + result_.lists_seconds;
+  const double search = seconds.index + seconds.lists;
   const bool own_normals = plan_.options.use_cloud_normals;
-  stages.normals = result_.normal_seconds + (own_normals ? 0.0 : search);
-  stages.features = result_.descriptor_seconds + (own_normals ? search : 0.0);
-  const double primitives = result_.primitives ? result_.primitive_seconds : 0.0;
-  if (result_.primitives) stages.primitives = primitives;
-  // The rest of the job: graph, BP, duplicates and the fan-out (never below 0 by rounding).
+  stages.normals = seconds.normals + (own_normals ? 0.0 : search);
+  stages.features = seconds.descriptors + (own_normals ? search : 0.0);
+  if (result_.primitives) stages.primitives = seconds.primitives;
+  // The rest of the job: graph, inference and the fan-out (never below 0 by rounding).
   stages.inference =
-      std::max(0.0, seconds_between(job_start_, job_end_) - plan_.choice_seconds -
-                        result_.prefilter_seconds - stages.normals - stages.features - primitives);
+      std::max(0.0, seconds_between(job_start_, job_end_) - plan_.choice_seconds - prefilter -
+                        stages.normals - stages.features - seconds.primitives);
   return std::nullopt;
 }
 

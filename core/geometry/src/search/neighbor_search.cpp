@@ -46,7 +46,7 @@ constexpr std::size_t kCandidatesPerNeighbor = 8;
 
 // Clouds this large check the stop token while nanoflann builds their tree (a 5M-point build
 // takes seconds); smaller ones build in tens of milliseconds and are checked only before and
-// after, since the check on every read makes a build ~30% slower.
+// after, since the check on every read slows every build down.
 constexpr std::size_t kCheckedBuildPoints = std::size_t(1) << 19;
 
 // nanoflann dataset adaptor over the finite points. Only the build reads points through it (the

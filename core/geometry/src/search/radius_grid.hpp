@@ -3,8 +3,8 @@
 // costs more than scanning the few grid cells that can hold them. Cells are half
 // of the radius wide where the cloud's extent allows, and ordered x-fastest, so the cells along x
 // of each (y, z) row are one contiguous run; a query skips the rows that lie wholly outside its
-// sphere and reads of the others only the x-span the sphere covers (on an LMS400 scan 40% fewer
-// candidates than radius-wide cells). The grid keeps the points and their cloud indices in cell
+// sphere and reads of the others only the x-span the sphere covers (far fewer candidates than
+// radius-wide cells). The grid keeps the points and their cloud indices in cell
 // order. Distances are computed in nanoflann's order, so a grid query returns exactly the set the
 // k-d tree would.
 
@@ -41,7 +41,7 @@ class RadiusGrid {
             std::size_t max_candidates = std::numeric_limits<std::size_t>::max()) const {
     // Every candidate is written branch-free and kept if inside, so the writes need room for all
     // candidates: a per-thread buffer that is never zero-filled (growing the lists for each run
-    // zero-filled every candidate, ~10% of a dense query).
+    // zero-filled every candidate, a visible share of a dense query).
     thread_local CandidateBuffer buffer;
     thread_local std::vector<Run> runs;
     const std::size_t candidates = query_runs(q, radius, runs);

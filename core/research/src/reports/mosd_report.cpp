@@ -147,8 +147,8 @@ MosdSceneReport report_mosd_scene(const LabelModel& model, const std::string& pa
 
   MosdSceneReport report;
   report.file = path;
-  report.feature_seconds = result.feature_seconds;
-  report.inference_seconds = result.inference_seconds;
+  report.feature_seconds = result.seconds.normals + result.seconds.descriptors;
+  report.inference_seconds = result.seconds.graph + result.seconds.inference;
   report.table_predicted.assign(kPrimitiveClassCount, 0);
   const std::uint32_t plane = class_id(PrimitiveClass::kPlane);
   for (std::size_t i = 0; i < cloud.size(); ++i) {

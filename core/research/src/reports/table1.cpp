@@ -58,10 +58,10 @@ std::vector<Table1Row> rows_for(const FeatureSettings& features, const std::stri
       const std::string source = std::string(synth::set_name(set)) + "#" + std::to_string(i);
       out.push_back(
           pipeline::prepare_scene(std::move(cloud), source, features, graph, all_ids, context));
-      feature_seconds += out.back().feature_seconds;
+      feature_seconds += out.back().seconds.descriptors;
       described_points += out.back().truth.size();
       say(format("%s: %s described (%zu points, %.1f s)", descriptor.c_str(), source.c_str(),
-                 out.back().truth.size(), out.back().feature_seconds));
+                 out.back().truth.size(), out.back().seconds.descriptors));
     }
   };
   load(synth::SceneSet::kTrain, options.train_scenes, train);

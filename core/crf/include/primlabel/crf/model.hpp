@@ -39,8 +39,8 @@ inline constexpr int kMaxNodeKnots = 64;
 void validate_node_knots(const std::vector<float>& knots);
 
 // The default tent knots, in scaled units (u = s * bin value; FPFH bins are percentages): dense
-// where most bin values lie, so the learnt per-bin curves bend where the classes differ. On the
-// default LMS400 sets (Table I) 6 knots label 98.41%, these 10 98.54%, 16 98.58%.
+// where most bin values lie, so the learnt per-bin curves bend where the classes differ. Fewer
+// knots lose accuracy, more gain little (docs/development.md, "Figures behind the code").
 inline const std::vector<float>& default_node_knots() {
   static const std::vector<float> knots = {0.0f,  0.025f, 0.05f, 0.1f, 0.15f,
                                            0.25f, 0.35f,  0.5f,  0.7f, 1.0f};

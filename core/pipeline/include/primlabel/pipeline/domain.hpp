@@ -1,7 +1,7 @@
 #pragma once
 // Whether a cloud is one a model can label: a model trained on one sensor's point spacing reads
-// a much denser or sparser cloud through radii that then hold other shapes (an LMS400 model on a
-// Kinect table labels 7% of it plane), and nothing else would tell the user.
+// a much denser or sparser cloud through radii that then hold other shapes (an LMS400 model
+// labels little of a Kinect table plane), and nothing else would tell the user.
 
 #include <string>
 

@@ -19,6 +19,7 @@
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/run_context.hpp"
 #include "primlabel/model/label_model.hpp"
+#include "primlabel/pipeline/stage_seconds.hpp"
 #include "primlabel/primitives/fit_primitives.hpp"
 #include "primlabel/tabletop/tabletop_objects.hpp"
 
@@ -33,9 +34,7 @@ struct DescribedCloud {
   // One radius search per point at the larger of the normal and feature radii, shared by
   // normals, descriptors and the graph (null when the neighbourhoods are not both radii).
   std::unique_ptr<NeighborLists> lists;
-  double normal_seconds = 0, feature_seconds = 0;
-  double index_seconds = 0;     // the neighbour index and the point-spacing measure
-  double lists_seconds = 0;     // the shared neighbour lists
+  StageSeconds seconds;         // its index, lists, normals and descriptors
   float point_spacing = 0;      // median_point_spacing of the described cloud (m; NaN: none)
   float surface_variation = 0;  // median_surface_variation of its normals (NaN: its own normals)
 };
@@ -46,8 +45,8 @@ using Cancelled = primlabel::Cancelled;
 // A radius neighbourhood without a cap (max_neighbors 0) gets this one wherever the pipeline
 // describes a cloud or builds its graph, for training and labeling alike: the nearest 1024 within
 // the radius. Each point then costs a bounded amount whatever the input (points packed into a
-// millimetre cost O(n * 1024), not O(n^2)). The default LMS400 scenes have at most 628 points
-// within the 25 mm feature radius (111 within 10 mm), so their features are unchanged.
+// millimetre cost O(n * 1024), not O(n^2)). The cap lies well above what the default scenes hold
+// within their radii, so their features are unchanged by it.
 inline constexpr int kDefaultMaxNeighbors = 1024;
 // `hood` with kDefaultMaxNeighbors when it is a radius neighbourhood without a cap; a model's own
 // cap and k-nearest neighbourhoods are kept.
@@ -109,18 +108,7 @@ struct LabelingResult {
   Descriptors descriptors;
   std::size_t labeled_points = 0;    // input points that got a descriptor (through their voxel)
   std::size_t described_points = 0;  // points described: voxels when downsampling
-  double prefilter_seconds = 0;      // table-top segmentation and voxel downsampling
-  double normal_seconds = 0;         // normal estimation (0 with the cloud's own normals)
-  double descriptor_seconds = 0;     // FPFH / PFH
-  double feature_seconds = 0;        // normals + descriptors
-  double inference_seconds = 0;      // graph + inference
-  // Finer splits of the above, for profiles (each also counted in its stage above except
-  // index_seconds, lists_seconds and fanout_seconds, which no stage above includes).
-  double voxel_seconds = 0;     // voxel downsampling (in prefilter_seconds)
-  double index_seconds = 0;     // neighbour index build and point-spacing measure
-  double lists_seconds = 0;     // the radius search shared by normals, descriptors and graph
-  double graph_seconds = 0;     // the CRF graph (in inference_seconds)
-  double fanout_seconds = 0;    // carrying voxel / duplicate / table-top results to every point
+  StageSeconds seconds;  // where the time went, stage by stage
   float point_spacing = 0;      // median point spacing of the described cloud (m)
   float surface_variation = 0;  // median surface variation of its computed normals
   // Not empty when point_spacing is far outside what the model was trained for (domain.hpp):
@@ -128,7 +116,6 @@ struct LabelingResult {
   std::string domain_warning;
   // With want_primitives: the fitted instances and every point's segment (primitive) id.
   std::optional<primitives::PrimitiveSet> primitives;
-  double primitive_seconds = 0;  // segmentation and fitting (in no stage above)
   // With want_objects: the table, the objects and every input point's object id.
   std::optional<tabletop::TabletopObjects> objects;
 };

@@ -13,6 +13,7 @@
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/model/svm_baseline.hpp"
+#include "primlabel/pipeline/stage_seconds.hpp"
 #include "primlabel/geometry/cloud_signature.hpp"
 
 namespace primlabel::pipeline {
@@ -22,8 +23,7 @@ struct SceneData {
   std::string source;
   crf::LabeledGraph graph;           // labels follow the class list of the last assign_labels
   std::vector<std::uint32_t> truth;  // taxonomy id per point
-  double normal_seconds = 0;
-  double feature_seconds = 0;   // descriptors only
+  StageSeconds seconds;         // its description's index, lists, normals and descriptors
   float point_spacing = 0;      // median point spacing as described (m; NaN: none)
   float surface_variation = 0;  // median surface variation of its normals (NaN: none)
   // The cloud's image size as acquired, before any voxel filter (0 x 0: unorganised).

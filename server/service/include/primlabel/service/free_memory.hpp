@@ -1,9 +1,10 @@
 #pragma once
 // Gives the heap's free pages back to the system once the server has gone quiet after a large
-// request. glibc keeps freed memory of big requests in its arenas (RSS stayed at 350-550 MB after
-// one 5M-point scan), so a container's memory limit would see an idle server as full. The trim
-// waits for a pause: trimming after every request made the next one fault all its pages in
-// again (~45k page faults, 20-30 ms of a 307k-point frame, most of the service's overhead).
+// request. glibc keeps freed memory of big requests in its arenas (hundreds of MB after one
+// multi-million-point scan), so a container's memory limit would see an idle server as full. The
+// trim waits for a pause: trimming after every request made the next one fault all its pages in
+// again, most of the service's overhead on a frame (docs/development.md, "Figures behind the
+// code").
 
 #include <chrono>
 #include <cstdint>
