@@ -4,14 +4,14 @@
 #
 #   bench/real_crossval.sh [BUILD_DIR] [OUT_DIR]
 #
-# 1. The fitted truth of learn0..44 once (`primlabel-eval --write-truth`, OUT_DIR/truth; kept).
+# 1. The fitted truth of learn0..44 once (`primlabel-research write-truth`, OUT_DIR/truth; kept).
 # 2. Folds by scene: scene n is in fold n mod 5; a fold's scenes are never trained on when it is
 #    scored.
 # 3. Model (i), `synthetic`: the recipe below on the 8 synthetic Kinect scenes alone. It sees no
 #    real scene, so one model serves every fold.
 #    Model (ii), `real`, per fold: the fitted truth of the other 36 scenes (unknown points, label
 #    0, are not trained on) + the same 8 synthetic scenes, same recipe otherwise.
-# 4. Each model labels the held-out scenes (`primlabel-eval --mosd-report --object-truth`): table
+# 4. Each model labels the held-out scenes (`primlabel-research mosd-report --object-truth`): table
 #    points labeled plane (against mOSD's table labels) and the object points against the fitted
 #    truth; the per-class counts are summed over the folds (support, true positives and
 #    predictions, recovered from each report's recall, precision and support), then printed as
@@ -43,7 +43,7 @@ VARIANT_NAME=${VARIANT_NAME:-variant}
 MODELS=(synthetic real)
 ((${#VARIANT[@]})) && MODELS+=("$VARIANT_NAME")
 [[ -f "$MOSD/learn0.pcd" ]] || { echo "real_crossval.sh: no mOSD scenes in $MOSD" >&2; exit 77; }
-for tool in primlabel-train primlabel-eval; do
+for tool in primlabel-train primlabel-research; do
   [[ -x "$BIN/$tool" ]] || { echo "real_crossval.sh: $BIN/$tool missing" >&2; exit 2; }
 done
 mkdir -p "$OUT"
@@ -57,7 +57,7 @@ missing=0
 for n in $(seq 0 44); do [[ -f "$OUT/truth/learn${n}_truth.pcd" ]] || missing=1; done
 if ((missing)); then
   log "writing the fitted truth of the 45 scenes into $OUT/truth"
-  $N "$BIN/primlabel-eval" --write-truth "$OUT/truth" "${scenes[@]}" >"$OUT/truth.log"
+  $N "$BIN/primlabel-research" write-truth "$OUT/truth" "${scenes[@]}" >"$OUT/truth.log"
 fi
 
 if [[ ! -f "$OUT/synthetic.plm" ]]; then
@@ -89,8 +89,8 @@ for f in $(seq 0 $((FOLDS - 1))); do
     log "fold $f: scoring ($model) on ${#held[@]} held-out scenes"
     path=$OUT/synthetic.plm
     [[ $model != synthetic ]] && path=$dir/$model.plm
-    $N "$BIN/primlabel-eval" --model "$path" --mosd-report "$dir/$model" --object-truth -q --json \
-      "${held[@]}" >"$dir/$model.json"
+    $N "$BIN/primlabel-research" mosd-report "$dir/$model" --model "$path" --object-truth \
+      -q --json "${held[@]}" >"$dir/$model.json"
   done
 done
 

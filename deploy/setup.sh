@@ -102,7 +102,7 @@ build() {
 #   class balance 0.25, multi-scale input (FPFH also at 15 and 40 mm, surface variation at every
 #   radius: +3 points of object accuracy in cross-validation, about 2.5x the CPU a frame),
 #   no augmentation (it did not help on the real mOSD scenes), from the
-#   fitted truth of the 45 real mOSD learning scenes (primlabel-eval --write-truth; its unknown
+#   fitted truth of the 45 real mOSD learning scenes (primlabel-research write-truth; its unknown
 #   points are not trained on) beside the 8 synthetic Kinect scenes: it beat the synthetic-only
 #   recipe in scene-level cross-validation (bench/real_crossval.sh). A fresh clone has no
 #   ../shared/data/mosd, so every machine gets the committed deploy/models/tabletop-kinect.plm
@@ -150,7 +150,7 @@ kinect_real_model() {
   done
   if ((${#scenes[@]})); then
     log "writing the fitted truth of ${#scenes[@]} mOSD scenes into $truth"
-    "$BUILD_DIR/bin/primlabel-eval" --write-truth "$truth" "${scenes[@]}" >/dev/null
+    "$BUILD_DIR/bin/primlabel-research" write-truth "$truth" "${scenes[@]}" >/dev/null
   fi
   out=$(cd "$(dirname "$out")" && pwd)/$(basename "$out")
   (cd "$BUILD_DIR" && "$BUILD_DIR/bin/primlabel-train" --kind crf --name tabletop-kinect \

@@ -1,28 +1,20 @@
-// primlabel-eval: labels clouds with a trained model and scores them against their ground truth,
-// or re-measures the paper's Table I and Fig. 4.
+// primlabel-eval: labels clouds with a trained model and scores them against their ground truth
+// (or, without one, prints the predicted label histogram). The paper's reproductions and the
+// studies of real scenes are primlabel-research's subcommands.
 //
 //   primlabel-eval --model table.plm scene.pcd [--json] [--out labeled.pcd]
 //   primlabel-eval --model table.plm scene.pcd --primitives scene_primitives.json  # instances
 //   primlabel-eval --model table.plm --no-truth mosd_scene.pcd     # predicted label histogram
 //   primlabel-eval --model table.plm --confusion-png confusion.png a.pcd b.pcd   # over all files
-//   primlabel-eval --table1 [--json]
-//   primlabel-eval --fig4 out/ [--fig4-scenes 3]                    # the paper's Fig. 4
-//   primlabel-eval --model kinect.plm --mosd-report out/ ../shared/data/mosd/*.pcd
-//   primlabel-eval --calibrate-kinect ../shared/data/mosd [--calibration-json out.json]
-//   primlabel-eval --model kinect.plm --mosd-report out/ --object-truth [--write-truth t/] scenes
-//   primlabel-eval --write-truth truth/ ../shared/data/mosd/*.pcd     # the fitted truth only
-//   primlabel-eval --truth-check 4                                   # its error on synthetic
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <functional>
+#include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
-#include "node_basis.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/crf/metrics.hpp"
@@ -33,11 +25,6 @@
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/primitives/primitives_json.hpp"
 #include "primlabel/research/confusion_plot.hpp"
-#include "primlabel/research/fig4.hpp"
-#include "primlabel/research/kinect_calibration.hpp"
-#include "primlabel/research/mosd_report.hpp"
-#include "primlabel/research/table1.hpp"
-#include "primlabel/research/truth_check.hpp"
 #include "primlabel/tabletop/objects_json.hpp"
 
 namespace {
@@ -45,16 +32,10 @@ namespace {
 using namespace primlabel;
 
 struct Arguments {
-  std::string model, classes, out, primitives_json, objects_json, confusion_png, fig4_dir, mosd_dir,
-      truth_dir, calibrate_dir, calibration_json;
+  std::string model, classes, out, primitives_json, objects_json, confusion_png;
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false;
-  bool table1 = false, no_pfh = false, no_svm = false, object_truth = false, fit_simulation = false;
-  int truth_check = 0;
-  double truth_radius = research::ObjectTruthOptions{}.label_radius;
-  std::string node_basis = "tent";
-  std::vector<float> node_knots;  // --node-knots, then the resolved basis (cli::node_knots)
-  int table1_train = 8, table1_test = 4, pfh_max_neighbors = 40, threads = 0, fig4_scenes = 3;
+  int threads = 0;
 };
 
 std::string class_name(std::uint32_t id) {
@@ -183,313 +164,88 @@ int evaluate_files(const Arguments& args) {
   return cli::kExitOk;
 }
 
-int table1(const Arguments& args) {
-  research::Table1Options options;
-  options.train_scenes = args.table1_train;
-  options.test_scenes = args.table1_test;
-  options.with_pfh = !args.no_pfh;
-  options.with_svm = !args.no_svm;
-  options.pfh_max_neighbors = args.pfh_max_neighbors;
-  options.node_knots = args.node_knots;
-  options.threads = args.threads;
-  if (!args.quiet)
-    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
-  const auto rows = research::run_table1(options);
-  std::fputs((args.json ? research::table1_json(rows) : research::table1_text(rows)).c_str(),
-             stdout);
-  return cli::kExitOk;
-}
-
-void make_directory(const std::string& dir) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw std::runtime_error(dir + ": cannot be created (" + ec.message() + ")");
-}
-
-research::MosdTruthRequest truth_request(const Arguments& args, const std::string& scene) {
-  research::MosdTruthRequest request;
-  request.enabled = args.object_truth || !args.truth_dir.empty();
-  request.options.label_radius = args.truth_radius;
-  if (!args.truth_dir.empty())
-    request.write_path = (std::filesystem::path(args.truth_dir) /
-                          (std::filesystem::path(scene).stem().string() + "_truth.pcd"))
-                             .string();
-  return request;
-}
-
-// The fitted object truth of mOSD scenes alone: a labeled PCD per scene and truth_fits.json.
-int write_truth(const Arguments& args) {
-  make_directory(args.truth_dir);
-  json::Json scenes = json::Json::array();
-  research::MosdObjectTruth all;
-  for (const std::string& path : args.files) {
-    const PointCloud cloud = read_cloud(path);
-    research::MosdObjectTruth t;
-    try {
-      t = research::fit_mosd_truth(cloud, truth_request(args, path), RunContext{args.threads});
-    } catch (const std::exception& e) {
-      throw std::runtime_error(path + ": " + e.what());
+// The research modes primlabel-eval had until issue 32 and their flags, now subcommands of
+// primlabel-research: an old script is told where its command went, not only that a flag is
+// unknown. The modes come first, so a mode's own flag names it over its companions.
+std::optional<std::string> moved_to_research(int argc, char** argv) {
+  struct Moved {
+    std::string_view flag, subcommand;
+  };
+  static constexpr Moved kMoved[] = {
+      {"--table1", "table1"},
+      {"--fig4", "fig4"},
+      {"--mosd-report", "mosd-report"},
+      {"--write-truth", "write-truth"},
+      {"--truth-check", "truth-check"},
+      {"--calibrate-kinect", "calibrate-kinect"},
+      {"--table1-train", "table1"},
+      {"--table1-test", "table1"},
+      {"--no-pfh", "table1"},
+      {"--no-svm", "table1"},
+      {"--pfh-max-neighbors", "table1"},
+      {"--node-basis", "table1"},
+      {"--node-knots", "table1"},
+      {"--fig4-scenes", "fig4"},
+      {"--object-truth", "mosd-report"},
+      {"--fit-simulation", "calibrate-kinect"},
+      {"--calibration-json", "calibrate-kinect"},
+  };
+  for (const Moved& moved : kMoved)
+    for (int i = 1; i < argc; ++i) {
+      const std::string_view arg = argv[i];
+      if (arg == "--") break;  // file names from here on
+      if (arg == moved.flag ||
+          (arg.starts_with(moved.flag) && arg.substr(moved.flag.size()).starts_with('=')))
+        return std::string(moved.flag) + " moved to primlabel-research: run `primlabel-research " +
+               std::string(moved.subcommand) + "` (see its --help)";
     }
-    std::printf(
-        "%s: %zu segments: %zu box, %zu upright cylinder, %zu lying cylinder, %zu "
-        "unfitted; %llu of %llu object points labeled; wrote %s\n",
-        path.c_str(), t.objects.size(), t.count(research::FittedKind::kBox),
-        t.count(research::FittedKind::kUprightCylinder),
-        t.count(research::FittedKind::kLyingCylinder), t.count(research::FittedKind::kUnfitted),
-        static_cast<unsigned long long>(t.truth_points),
-        static_cast<unsigned long long>(t.object_points), t.truth_file.c_str());
-    json::Json scene = research::object_truth_json(t, true);
-    scene["file"] = path;
-    scenes.push_back(std::move(scene));
-    all.objects.insert(all.objects.end(), t.objects.begin(), t.objects.end());
-    all.object_points += t.object_points;
-    all.truth_points += t.truth_points;
-  }
-  const json::Json out = {{"scenes", std::move(scenes)},
-                          {"overall", research::object_truth_json(all, false)}};
-  atomic_write_file((std::filesystem::path(args.truth_dir) / "truth_fits.json").string(),
-                    json::dump(out) + "\n");
-  return cli::kExitOk;
-}
-
-int truth_check(const Arguments& args) {
-  research::TruthCheckOptions options;
-  options.scenes = args.truth_check;
-  options.truth.label_radius = args.truth_radius;
-  const research::TruthCheck check =
-      research::check_truth_on_synthetic(options, RunContext{args.threads});
-  std::fputs(
-      (args.json ? research::truth_check_json(check) : research::truth_check_text(check)).c_str(),
-      stdout);
-  return cli::kExitOk;
-}
-
-int mosd_report(const Arguments& args) {
-  const LabelModel model = load_model(args.model);
-  make_directory(args.mosd_dir);
-  if (!args.truth_dir.empty()) make_directory(args.truth_dir);
-  pipeline::LabelingOptions options;
-  options.tabletop_only = args.tabletop_only;
-  const RunContext context{args.threads};
-  std::vector<research::MosdSceneReport> scenes;
-  for (const std::string& path : args.files) {
-    const std::string png = (std::filesystem::path(args.mosd_dir) /
-                             (std::filesystem::path(path).stem().string() + "_labels.png"))
-                                .string();
-    scenes.push_back(
-        research::report_mosd_scene(model, path, png, options, context, truth_request(args, path)));
-    if (!args.quiet)
-      std::fprintf(stderr, "%s: %.2f%% of %llu table points plane, wrote %s\n", path.c_str(),
-                   100.0 * scenes.back().plane_share(),
-                   static_cast<unsigned long long>(scenes.back().table_points), png.c_str());
-  }
-  const research::MosdReport report = research::summarize_mosd(std::move(scenes));
-  const std::string json = research::mosd_report_json(report);
-  const std::string json_path =
-      (std::filesystem::path(args.mosd_dir) / "mosd_report.json").string();
-  atomic_write_file(json_path, json);
-  std::fputs((args.json ? json : research::mosd_report_text(report)).c_str(), stdout);
-  return cli::kExitOk;
-}
-
-// The simulated Kinect's parameters measured on the table planes of the mOSD scenes in a folder.
-int calibrate_kinect(const Arguments& args) {
-  std::vector<std::string> files;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(args.calibrate_dir, ec))
-    if (entry.path().extension() == ".pcd") files.push_back(entry.path().string());
-  if (ec) throw std::runtime_error(args.calibrate_dir + ": cannot be read (" + ec.message() + ")");
-  if (files.empty()) throw std::runtime_error(args.calibrate_dir + ": no .pcd file");
-  std::sort(files.begin(), files.end());
-  std::function<void(const std::string&)> progress;
-  if (!args.quiet)
-    progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
-  const research::KinectCalibration calibration =
-      research::calibrate_mosd(files, research::KinectCalibrationOptions{}, progress);
-  std::string json = research::kinect_calibration_json(calibration);
-  std::string text = research::kinect_calibration_text(calibration);
-  if (args.fit_simulation) {
-    const research::KinectSimulationFit fit =
-        research::fit_kinect_simulation(calibration, progress);
-    text += research::kinect_simulation_fit_text(fit);
-    json::Json root = json::Json::parse(json);
-    root["simulation_fit"] = {
-        {"depth_noise", json::rounded(fit.depth_noise, "%.6g")},
-        {"noise_correlation_px", fit.noise_correlation_px},
-        {"independent_noise_share", fit.independent_noise_share},
-        {"autocorrelation_rms", json::rounded(fit.autocorrelation_rms, "%.6g")},
-        {"simulated_depth_noise", json::rounded(fit.simulated.depth_noise, "%.6g")},
-        {"simulated_autocorrelation", fit.simulated.autocorrelation}};
-    json = json::dump(root) + "\n";
-  }
-  if (!args.calibration_json.empty()) atomic_write_file(args.calibration_json, json);
-  std::fputs((args.json ? json : text).c_str(), stdout);
-  return cli::kExitOk;
-}
-
-int fig4(const Arguments& args) {
-  research::Fig4Options options;
-  options.scenes = args.fig4_scenes;
-  options.threads = args.threads;
-  if (!args.quiet)
-    options.progress = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
-  const research::Fig4 result = research::run_fig4(options);
-  research::write_fig4(result, args.fig4_dir);
-  if (!args.json) {
-    std::printf("%s", research::hik_text(result).c_str());
-    return cli::kExitOk;
-  }
-  const research::ClassSignatures& s = result.signatures;
-  json::Json classes = json::Json::array(), points = json::Json::array();
-  for (std::uint32_t id : s.class_ids) classes.push_back(class_name(id));
-  for (const auto count : s.points) points.push_back(count);
-  json::Json hik = json::Json::array();
-  for (Eigen::Index r = 0; r < result.hik.rows(); ++r) {
-    json::Json row = json::Json::array();
-    for (Eigen::Index c = 0; c < result.hik.cols(); ++c) row.push_back(score(result.hik(r, c)));
-    hik.push_back(std::move(row));
-  }
-  const json::Json line = {
-      {"classes", std::move(classes)}, {"points", std::move(points)}, {"hik", std::move(hik)}};
-  std::printf("%s\n", json::dump(line).c_str());
-  return cli::kExitOk;
+  return std::nullopt;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Label clouds with a trained model and score them, or re-measure Table I."};
+  CLI::App app{"Label clouds with a trained model and score them against their ground truth."};
   // Every option with a default shows it in --help ("[0.025]").
   app.option_defaults()->always_capture_default();
   app.set_version_flag("--version", primlabel::version_line("primlabel-eval"));
   app.name("primlabel-eval");
   Arguments args;
-  auto* files = app.add_option("files", args.files, "clouds to label (.pcd or .ply)");
-  auto* model = app.add_option("--model", args.model, "model file (primlabel-train -o)");
-  app.add_flag("--json", args.json, "one JSON object per file (or per Table I row) on stdout");
+  app.add_option("files", args.files, "clouds to label (.pcd or .ply)")->required();
+  app.add_option("--model", args.model, "model file (primlabel-train -o)")->required();
+  app.add_flag("--json", args.json, "one JSON object per file on stdout");
   auto* no_truth =
       app.add_flag("--no-truth", args.no_truth,
                    "the files' labels are no primitive classes (e.g. segment ids): print the "
                    "predicted label histogram");
   app.add_option("--classes", args.classes, "class map of the files' labels (id name per line)");
-  auto* out = app.add_option("--out", args.out, "write the predicted labels (one input file)");
-  auto* primitives_out = app.add_option(
+  app.add_option("--out", args.out, "write the predicted labels (one input file)");
+  app.add_option(
       "--primitives", args.primitives_json,
       "group the predicted labels into connected segments, fit each with its class's primitive "
       "(plane, cylinder, sphere, torus, edge line) and write them as JSON (one input file)");
-  auto* objects_out = app.add_option(
+  app.add_option(
       "--objects", args.objects_json,
       "with --tabletop-only: write the table and its objects (plane, hull; per object points, "
       "centroid, bounds, height, primitive ids with --primitives) as JSON (one input file)");
-  auto* mosd =
-      app.add_option("--mosd-report", args.mosd_dir,
-                     "mOSD scenes (label 1-9 table): share of table points labeled plane, and a "
-                     "labeled PNG per scene, into DIR (with mosd_report.json)")
-          ->needs(model)
-          ->excludes(no_truth)
-          ->excludes(out)
-          ->excludes(primitives_out)
-          ->excludes(objects_out);
-  auto* object_truth =
-      app.add_flag("--object-truth", args.object_truth,
-                   "--mosd-report: also fit box / cylinder models to the object segments, label "
-                   "their points by the ground-truth rule and score the model on them per class")
-          ->needs(mosd);
-  auto* write_truth_dir =
-      app.add_option("--write-truth", args.truth_dir,
-                     "write the fitted object truth of each mOSD scene as DIR/<scene>_truth.pcd "
-                     "(taxonomy labels, 0 unscored; a `segment` field); without --model only "
-                     "that, with truth_fits.json")
-          ->excludes(no_truth)
-          ->excludes(out);
-  auto* check = app.add_option("--truth-check", args.truth_check,
-                               "the fitted truth's own error: fit and label N held-out synthetic "
-                               "Kinect scenes and compare with their true labels, per class")
-                    ->check(CLI::PositiveNumber);
-  app.add_option("--truth-radius", args.truth_radius,
-                 "label radius of the fitted truth (m), as primlabel-synth --radius")
-      ->check(CLI::PositiveNumber);
-  check->excludes(model)->excludes(files)->excludes(object_truth)->excludes(write_truth_dir);
   app.add_option("--confusion-png", args.confusion_png,
                  "confusion matrix over all scored files as PNG (rows true, columns predicted)")
-      ->excludes(no_truth)
-      ->excludes(mosd);
+      ->excludes(no_truth);
   app.add_flag("--tabletop-only", args.tabletop_only, "label only the table and the objects on it");
-  auto* t1 = app.add_flag("--table1", args.table1,
-                          "re-measure the paper's Table I on synthetic LMS400 scenes");
-  app.add_option("--table1-train", args.table1_train, "Table I: training scenes (default 8)")
-      ->check(CLI::PositiveNumber)
-      ->needs(t1);
-  app.add_option("--table1-test", args.table1_test, "Table I: test scenes (default 4)")
-      ->check(CLI::PositiveNumber)
-      ->needs(t1);
-  app.add_flag("--no-pfh", args.no_pfh, "Table I: FPFH rows only")->needs(t1);
-  app.add_option("--node-basis", args.node_basis,
-                 "Table I: CRF / node-only node features, tent (default) or linear (as the paper)")
-      ->check(CLI::IsMember({"tent", "linear"}))
-      ->needs(t1);
-  app.add_option("--node-knots", args.node_knots, std::string("Table I: ") + cli::kNodeKnotsHelp)
-      ->delimiter(',')
-      ->needs(t1);
-  app.add_flag("--no-svm", args.no_svm, "Table I: no SVM rows")->needs(t1);
-  app.add_option("--pfh-max-neighbors", args.pfh_max_neighbors,
-                 "Table I: PFH uses the M nearest within the feature radius (default 40)")
-      ->check(CLI::PositiveNumber)
-      ->needs(t1);
-  auto* f4 = app.add_option("--fig4", args.fig4_dir,
-                            "write the paper's Fig. 4 (class-mean FPFH signatures, HIK distance "
-                            "matrix; CSV and PNG) from synthetic LMS400 training scenes to DIR");
-  app.add_option("--fig4-scenes", args.fig4_scenes, "Fig. 4: training scenes (default 3)")
-      ->check(CLI::PositiveNumber)
-      ->needs(f4);
-  auto* calibrate = app.add_option(
-      "--calibrate-kinect", args.calibrate_dir,
-      "measure depth noise, disparity quantisation, density and missing returns on the table "
-      "planes of the mOSD scenes (*.pcd, label 1-9 table) in DIR; fit the simulated Kinect");
-  app.add_flag("--fit-simulation", args.fit_simulation,
-               "--calibrate-kinect: also fit the simulator's correlated depth error by simulating "
-               "bare-table frames (about 20 s of CPU)")
-      ->needs(calibrate);
-  app.add_option("--calibration-json", args.calibration_json,
-                 "--calibrate-kinect: also write the calibration as JSON to FILE")
-      ->needs(calibrate);
   app.add_option("--threads", args.threads, "worker threads")
       ->check(CLI::PositiveNumber)
       ->default_str("all cores");
   app.add_flag("-q,--quiet", args.quiet, "no progress on stderr");
-  t1->excludes(model)->excludes(files)->excludes(f4)->excludes(calibrate);
-  calibrate->excludes(model)->excludes(files)->excludes(f4);
-  f4->excludes(model)->excludes(files);
 
+  if (const auto moved = moved_to_research(argc, argv)) {
+    std::fprintf(stderr, "primlabel-eval: usage error: %s\n", moved->c_str());
+    return cli::kExitUsage;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
     std::fprintf(stderr, "primlabel-eval: usage error: %s (see --help)\n", e.what());
-    return cli::kExitUsage;
-  }
-  try {
-    args.node_knots = cli::node_knots(args.node_basis, args.node_knots);  // resolved once
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "primlabel-eval: usage error: %s\n", e.what());
-    return cli::kExitUsage;
-  }
-  const bool study =
-      args.table1 || !args.fig4_dir.empty() || args.truth_check > 0 || !args.calibrate_dir.empty();
-  const bool truth_only = !args.truth_dir.empty() && args.model.empty();
-  if (!args.truth_dir.empty() && !args.model.empty() && args.mosd_dir.empty()) {
-    std::fprintf(stderr,
-                 "primlabel-eval: usage error: --write-truth with --model needs --mosd-report\n");
-    return cli::kExitUsage;
-  }
-  if (truth_only && args.files.empty()) {
-    std::fprintf(stderr, "primlabel-eval: usage error: --write-truth needs mOSD scene files\n");
-    return cli::kExitUsage;
-  }
-  if (!study && !truth_only && (args.model.empty() || args.files.empty())) {
-    std::fprintf(stderr,
-                 "primlabel-eval: usage error: give --model and at least one file, or --table1 "
-                 "or --fig4 or --calibrate-kinect (see --help)\n");
     return cli::kExitUsage;
   }
   if (!args.out.empty() && args.files.size() != 1) {
@@ -508,12 +264,6 @@ int main(int argc, char** argv) {
     return cli::kExitUsage;
   }
   try {
-    if (args.table1) return table1(args);
-    if (!args.fig4_dir.empty()) return fig4(args);
-    if (!args.calibrate_dir.empty()) return calibrate_kinect(args);
-    if (args.truth_check > 0) return truth_check(args);
-    if (truth_only) return write_truth(args);
-    if (!args.mosd_dir.empty()) return mosd_report(args);
     return evaluate_files(args);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "primlabel-eval: error: %s\n", e.what());

@@ -1,5 +1,6 @@
 #pragma once
-// The CRF node feature basis as primlabel-train and primlabel-eval take it on the command line.
+// The CRF node feature basis as primlabel-train and primlabel-research table1 take it on the
+// command line.
 
 #include <string>
 #include <vector>

@@ -58,7 +58,7 @@ TEST(KinectModel, RecordsItsDomainTrainingDataAndAttribution) {
 // 11 min with its truth.
 // Figures recorded 2026-12-05 (the multi-scale recipe) with
 // `deploy/setup.sh kinect-model OUT 0 17 25 33`, then
-// `primlabel-eval --model OUT --mosd-report DIR --object-truth learn5.pcd learn36.pcd`
+// `primlabel-research mosd-report DIR --model OUT --object-truth learn5.pcd learn36.pcd`
 // (held-out scenes). Tolerances cover thread-count rounding in training, not recipe changes.
 TEST(KinectModel, RecipeRetrainedOnTheSubsetReproducesItsFigures) {
   const std::string mosd = shared_data("mosd");
@@ -81,10 +81,9 @@ TEST(KinectModel, RecipeRetrainedOnTheSubsetReproducesItsFigures) {
   EXPECT_TRUE(m.features.surface_variation_features);
   EXPECT_NEAR(m.validation.accuracy, kSubsetValidationAccuracy, 0.002);
 
-  const CommandResult scored =
-      run_command(binary("primlabel-eval") + " --model " + model + " --mosd-report " +
-                  (dir / "report").string() + " --object-truth -q --json " + mosd + "/learn5.pcd " +
-                  mosd + "/learn36.pcd");
+  const CommandResult scored = run_command(
+      binary("primlabel-research") + " mosd-report " + (dir / "report").string() + " --model " +
+      model + " --object-truth -q --json " + mosd + "/learn5.pcd " + mosd + "/learn36.pcd");
   ASSERT_EQ(scored.exit_code, 0) << scored.output;
   const auto report = nlohmann::json::parse(scored.output);
   EXPECT_NEAR(report["plane_share"].get<double>(), kSubsetTablePlane, 0.002) << scored.output;

@@ -1,5 +1,5 @@
 // primlabel-train and primlabel-eval as a user runs them: a model trained by the tool loads and
-// labels, exit codes 0 / 1 / 2 and one-line errors.
+// labels, exit codes 0 / 1 / 2 and one-line errors (primlabel-research: tests/research).
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <utility>
+#include <vector>
 
 #include "png_decode.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
@@ -187,11 +189,7 @@ TEST_F(PipelineCli, CorruptModelFailsWithOneLine) {
 TEST_F(PipelineCli, BadUsageExitsTwo) {
   for (const std::string& command :
        {eval() + " --model", eval() + " --bogus-flag x.pcd", eval() + " x.pcd",
-        eval() + " --table1 --model m.plm", eval() + " --fig4 out --model m.plm",
-        eval() + " --fig4-scenes 2 --table1", eval() + " --fig4 out --table1",
         eval() + " --model m.plm --no-truth --confusion-png c.png x.pcd",
-        eval() + " --mosd-report out x.pcd", eval() + " --model m.plm --mosd-report out",
-        eval() + " --model m.plm --mosd-report out --confusion-png c.png x.pcd",
         test::binary("primlabel-train") + " --kind nonsense -o m.plm",
         test::binary("primlabel-train") + " --synth-train 1",
         test::binary("primlabel-train") + " --kind svm --curve c.csv -o m.plm",
@@ -199,9 +197,6 @@ TEST_F(PipelineCli, BadUsageExitsTwo) {
         test::binary("primlabel-train") + " --train a.pcd --synth-val 1 -o m.plm",
         test::binary("primlabel-train") +
             " --train a.pcd --synth-train 1 --sensor-name kinect -o m.plm",
-        // Bad node knots are refused before any scene is described (one line, no progress).
-        eval() + " --table1 --node-knots 0,0.5,0.2",
-        eval() + " --table1 --node-basis linear --node-knots 0,1",
         test::binary("primlabel-train") + " --node-knots 0 -o m.plm",
         test::binary("primlabel-train") + " --node-knots 0,0.2,0.2 -o m.plm",
         // Bad augmentation specs, and augmentation of files (only synthetic scenes are rescanned).
@@ -212,9 +207,7 @@ TEST_F(PipelineCli, BadUsageExitsTwo) {
         // Multi-scale input: FPFH only, at most 4 further radii, each > 0.
         test::binary("primlabel-train") + " --descriptor pfh --surface-variation -o m.plm",
         test::binary("primlabel-train") + " --extra-radii 0.01,0.02,0.03,0.04,0.05 -o m.plm",
-        test::binary("primlabel-train") + " --extra-radii 0.01,-0.02 -o m.plm",
-        eval() + " --calibrate-kinect dir --model m.plm", eval() + " --calibrate-kinect dir x.pcd",
-        eval() + " --calibration-json c.json --table1"}) {
+        test::binary("primlabel-train") + " --extra-radii 0.01,-0.02 -o m.plm"}) {
     const Result r = run(command);
     EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
     EXPECT_EQ(lines(r.output), 1) << command << "\n" << r.output;
@@ -284,10 +277,32 @@ TEST_F(PipelineCli, TrainAtAVoxelSizeRecordsItAndEvalAppliesIt) {
   EXPECT_EQ(e.output.find("domain"), std::string::npos) << e.output;  // served at its density
 }
 
-TEST_F(PipelineCli, CalibrateKinectWithoutScenesFailsWithOneLine) {
-  const Result r = run(eval() + " -q --calibrate-kinect /nonexistent/mosd");
-  EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_EQ(lines(r.output), 1) << r.output;
+// The research modes are primlabel-research's subcommands now (issue 32): primlabel-eval refuses
+// their flags with one line naming the subcommand, and exits 2 before reading anything.
+TEST_F(PipelineCli, EvalRefusesTheResearchModesNamingTheirSubcommand) {
+  const std::string model = " --model " + zero_model_path() + " ";
+  for (const auto& [arguments, subcommand] : std::vector<std::pair<std::string, std::string>>{
+           {" --table1 --json", "table1"},
+           {" --fig4 out", "fig4"},
+           {" --fig4-scenes 2", "fig4"},
+           {model + "--mosd-report out --object-truth " + scene_path(), "mosd-report"},
+           {model + "--object-truth " + scene_path(), "mosd-report"},
+           {" --write-truth t " + scene_path(), "write-truth"},
+           {" --truth-check 4", "truth-check"},
+           {" --calibrate-kinect dir --fit-simulation", "calibrate-kinect"},
+           {" --calibration-json=c.json", "calibrate-kinect"},
+           {" --node-knots 0,0.5,1 --table1", "table1"}}) {
+    const Result r = run(eval() + arguments);
+    EXPECT_EQ(r.exit_code, 2) << arguments << "\n" << r.output;
+    EXPECT_EQ(lines(r.output), 1) << arguments << "\n" << r.output;
+    EXPECT_NE(r.output.find("primlabel-eval: usage error: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("`primlabel-research " + subcommand + "`"), std::string::npos)
+        << arguments << "\n"
+        << r.output;
+  }
+  // After "--" a file may have any name.
+  const Result file = run(eval() + model + "-q -- --table1");
+  EXPECT_EQ(file.exit_code, 1) << file.output;  // no such file, not a usage error
 }
 
 TEST_F(PipelineCli, TrainMissingFileFails) {

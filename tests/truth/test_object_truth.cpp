@@ -158,22 +158,22 @@ TEST(ObjectTruthMosd, CylinderSceneGetsUprightCylinders) {
   }
 }
 
-// primlabel-eval --write-truth: the fitted truth of a scene as a labeled cloud (taxonomy labels,
-// a segment field) and truth_fits.json; usage errors exit 2 with a reason.
+// primlabel-research write-truth: the fitted truth of a scene as a labeled cloud (taxonomy
+// labels, a segment field) and truth_fits.json; usage errors exit 2 with a reason.
 TEST(ObjectTruthCli, WritesTheTruthOfAScene) {
-  const std::string eval = test::binary("primlabel-eval");
-  const test::CommandResult no_files = test::run_command(eval + " --write-truth /tmp/x");
+  const std::string write_truth = test::binary("primlabel-research") + " write-truth";
+  const test::CommandResult no_files = test::run_command(write_truth + " /tmp/x");
   EXPECT_EQ(no_files.exit_code, 2) << no_files.output;
-  EXPECT_NE(no_files.output.find("--write-truth needs"), std::string::npos) << no_files.output;
-  const test::CommandResult no_report =
-      test::run_command(eval + " --model m.plm --write-truth /tmp/x a.pcd");
-  EXPECT_EQ(no_report.exit_code, 2) << no_report.output;
+  EXPECT_NE(no_files.output.find("SCENE is required"), std::string::npos) << no_files.output;
+  const test::CommandResult with_model =  // a model is mosd-report's
+      test::run_command(write_truth + " /tmp/x --model m.plm a.pcd");
+  EXPECT_EQ(with_model.exit_code, 2) << with_model.output;
 
   const std::string path = mosd("learn0");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
   const test::TempDir dir;
   const test::CommandResult r =
-      test::run_command(eval + " --threads 2 --write-truth " + dir.file("t") + " " + path);
+      test::run_command(write_truth + " --threads 2 " + dir.file("t") + " " + path);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("2 box"), std::string::npos) << r.output;
   const PointCloud truth = load_labeled_cloud(dir.file("t/learn0_truth.pcd"));

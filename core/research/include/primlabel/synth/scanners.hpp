@@ -55,12 +55,12 @@ PointCloud scan_lms400(const Scene& scene, const Lms400Options& options, double 
 // 1/subpixel of a disparity pixel, shadows where the projector does not light the surface.
 //
 // The error model is calibrated on the table planes of the 45 mOSD learning scenes
-// (primlabel-eval --calibrate-kinect --fit-simulation, docs/results.md "Kinect calibration"): depth levels
-// are z^2 / F apart with F = disparity_focal_px * baseline * subpixel = 344.9 m px measured (0.5%
-// rms over 0.6-1.7 m); the error is correlated over ~3.5 px (autocorrelation 0.70 / 0.55 / 0.34
-// at 1 / 2 / 4 px), and depth_noise is what makes simulated frames show the real residual to
-// 24-px tile planes, 1.70e-3 * z^2 (tiles absorb part of a correlated error). The values before
-// the calibration: depth_noise 1.425e-3, white, disparity in focal_px (F = 315).
+// (primlabel-research calibrate-kinect --fit-simulation, docs/results.md "Kinect calibration"):
+// depth levels are z^2 / F apart with F = disparity_focal_px * baseline * subpixel = 344.9 m px
+// measured (0.5% rms over 0.6-1.7 m); the error is correlated over ~3.5 px (autocorrelation
+// 0.70 / 0.55 / 0.34 at 1 / 2 / 4 px), and depth_noise is what makes simulated frames show the
+// real residual to 24-px tile planes, 1.70e-3 * z^2 (tiles absorb part of a correlated error).
+// The values before the calibration: depth_noise 1.425e-3, white, disparity in focal_px (F = 315).
 struct KinectOptions {
   Vec3d position = Vec3d(0, -0.85, 0.75);
   Vec3d target = Vec3d(0, 0.05, 0);
