@@ -27,6 +27,7 @@
 #include <stop_token>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "bench_commands.hpp"
@@ -47,6 +48,7 @@ struct Arguments {
   std::vector<float> voxel_sizes = {-1.0f};  // < 0: the model's own
   int repeat = 1;
   bool compare_unshared = false;  // also each case without the shared neighbour lists
+  bool compare_cascade = false;   // also each case with the plane cascade
   int stop_latency = 0;           // > 0: stops per input
 };
 
@@ -56,13 +58,24 @@ struct Row {
   std::string sensor, model;
   int threads = 0;
   float voxel = 0;
-  std::size_t points = 0, labeled = 0, described = 0;
+  std::size_t points = 0, labeled = 0, described = 0, cascaded = 0;
+  double accuracy = 0;  // share of the scene's labeled points labeled right (NaN: no truth)
   double feature_s = 0, inference_s = 0, total_s = 0;
   double p50_ms = 0, p90_ms = 0;
   double cpu_p50_ms = 0;  // process CPU time (all threads) per run: steadier on a busy machine
   pipeline::StageSeconds stages;  // the p50 run's
   double points_per_s() const { return double(points) / std::max(total_s, 1e-9); }
 };
+
+// The share of the scene's points with a true class (not unknown) that `labels` gets right.
+double accuracy_against(const PointCloud& scene, const std::vector<std::uint32_t>& labels) {
+  if (scene.labels.size() != labels.size()) return std::numeric_limits<double>::quiet_NaN();
+  const std::uint32_t unknown = class_id(PrimitiveClass::kUnknown);
+  std::size_t scored = 0, right = 0;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (scene.labels[i] != unknown) ++scored, right += labels[i] == scene.labels[i] ? 1 : 0;
+  return scored ? double(right) / double(scored) : std::numeric_limits<double>::quiet_NaN();
+}
 
 // CPU time of the whole process so far (user + system, all threads), ms.
 double process_cpu_ms() {
@@ -106,12 +119,13 @@ LabelModel quick_model(synth::SensorKind sensor) {
 }
 
 Row measure(const LabelModel& model, const PointCloud& scene, int threads, int repeat, float voxel,
-            bool share_lists) {
+            bool share_lists, bool cascade) {
   Row best;
   best.total_s = std::numeric_limits<double>::infinity();
   pipeline::LabelingOptions options;
   if (voxel >= 0.0f) options.voxel_size = voxel;
   options.share_neighbor_lists = share_lists;
+  options.plane_cascade = cascade;
   std::vector<double> totals, cpu;
   std::vector<pipeline::StageSeconds> runs;
   for (int r = 0; r < repeat; ++r) {
@@ -130,6 +144,8 @@ Row measure(const LabelModel& model, const PointCloud& scene, int threads, int r
       best.inference_s = result.seconds.graph + result.seconds.inference;
       best.labeled = result.labeled_points;
       best.described = result.described_points;
+      best.cascaded = result.cascaded_points;
+      best.accuracy = accuracy_against(scene, result.labels);
     }
     runs.push_back(result.seconds);
   }
@@ -247,8 +263,13 @@ int run_pipeline_bench(const Arguments& args) {
   std::optional<LabelModel> given;
   if (!args.model.empty()) given = load_model(args.model);
   std::vector<Row> rows;
-  std::printf("%-7s %-10s %3s %6s %8s %8s %8s %8s %7s %8s", "sensor", "model", "thr", "voxel",
-              "points", "voxels", "p50 ms", "p90 ms", "frame/s", "cpu ms");
+  std::printf("%-7s %-18s %3s %6s %8s %8s %8s %8s %8s %7s %8s %6s", "sensor", "model", "thr",
+              "voxel", "points", "voxels", "cascaded", "p50 ms", "p90 ms", "frame/s", "cpu ms",
+              "acc %");
+  // (shared lists, plane cascade) per case: the default first, then the comparisons asked for.
+  std::vector<std::pair<bool, bool>> variants = {{true, false}};
+  if (args.compare_unshared) variants.insert(variants.begin(), {false, false});
+  if (args.compare_cascade) variants.emplace_back(true, true);
   for (const pipeline::LabelingStage& c : pipeline::kLabelingStages)
     std::printf(" %*s", bench::stage_column_width(c), c.name);
   std::printf("\n");
@@ -260,14 +281,14 @@ int run_pipeline_bench(const Arguments& args) {
         given ? "file" : std::string(model.kind == ModelKind::kCrf ? "crf" : "node") + "-quick";
     for (float voxel : args.voxel_sizes)
       for (int threads : args.threads)
-        for (bool share :
-             args.compare_unshared ? std::vector<bool>{false, true} : std::vector<bool>{true}) {
-          Row row = measure(model, scene, threads, args.repeat, voxel, share);
+        for (const auto& [share, cascade] : variants) {
+          Row row = measure(model, scene, threads, args.repeat, voxel, share, cascade);
           row.sensor = name;
-          row.model = model_name + (share ? "" : "-unshared");
-          std::printf("%-7s %-10s %3d %6.3f %8zu %8zu %8.1f %8.1f %7.2f %8.1f", row.sensor.c_str(),
-                      row.model.c_str(), row.threads, row.voxel, row.points, row.described,
-                      row.p50_ms, row.p90_ms, 1e3 / row.p50_ms, row.cpu_p50_ms);
+          row.model = model_name + (share ? "" : "-unshared") + (cascade ? "-cascade" : "");
+          std::printf("%-7s %-18s %3d %6.3f %8zu %8zu %8zu %8.1f %8.1f %7.2f %8.1f %6.2f",
+                      row.sensor.c_str(), row.model.c_str(), row.threads, row.voxel, row.points,
+                      row.described, row.cascaded, row.p50_ms, row.p90_ms, 1e3 / row.p50_ms,
+                      row.cpu_p50_ms, 100 * row.accuracy);
           for (const pipeline::LabelingStage& c : pipeline::kLabelingStages)
             std::printf(" %*.1f", bench::stage_column_width(c), bench::stage_ms(row.stages, c));
           std::printf("\n");
@@ -288,6 +309,8 @@ int run_pipeline_bench(const Arguments& args) {
                         {"points", r.points},
                         {"described", r.described},
                         {"labeled", r.labeled},
+                        {"cascaded", r.cascaded},
+                        {"accuracy", json::rounded(r.accuracy, "%.5f")},
                         {"feature_s", json::rounded(r.feature_s, "%.4f")},
                         {"inference_s", json::rounded(r.inference_s, "%.4f")},
                         {"total_s", json::rounded(r.total_s, "%.4f")},
@@ -324,6 +347,8 @@ BenchCommand add_pipeline_command(CLI::App& parent) {
       ->delimiter(',');
   cmd->add_flag("--compare-unshared", args->compare_unshared,
                 "also run every case with each stage searching itself (no shared neighbour lists)");
+  cmd->add_flag("--compare-cascade", args->compare_cascade,
+                "also run every case with the plane cascade (LabelingOptions::plane_cascade)");
   cmd->add_option("--repeat", args->repeat, "runs per case, the fastest counts (default 1)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--stop-latency", args->stop_latency,

@@ -34,7 +34,7 @@ using namespace primlabel;
 struct Arguments {
   std::string model, classes, out, primitives_json, objects_json, confusion_png;
   std::vector<std::string> files;
-  bool json = false, no_truth = false, tabletop_only = false, quiet = false;
+  bool json = false, no_truth = false, tabletop_only = false, quiet = false, plane_cascade = false;
   int threads = 0;
 };
 
@@ -111,6 +111,7 @@ int evaluate_files(const Arguments& args) {
       cloud = args.classes.empty() ? load_labeled_cloud(path) : load_labeled_cloud(path, map);
     pipeline::LabelingOptions options;
     options.tabletop_only = args.tabletop_only;
+    options.plane_cascade = args.plane_cascade;
     options.want_primitives = !args.primitives_json.empty();
     options.want_objects = !args.objects_json.empty();
     const pipeline::LabelingResult result =
@@ -232,6 +233,9 @@ int main(int argc, char** argv) {
                  "confusion matrix over all scored files as PNG (rows true, columns predicted)")
       ->excludes(no_truth);
   app.add_flag("--tabletop-only", args.tabletop_only, "label only the table and the objects on it");
+  app.add_flag("--plane-cascade", args.plane_cascade,
+               "label points that are planar within the scene's plane noise plane without "
+               "describing them (faster; see LabelingOptions::plane_cascade)");
   app.add_option("--threads", args.threads, "worker threads")
       ->check(CLI::PositiveNumber)
       ->default_str("all cores");

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -381,6 +382,47 @@ TEST(Fpfh, PairsComputedOnceGiveTheDefinitionsBits) {
       }
     }
   }
+}
+
+// Describing some points only gives those points the bits of the whole computation (with the
+// cloud's neighbour index and with shared lists) and the others NaN rows.
+TEST(Fpfh, WantedPointsGetTheWholeComputationsBitsAndTheOthersNaN) {
+  PointCloud cloud = sphere_with_normals(6000, 21);
+  for (std::size_t i = 3; i < cloud.size(); i += 211)
+    cloud.normals[i] = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  std::vector<std::uint8_t> wanted(cloud.size(), 0);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    wanted[i] = cloud.xyz[i].z() > 1.03f || i % 17 == 0;  // a cap and a scatter
+  const NeighborSearch search(cloud.xyz);
+  const NeighborLists lists(cloud.xyz, search, Neighborhood::Radius(0.015f), std::size_t(1) << 28);
+  for (const Neighborhood& hood :
+       {Neighborhood::Radius(0.012f), Neighborhood::Hybrid(0.012f, 30), Neighborhood::Knn(12)}) {
+    FeatureOptions options;
+    options.neighborhood = hood;
+    for (const NeighborLists* shared : {static_cast<const NeighborLists*>(nullptr), &lists}) {
+      const Descriptors all = compute_fpfh(cloud, options, RunContext{2}, nullptr, &search, shared);
+      options.wanted = wanted;
+      FeatureStats stats;
+      const Descriptors some = compute_fpfh(cloud, options, RunContext{2}, &stats, &search, shared);
+      options.wanted = {};
+      std::size_t described = 0;
+      for (std::size_t p = 0; p < cloud.size(); ++p) {
+        const std::span<const float> got = some.row(p), full = all.row(p);
+        if (!wanted[p]) {
+          ASSERT_TRUE(std::isnan(got[0])) << hood.describe() << ": point " << p;
+          continue;
+        }
+        described += std::isfinite(full[0]) ? 1 : 0;
+        ASSERT_EQ(0, std::memcmp(got.data(), full.data(), kFpfhSize * sizeof(float)))
+            << hood.describe() << (shared ? " (shared lists)" : "") << ": point " << p;
+      }
+      EXPECT_EQ(stats.computed + stats.isolated, described);
+    }
+  }
+  FeatureOptions wrong;
+  wrong.neighborhood = Neighborhood::Radius(0.012f);
+  wrong.wanted = std::span<const std::uint8_t>(wanted.data(), wanted.size() - 1);
+  EXPECT_THROW(compute_fpfh(cloud, wrong), std::invalid_argument);
 }
 
 TEST(Features, IdenticalForAnyThreadCount) {

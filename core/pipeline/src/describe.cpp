@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "multi_scale_input.hpp"
+#include "plane_cascade.hpp"
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/normals.hpp"
 #include "primlabel/geometry/point_spacing.hpp"
@@ -116,11 +117,34 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   } else {
     out.surface_variation = std::numeric_limits<float>::quiet_NaN();  // the client's normals
   }
+  // The plane cascade: only the points it leaves to the CRF are described (FPFH of the cloud's
+  // own points alone can describe a subset).
+  std::vector<std::uint8_t> wanted;
+  if (options.plane_cascade && !options.use_cloud_normals && fpfh && !sampled &&
+      normal_hood.radius > 0.0f && feature_hood.radius > 0.0f) {
+    const auto cascade_start = std::chrono::steady_clock::now();
+    const CascadeScale scale{std::max(normal_hood.radius, feature_hood.radius),
+                             normal_hood.radius >= feature_hood.radius};
+    const std::vector<float> variation =
+        scale.is_normal_radius
+            ? cloud.curvature
+            : surface_variations(cloud.xyz, scale.radius, *out.search, out.lists.get(), stage);
+    const CascadeNoise noise{options.trained_roughness, options.trained_surface_variation};
+    const float max_variation =
+        cascade_max_variation(median_surface_variation(variation), noise, scale);
+    out.cascaded = cascaded_planes(cloud, variation, max_variation, feature_hood.radius,
+                                   *out.search, out.lists.get(), stage);
+    wanted.resize(out.cascaded.size());
+    for (std::size_t i = 0; i < wanted.size(); ++i) wanted[i] = out.cascaded[i] ? 0 : 1;
+    if (std::find(wanted.begin(), wanted.end(), 0) == wanted.end()) wanted.clear();  // none
+    out.seconds.cascade = seconds_since(cascade_start);
+  }
 
   const auto start = std::chrono::steady_clock::now();
   FeatureOptions feature_options;
   feature_options.neighborhood = feature_hood;
   feature_options.fpfh_variant = settings.fpfh_variant;
+  feature_options.wanted = wanted;
   if (sampled) {
     // Every point described against the sample's points (same indices as the cloud).
     const std::vector<Vec3f> sample = voxel_sample(cloud.xyz, settings.feature_sample_size, stage);
@@ -132,7 +156,7 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
                            : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
   }
   out.descriptors = multi_scale_input(cloud, std::move(out.descriptors), settings, *out.search,
-                                      !options.use_cloud_normals, stage);
+                                      !options.use_cloud_normals, wanted, stage);
   out.seconds.descriptors = seconds_since(start);
   return out;
 }

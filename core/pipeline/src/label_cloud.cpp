@@ -4,6 +4,7 @@
 // and inferred (CRF or node-only) or classified point by point (SVM); the answers go back to every
 // input point (fan_out.hpp), whose labels then give the primitives and the objects.
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 #include <string>
@@ -45,6 +46,41 @@ void fit_primitives_of_input(const PointCloud& cloud, const LabelingOptions& opt
   result.seconds.primitives = seconds_since(start);
 }
 
+// The plane cascade's points (described.cascaded) labeled plane. Their probabilities: the mean
+// row of the points the model itself labeled plane in this cloud (one-hot plane when it labeled
+// none), so they say how sure the model is of this scene's planes, not more.
+void label_cascaded_planes(const std::vector<std::uint8_t>& cascaded,
+                           const LabelingOptions& options, LabelingResult& result) {
+  const std::uint32_t plane = class_id(PrimitiveClass::kPlane);
+  const std::vector<std::uint32_t>& ids = result.class_ids;
+  const auto column = std::find(ids.begin(), ids.end(), plane);
+  if (column == ids.end()) return;  // a model without planes: the CRF labeled every point
+  if (options.want_probabilities) {
+    Eigen::VectorXd mean = Eigen::VectorXd::Zero(result.probabilities.cols());
+    std::size_t counted = 0;
+    for (std::size_t i = 0; i < cascaded.size(); ++i)
+      if (!cascaded[i] && result.labels[i] == plane) {
+        mean += result.probabilities.row(Eigen::Index(i)).transpose().cast<double>();
+        ++counted;
+      }
+    if (counted > 0) {
+      mean /= double(counted);
+    } else {
+      mean.setZero();
+      mean(column - ids.begin()) = 1.0;
+    }
+    const Eigen::RowVectorXf row = mean.transpose().cast<float>();
+    for (std::size_t i = 0; i < cascaded.size(); ++i)
+      if (cascaded[i]) result.probabilities.row(Eigen::Index(i)) = row;
+  }
+  for (std::size_t i = 0; i < cascaded.size(); ++i)
+    if (cascaded[i]) {
+      result.labels[i] = plane;
+      ++result.cascaded_points;
+    }
+  result.labeled_points += result.cascaded_points;
+}
+
 // Every point of `cloud` described and labeled, one row per point. `is_input`: `cloud` is the
 // caller's cloud itself, so wanted primitives are fitted here, while the description's neighbour
 // index and lists are alive to be reused.
@@ -56,6 +92,9 @@ LabelingResult label_described(const LabelModel& model, const FeatureSettings& f
   DescribeOptions describe_options;
   describe_options.use_cloud_normals = options.use_cloud_normals;
   describe_options.share_neighbor_lists = options.share_neighbor_lists;
+  describe_options.plane_cascade = options.plane_cascade && !options.want_descriptors;
+  describe_options.trained_roughness = model.training.roughness_max;
+  describe_options.trained_surface_variation = model.training.surface_variation_max;
   DescribedCloud described = describe_cloud(cloud, features, describe_options, context);
   result.seconds = described.seconds;
   result.described_points = cloud.size();
@@ -63,7 +102,9 @@ LabelingResult label_described(const LabelModel& model, const FeatureSettings& f
   result.surface_variation = described.surface_variation;
   context.throw_if_stopped("labeling");
   if (model.kind == ModelKind::kSvm) {  // point by point: no graph
+    const std::vector<std::uint8_t> cascaded = std::move(described.cascaded);
     classify_with_svm(model, std::move(described), options, context, result);
+    label_cascaded_planes(cascaded, options, result);
     return result;
   }
 
@@ -88,6 +129,7 @@ LabelingResult label_described(const LabelModel& model, const FeatureSettings& f
     result.descriptors =
         leading_values(std::move(described.descriptors), model.features.descriptor_dim());
   result.labeled_points = graph.num_active();
+  label_cascaded_planes(described.cascaded, options, result);
   if (options.want_primitives && is_input)
     fit_primitives_of_input(
         cloud, options, context,

@@ -28,6 +28,7 @@ constexpr std::size_t kBlock = 512;  // points per parallel block
 std::vector<std::vector<float>> scaled_variations(const std::vector<Vec3f>& xyz,
                                                   const std::vector<float>& radii,
                                                   const NeighborLists& lists,
+                                                  std::span<const std::uint8_t> wanted,
                                                   const RunContext& context) {
   const std::size_t n = xyz.size(), scales = radii.size();
   std::vector<std::vector<float>> out(scales, std::vector<float>(n, 0.0f));
@@ -40,7 +41,7 @@ std::vector<std::vector<float>> scaled_variations(const std::vector<Vec3f>& xyz,
         std::vector<PointMoments> moments(scales);
         const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
         for (std::size_t i = first; i < last; ++i) {
-          if (!is_finite(xyz[i])) continue;
+          if (!is_finite(xyz[i]) || (!wanted.empty() && !wanted[i])) continue;
           lists.find(i, widest, list);
           std::fill(moments.begin(), moments.end(), PointMoments{});
           for (std::size_t j = 0; j < list.size(); ++j)
@@ -67,7 +68,8 @@ std::vector<std::vector<float>> scaled_variations(const std::vector<Vec3f>& xyz,
 
 Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
                               const FeatureSettings& settings, const NeighborSearch& search,
-                              bool curvature_at_normal_radius, const RunContext& context) {
+                              bool curvature_at_normal_radius, std::span<const std::uint8_t> wanted,
+                              const RunContext& context) {
   if (!settings.multi_scale()) return descriptors;
   const std::size_t n = cloud.size();
   const int d = settings.descriptor_dim();
@@ -84,6 +86,7 @@ Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
     FeatureOptions options;
     options.neighborhood = capped(Neighborhood::Radius(radius));
     options.fpfh_variant = settings.fpfh_variant;
+    options.wanted = wanted;
     blocks.push_back(compute_fpfh(cloud, options, context, nullptr, &search, &lists));
   }
   // Variations at the normal radius (estimate_normals' curvature when it ran at that radius),
@@ -98,7 +101,7 @@ Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
     if (!curvature_at_normal_radius) ascending.push_back(settings.normals.radius);
     std::sort(ascending.begin(), ascending.end());
     ascending.erase(std::unique(ascending.begin(), ascending.end()), ascending.end());
-    measured = scaled_variations(cloud.xyz, ascending, lists, context);
+    measured = scaled_variations(cloud.xyz, ascending, lists, wanted, context);
     const auto at = [&](float radius) {
       return &measured[std::size_t(std::lower_bound(ascending.begin(), ascending.end(), radius) -
                                    ascending.begin())];

@@ -5,6 +5,9 @@
 // noise that grows with range) look different at different scales; one 25 mm FPFH cannot tell a
 // rounded corner from a noisy edge.
 
+#include <cstdint>
+#include <span>
+
 #include "primlabel/geometry/descriptors.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
@@ -22,9 +25,12 @@ inline constexpr float kSurfaceVariationScale = 300.0f;
 // `curvature_at_normal_radius`: cloud.curvature is estimate_normals' at the model's normal
 // radius, so it is the first variation (else that is measured too). A point whose descriptor is
 // NaN keeps an all-NaN row; a variation that cannot be measured (too few neighbours) is 0.
+// `wanted` (empty: every point): only the points marked non-zero are widened, the others keep
+// their (NaN) rows, as FeatureOptions::wanted.
 Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
                               const FeatureSettings& settings, const NeighborSearch& search,
-                              bool curvature_at_normal_radius, const RunContext& context);
+                              bool curvature_at_normal_radius, std::span<const std::uint8_t> wanted,
+                              const RunContext& context);
 
 // The first `dim` values of each row: what clients get back as the descriptor.
 Descriptors leading_values(Descriptors descriptors, int dim);

@@ -12,6 +12,8 @@
 #include <atomic>
 #include <limits>
 #include <span>
+#include <stdexcept>
+#include <string>
 
 #include "feature_neighborhood.hpp"
 #include "pair_bins_batch.hpp"
@@ -263,6 +265,29 @@ void weight_spfh(const PointCloud& cloud, std::size_t p, const std::vector<float
     weight_spfh_of<false>(cloud, p, spfh, spfh_sums, list, usable, fpfh);
 }
 
+// The points pass 1 must describe for the wanted ones: each usable wanted point and every
+// neighbour of one (pass 2 weighs their histograms).
+template <typename NeighborsOf>
+std::vector<std::uint8_t> needed_for(std::span<const std::uint8_t> wanted,
+                                     const NeighborsOf& neighbors_of,
+                                     const std::vector<char>& usable, std::ptrdiff_t blocks,
+                                     const RunContext& context) {
+  const std::size_t n = wanted.size();
+  std::vector<std::uint8_t> needed(n, 0);
+  detail::for_each_block(
+      blocks, context, [] { return NeighborList(); },
+      [&](NeighborList& scratch, std::ptrdiff_t block) {
+        const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+        for (std::size_t p = first; p < last; ++p) {
+          if (!wanted[p] || !usable[p]) continue;
+          std::atomic_ref<std::uint8_t>(needed[p]).store(1, std::memory_order_relaxed);
+          for (std::uint32_t q : neighbors_of(p, scratch))
+            std::atomic_ref<std::uint8_t>(needed[q]).store(1, std::memory_order_relaxed);
+        }
+      });
+  return needed;
+}
+
 }  // namespace
 
 Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
@@ -323,6 +348,18 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
   // cap is not the whole ball: its point's row, and the rows of points that then miss a pair,
   // take the per-point path, as do k-nearest neighbourhoods and counts beyond the memory bound.
   const Neighborhood& hood = options.neighborhood;
+  // Only some points wanted: pass 1 on them and their neighbours alone. A needed point that then
+  // misses a pair its list expects (its lower neighbour was not needed) takes the per-point path
+  // like any other, so the rows are the same bits.
+  const bool subset = !options.wanted.empty();
+  if (subset && options.wanted.size() != n)
+    throw std::invalid_argument("FPFH: " + std::to_string(options.wanted.size()) +
+                                " wanted flags for " + std::to_string(n) + " points");
+  const std::vector<std::uint8_t> needed =
+      subset
+          ? needed_for(options.wanted, neighbors_of, usable, blocks, context.with_threads(threads))
+          : std::vector<std::uint8_t>{};
+  throw_if_stopped(stop, "FPFH");
   const bool symmetric = hood.radius > 0.0f && hood.k == 0 &&
                          n * kPairCountBytes * std::size_t(threads) <= kPairCountBudget;
   if (symmetric) {
@@ -345,7 +382,7 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
           const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
           for (std::size_t p = first; p < last; ++p) {
             if (stop.stop_requested()) return;
-            if (!usable[p]) continue;
+            if (!usable[p] || (subset && !needed[p])) continue;
             const std::span<const std::uint32_t> list = neighbors_of(p, scratch.pairs.list);
             keep_for_pass_2(p, list);
             cut[p] = hood.max_neighbors > 0 && list.size() >= std::size_t(hood.max_neighbors);
@@ -366,7 +403,7 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
           const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
           for (std::size_t p = first; p < last; ++p) {
             if (stop.stop_requested()) return;
-            if (!usable[p] || neighbor_count[p] < 2) continue;
+            if (!usable[p] || (subset && !needed[p]) || neighbor_count[p] < 2) continue;
             std::uint64_t received = 0;
             std::uint32_t counts[kFpfhSize] = {};
             for (std::size_t t = 0; t < used; ++t) {
@@ -395,7 +432,7 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
           for (std::size_t p = first; p < last; ++p) {
             // Per point: a stop is honoured within one (capped) neighbourhood's time.
             if (stop.stop_requested()) return;
-            if (!usable[p]) continue;
+            if (!usable[p] || (subset && !needed[p])) continue;
             const std::span<const std::uint32_t> list = neighbors_of(p, scratch.list);
             keep_for_pass_2(p, list);
             if (neighbor_count[p] < 2) continue;
@@ -419,7 +456,7 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
         for (std::size_t p = first; p < last; ++p) {
           if (stop.stop_requested()) return;
           float* out = &fpfh[p * kFpfhSize];
-          if (!usable[p]) {
+          if (!usable[p] || (subset && !options.wanted[p])) {
             std::fill(out, out + kFpfhSize, std::numeric_limits<float>::quiet_NaN());
             continue;
           }

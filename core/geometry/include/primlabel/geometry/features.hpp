@@ -9,6 +9,8 @@
 // bin 0).
 
 #include <cstddef>
+#include <cstdint>
+#include <span>
 #include <vector>
 
 #include "primlabel/geometry/descriptors.hpp"
@@ -43,6 +45,10 @@ struct FeatureOptions {
   // FPFH keeps each point's neighbour list between its two passes up to this many bytes (4 per
   // neighbour); points beyond it are searched twice. Results do not depend on it.
   std::size_t neighbor_cache_bytes = std::size_t(1) << 30;
+  // FPFH only: when not empty (one entry per point), only the points marked non-zero are
+  // described, bit for bit as without it; the others get NaN rows. The histograms of their
+  // neighbours are computed, nothing further, so the cost follows the marked points.
+  std::span<const std::uint8_t> wanted;
 };
 
 struct FeatureStats {

@@ -34,9 +34,12 @@ struct DescribedCloud {
   // One radius search per point at the larger of the normal and feature radii, shared by
   // normals, descriptors and the graph (null when the neighbourhoods are not both radii).
   std::unique_ptr<NeighborLists> lists;
-  StageSeconds seconds;         // its index, lists, normals and descriptors
+  StageSeconds seconds;         // its index, lists, normals, cascade and descriptors
   float point_spacing = 0;      // median_point_spacing of the described cloud (m; NaN: none)
   float surface_variation = 0;  // median_surface_variation of its normals (NaN: its own normals)
+  // With DescribeOptions::plane_cascade: 1 for the points the plane cascade labels plane
+  // (their descriptor rows are NaN); empty otherwise.
+  std::vector<std::uint8_t> cascaded;
 };
 
 // Thrown by describe_cloud and label_cloud when their stop token is requested.
@@ -59,6 +62,12 @@ struct DescribeOptions {
   // stage searches itself (the same neighbours; FPFH sums them in another order, so descriptors
   // differ in rounding). For benchmarks and tests that compare the two.
   bool share_neighbor_lists = true;
+  // The plane cascade (LabelingOptions::plane_cascade), bounded by the noise of the model's
+  // training scans (TrainingSummary::roughness_max, else surface_variation_max). Needs estimated
+  // normals, radius neighbourhoods and FPFH of the cloud's own points: ignored otherwise.
+  bool plane_cascade = false;
+  float trained_roughness = 0.0f;
+  float trained_surface_variation = 0.0f;
 };
 
 // Throws std::invalid_argument for settings describe_cloud cannot honour (voxel downsampling:
@@ -98,6 +107,13 @@ struct LabelingOptions {
   // With tabletop_only: the table and its objects as instances, every input point's object id
   // and, with want_primitives, the primitives of each (LabelingResult::objects).
   bool want_objects = false;
+  // The plane cascade: points whose neighbourhood is planar within the scene's plane noise are
+  // labeled plane without a descriptor or a CRF node (far fewer points to describe and infer on
+  // a table-top scene); those within the feature radius of a point that is not planar are
+  // described and inferred as before. Their probabilities are the mean of the points the model
+  // labeled plane. Off with want_descriptors or use_cloud_normals (every point is then
+  // described), and for models that recorded no surface variation of their training scenes.
+  bool plane_cascade = false;
 };
 
 struct LabelingResult {
@@ -108,9 +124,10 @@ struct LabelingResult {
   Descriptors descriptors;
   std::size_t labeled_points = 0;    // input points that got a descriptor (through their voxel)
   std::size_t described_points = 0;  // points described: voxels when downsampling
-  StageSeconds seconds;  // where the time went, stage by stage
-  float point_spacing = 0;      // median point spacing of the described cloud (m)
-  float surface_variation = 0;  // median surface variation of its computed normals
+  std::size_t cascaded_points = 0;   // of those, labeled plane by the plane cascade
+  StageSeconds seconds;              // where the time went, stage by stage
+  float point_spacing = 0;           // median point spacing of the described cloud (m)
+  float surface_variation = 0;       // median surface variation of its computed normals
   // Not empty when point_spacing is far outside what the model was trained for (domain.hpp):
   // the labels are then unreliable, and the caller should be told so.
   std::string domain_warning;

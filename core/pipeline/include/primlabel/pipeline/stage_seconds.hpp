@@ -14,6 +14,7 @@ struct StageSeconds {
   double index = 0;        // the neighbour index and the point-spacing measure
   double lists = 0;        // the radius search shared by normals, descriptors and graph
   double normals = 0;      // normal estimation (0 with the cloud's own normals)
+  double cascade = 0;      // the plane cascade's split (LabelingOptions::plane_cascade)
   double descriptors = 0;  // FPFH / PFH
   double graph = 0;        // the CRF's neighbourhood graph
   double inference = 0;    // CRF inference, or the SVM point by point
@@ -28,13 +29,14 @@ struct LabelingStage {
   double StageSeconds::*seconds;
 };
 
-inline constexpr std::array<LabelingStage, 11> kLabelingStages = {{
+inline constexpr std::array<LabelingStage, 12> kLabelingStages = {{
     {"voxels", &StageSeconds::voxels},
     {"tabletop", &StageSeconds::tabletop},
     {"duplicates", &StageSeconds::duplicates},
     {"index", &StageSeconds::index},
     {"lists", &StageSeconds::lists},
     {"normals", &StageSeconds::normals},
+    {"cascade", &StageSeconds::cascade},
     {"descriptors", &StageSeconds::descriptors},
     {"graph", &StageSeconds::graph},
     {"inference", &StageSeconds::inference},

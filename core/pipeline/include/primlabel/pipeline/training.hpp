@@ -10,11 +10,11 @@
 
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/crf/training.hpp"
+#include "primlabel/geometry/cloud_signature.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/model/svm_baseline.hpp"
 #include "primlabel/pipeline/stage_seconds.hpp"
-#include "primlabel/geometry/cloud_signature.hpp"
 
 namespace primlabel::pipeline {
 
@@ -23,9 +23,9 @@ struct SceneData {
   std::string source;
   crf::LabeledGraph graph;           // labels follow the class list of the last assign_labels
   std::vector<std::uint32_t> truth;  // taxonomy id per point
-  StageSeconds seconds;         // its description's index, lists, normals and descriptors
-  float point_spacing = 0;      // median point spacing as described (m; NaN: none)
-  float surface_variation = 0;  // median surface variation of its normals (NaN: none)
+  StageSeconds seconds;              // its description's index, lists, normals and descriptors
+  float point_spacing = 0;           // median point spacing as described (m; NaN: none)
+  float surface_variation = 0;       // median surface variation of its normals (NaN: none)
   // The cloud's image size as acquired, before any voxel filter (0 x 0: unorganised).
   std::uint32_t image_width = 0, image_height = 0;
   // Its signature as acquired (cloud_signature.hpp); zeros when not measured.
