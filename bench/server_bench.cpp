@@ -10,6 +10,10 @@
 //     voxel size; prints frames/s, p50 / p90 and per-stage ms (the server's stages from the
 //     summary, label_cloud's finer split in process) instead of table / kinect.
 //
+// label_cloud in process gets the options the server derives from the same request header
+// (service/label_options.hpp: the plane cascade on by default), so the labels must match; the
+// points the cascade labeled plane are printed (0 for the random model, which recorded no noise).
+//
 // The model is a CRF with seeded random weights and the default feature settings (the same
 // compute as a trained one). One labeling job at a time, 2 OpenMP threads, as the server runs
 // on this 2-core machine. Prints one line per figure and a JSON line at the end.
@@ -37,6 +41,7 @@
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/rpc/label_server.hpp"
 #include "primlabel/scrape/exposition_parser.hpp"
+#include "primlabel/service/label_options.hpp"
 #include "primlabel/synth/generate.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "primlabel/wire/packing.hpp"
@@ -112,6 +117,13 @@ std::vector<v1::LabelRequest> requests_for(const PointCloud& cloud, std::size_t 
   return requests;
 }
 
+// What the server makes of such a request's header: label_cloud's options in process.
+pipeline::LabelingOptions served_options(const PointCloud& cloud, const std::string& model) {
+  PointCloud empty;
+  empty.viewpoint = cloud.viewpoint;
+  return server::labeling_options(requests_for(empty, 1, model).front().header());
+}
+
 // One streamed request; returns the labels it got (empty on failure) and, when asked, the
 // summary's stage timings.
 std::vector<std::uint32_t> label_over_grpc(v1::Labeler::Stub& stub, const PointCloud& cloud,
@@ -146,11 +158,12 @@ Latency compare(const char* name, const LabelModel& model, const PointCloud& clo
                 v1::Labeler::Stub& stub, int reps, int threads) {
   Latency latency;
   const RunContext context{threads};
+  const pipeline::LabelingOptions options = served_options(cloud, "bench");
   std::vector<std::uint32_t> reference;
   for (int rep = -1; rep < reps; ++rep) {  // rep -1 warms both paths up
     PointCloud copy = cloud;
     auto start = Clock::now();
-    reference = pipeline::label_cloud(model, copy, {}, context).labels;
+    reference = pipeline::label_cloud(model, copy, options, context).labels;
     const double local = ms_since(start);
     start = Clock::now();
     const std::vector<std::uint32_t> labels = label_over_grpc(stub, cloud);
@@ -172,7 +185,7 @@ Latency compare(const char* name, const LabelModel& model, const PointCloud& clo
 
 struct FrameFigures {
   std::string name;
-  std::size_t points = 0, described = 0;
+  std::size_t points = 0, described = 0, cascaded = 0;
   float voxel = 0;
   double server_p50 = 0, server_p90 = 0, local_p50 = 0, local_p90 = 0;
   std::map<std::string, double> server_stages;               // of the run nearest the server p50
@@ -196,13 +209,14 @@ FrameFigures frame_figures(const std::string& label, const std::string& name,
   out.points = cloud.size();
   out.voxel = model.features.voxel_size;
   const RunContext context{threads};
+  const pipeline::LabelingOptions options = served_options(cloud, name);
   std::vector<double> server_ms, local_ms;
   std::vector<std::map<std::string, double>> server_stages;
   std::vector<pipeline::StageSeconds> local_seconds;
   for (int rep = -1; rep < reps; ++rep) {
     PointCloud copy = cloud;
     auto start = Clock::now();
-    pipeline::LabelingResult result = pipeline::label_cloud(model, copy, {}, context);
+    pipeline::LabelingResult result = pipeline::label_cloud(model, copy, options, context);
     const double local = ms_since(start);
     std::map<std::string, double> stages;
     start = Clock::now();
@@ -212,6 +226,7 @@ FrameFigures frame_figures(const std::string& label, const std::string& name,
       std::fprintf(stderr, "%s: labels differ from label_cloud!\n", label.c_str());
     if (rep < 0) continue;
     out.described = result.described_points;
+    out.cascaded = result.cascaded_points;
     local_ms.push_back(local);
     local_seconds.push_back(result.seconds);
     server_ms.push_back(served);
@@ -227,10 +242,10 @@ FrameFigures frame_figures(const std::string& label, const std::string& name,
     out.local_stages.emplace_back(stage.name, bench::stage_ms(local, stage));
 
   std::printf(
-      "%-24s %7zu points (%6zu described, voxel %.3f m): server p50 %7.1f ms p90 %7.1f ms "
-      "(%5.2f frames/s) | in-process p50 %7.1f ms p90 %7.1f ms  (%d reps)\n",
-      label.c_str(), out.points, out.described, out.voxel, out.server_p50, out.server_p90,
-      1e3 / out.server_p50, out.local_p50, out.local_p90, reps);
+      "%-24s %7zu points (%6zu described, %6zu of them cascaded, voxel %.3f m): server p50 %7.1f "
+      "ms p90 %7.1f ms (%5.2f frames/s) | in-process p50 %7.1f ms p90 %7.1f ms  (%d reps)\n",
+      label.c_str(), out.points, out.described, out.cascaded, out.voxel, out.server_p50,
+      out.server_p90, 1e3 / out.server_p50, out.local_p50, out.local_p90, reps);
   std::printf("%-24s   server stages ms:", "");
   double staged = 0;
   for (const auto& [stage, ms] : out.server_stages) {
@@ -410,6 +425,7 @@ int run_server_bench(const Arguments& args) {
     rows.push_back({{"frame", f.name},
                     {"points", f.points},
                     {"described", f.described},
+                    {"cascaded", f.cascaded},
                     {"voxel_size", json::rounded(f.voxel, "%.4f")},
                     {"server_p50_ms", json::rounded(f.server_p50, "%.2f")},
                     {"server_p90_ms", json::rounded(f.server_p90, "%.2f")},

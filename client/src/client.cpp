@@ -41,6 +41,7 @@ v1::LabelRequest header_request(const PointCloud& cloud, const LabelOptions& o) 
   options.set_tabletop_only(o.tabletop_only);
   options.set_return_objects(o.objects);
   options.set_voxel_size(o.voxel_size);
+  options.set_every_point(o.every_point);
   options.set_normal_radius(o.normal_radius);
   options.set_feature_radius(o.feature_radius);
   options.set_non_finite(o.reject_non_finite ? v1::NON_FINITE_REJECT : v1::NON_FINITE_DROP);

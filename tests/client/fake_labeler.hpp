@@ -40,8 +40,9 @@ class FakeLabeler final : public v1::Labeler::Service {
   std::atomic<int> chunks_received{0};
   std::atomic<std::uint64_t> points_received{0};
   std::mutex mutex;
-  std::vector<std::string> scan_ids;     // in arrival order
-  std::vector<v1::PointLayout> layouts;  // of each scan, in arrival order (guarded by mutex)
+  std::vector<std::string> scan_ids;      // in arrival order
+  std::vector<v1::PointLayout> layouts;   // of each scan, in arrival order (guarded by mutex)
+  std::vector<v1::LabelOptions> options;  // likewise
 
   // When set, every Label / LabelCloud call is counted here as the real server does:
   // primlabel_requests_total{method, model, status}.
@@ -262,6 +263,7 @@ class FakeLabeler final : public v1::Labeler::Service {
       std::lock_guard lock(mutex);
       scan_ids.push_back(header.scan_id());
       layouts.push_back(header.layout());
+      options.push_back(header.options());
     }
     // As the real server says how it chose: named, or (the fake's only model) the default.
     summary.set_model_choice(header.model().empty() ? v1::MODEL_CHOICE_DEFAULT

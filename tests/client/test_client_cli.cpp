@@ -126,6 +126,24 @@ TEST(ClientCli, LabelSendsTheFramesShapeAndPrintsHowTheModelWasChosen) {
   EXPECT_EQ(server.service.layouts[1].height(), 0u);  // unorganised: no shape sent
 }
 
+// --every-point asks the server to describe every point (no plane cascade); without it the
+// request leaves the server's default.
+TEST(ClientCli, EveryPointReachesTheRequest) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  const std::string base = cli() + " --server " + server.address() + " label " +
+                           dir.file("scan.pcd") + " -o " + dir.file("out.pcd");
+  const auto plain = test::run_command(base);
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  const auto every = test::run_command(base + " --every-point");
+  ASSERT_EQ(every.exit_code, 0) << every.output;
+  std::lock_guard lock(server.service.mutex);
+  ASSERT_EQ(server.service.options.size(), 2u);
+  EXPECT_FALSE(server.service.options[0].every_point());
+  EXPECT_TRUE(server.service.options[1].every_point());
+}
+
 // --primitives writes primlabel-eval's JSON from the summary's primitives (the fake's known
 // instances, read back with the core's parser).
 TEST(ClientCli, PrimitivesGoToTheirJsonFile) {

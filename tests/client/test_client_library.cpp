@@ -303,6 +303,21 @@ TEST(ClientCalls, ChunksAnsweredInReverseOrderStillLandInInputOrder) {
   for (std::size_t i = 0; i < 3000; ++i) ASSERT_EQ(result.labels[i], i % 7);
 }
 
+// LabelOptions::every_point reaches the header, streamed and unary; off by default (the
+// server's plane cascade).
+TEST(ClientCalls, EveryPointReachesTheRequest) {
+  FakeServer server;
+  Client client(fast_options(server.address()));
+  client.label(labeled_line(50), LabelOptions{});
+  client.label(labeled_line(50), label_options([](auto& o) { o.every_point = true; }));
+  client.label_unary(labeled_line(50), label_options([](auto& o) { o.every_point = true; }));
+  std::lock_guard lock(server.service.mutex);
+  ASSERT_EQ(server.service.options.size(), 3u);
+  EXPECT_FALSE(server.service.options[0].every_point());
+  EXPECT_TRUE(server.service.options[1].every_point());
+  EXPECT_TRUE(server.service.options[2].every_point());
+}
+
 TEST(ClientCalls, UnaryLabelsInOneMessage) {
   FakeServer server;
   Client client(fast_options(server.address()));

@@ -279,6 +279,13 @@ TEST(NodeParameters, ObjectsAndPrimitivesGoIntoTheLabelOptions) {
   EXPECT_TRUE(options.primitives);
 }
 
+TEST(NodeParameters, EveryPointGoesIntoTheLabelOptions) {
+  rosnode::NodeParameters parameters;
+  EXPECT_FALSE(rosnode::label_options(parameters).every_point);  // the service's cascade
+  parameters.every_point = true;
+  EXPECT_TRUE(rosnode::label_options(parameters).every_point);
+}
+
 TEST(NodeParameters, TheViewpointGoesIntoTheLabelOptionsOnlyWhenSet) {
   rosnode::NodeParameters parameters;
   EXPECT_FALSE(rosnode::label_options(parameters).viewpoint.has_value());  // the frame's origin

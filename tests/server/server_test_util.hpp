@@ -21,6 +21,7 @@
 #include "primlabel/rpc/label_server.hpp"
 #include "primlabel/scrape/exposition_parser.hpp"
 #include "primlabel/scrape/http_fetch.hpp"
+#include "primlabel/service/label_options.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 #include "primlabel/wire/packing.hpp"
 #include "random_label_model.hpp"
@@ -171,9 +172,10 @@ struct TestServer {
   std::unique_ptr<v1::ModelAdmin::Stub> admin;
 };
 
-// The reference: label_cloud in process with the same model and options.
+// The reference: label_cloud in process with the same model and the options the server takes
+// from a header that asks for nothing (service/label_options.hpp: the plane cascade on).
 inline std::vector<std::uint32_t> reference_labels(const LabelModel& model, PointCloud cloud) {
-  return pipeline::label_cloud(model, cloud, {}).labels;
+  return pipeline::label_cloud(model, cloud, server::labeling_options(v1::ScanHeader{})).labels;
 }
 
 }  // namespace primlabel::servertest

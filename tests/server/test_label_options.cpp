@@ -22,6 +22,7 @@ TEST(LabelOptions, EveryFieldOfTheRequestReachesThePipeline) {
   options.set_feature_radius(0.03f);
   options.set_return_primitives(true);
   options.set_return_objects(true);
+  options.set_every_point(true);
   header.mutable_layout()->set_normals(true);
   const pipeline::LabelingOptions labeling = labeling_options(header);
   EXPECT_TRUE(labeling.want_descriptors && labeling.want_probabilities && labeling.tabletop_only);
@@ -29,8 +30,11 @@ TEST(LabelOptions, EveryFieldOfTheRequestReachesThePipeline) {
   EXPECT_EQ(labeling.voxel_size, 0.01f);
   EXPECT_EQ(labeling.normal_radius, 0.02f);
   EXPECT_EQ(labeling.feature_radius, 0.03f);
+  EXPECT_FALSE(labeling.plane_cascade);  // every_point
   EXPECT_FALSE(refuse_options(labeling));
-  EXPECT_FALSE(labeling_options(v1::ScanHeader{}).want_objects);
+  const pipeline::LabelingOptions defaults = labeling_options(v1::ScanHeader{});
+  EXPECT_FALSE(defaults.want_objects);
+  EXPECT_TRUE(defaults.plane_cascade);  // the service cascades unless every_point is asked
 }
 
 TEST(LabelOptions, RefusalsNameTheRequestsFieldsAndTheModel) {

@@ -4,9 +4,12 @@
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 
+#include <algorithm>
 #include <chrono>
+#include <random>
 #include <thread>
 
+#include "primlabel/geometry/cloud_signature.hpp"
 #include "server_test_util.hpp"
 #include "small_svm_model.hpp"
 
@@ -100,6 +103,85 @@ TEST(LabelService, SvmModelsLabelAsInProcess) {
   EXPECT_EQ(answer.labels, reference_labels(model, cloud));
   ASSERT_TRUE(answer.summary);
   EXPECT_GT(answer.summary->points_labeled(), cloud.size() / 2);
+}
+
+// The plane cascade is the service's default (LabelOptions.every_point turns it off): a model
+// that recorded its training scans' noise labels the planar points of a noisy table plane without
+// describing them, LabelSummary.cascaded_points counts them, and the labels are label_cloud's
+// with the matching option, with the cascade and without it.
+// The table with its box, 0.5 mm of noise on every coordinate (a laser scanner's).
+PointCloud noisy_table_with_box() {
+  PointCloud cloud = table_with_box_cloud(0.005f);
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 0.0005f);
+  for (Vec3f& p : cloud.xyz) p += Vec3f(noise(rng), noise(rng), noise(rng));
+  return cloud;
+}
+
+TEST(LabelService, ThePlaneCascadeIsTheDefaultAndEveryPointTurnsItOff) {
+  const PointCloud cloud = noisy_table_with_box();
+  LabelModel model = random_label_model("cascade", "1");
+  // What primlabel-train records of its scans: here the very cloud's roughness.
+  model.training.roughness_max = measure_signature(cloud.xyz, cloud.viewpoint.origin).roughness;
+  ASSERT_GT(model.training.roughness_max, 0.0003f);
+  TestServer server({model});
+  const auto in_process = [&](bool cascade) {
+    PointCloud local = cloud;
+    pipeline::LabelingOptions options;
+    options.plane_cascade = cascade;
+    return pipeline::label_cloud(model, local, options);
+  };
+
+  const LabelAnswer cascaded =
+      label_stream(*server.stub, scan_requests(cloud, header_for("cascade"), 5000));
+  ASSERT_TRUE(cascaded.status.ok()) << cascaded.status.error_message();
+  const pipeline::LabelingResult with = in_process(true);
+  EXPECT_GT(with.cascaded_points, cloud.size() / 4);  // the table, away from the box
+  EXPECT_EQ(cascaded.summary->cascaded_points(), with.cascaded_points);
+  EXPECT_EQ(cascaded.labels, with.labels);
+  const std::uint32_t plane = class_id(PrimitiveClass::kPlane);
+  EXPECT_GE(std::size_t(std::count(cascaded.labels.begin(), cascaded.labels.end(), plane)),
+            with.cascaded_points);
+
+  v1::ScanHeader header = header_for("cascade");
+  header.mutable_options()->set_every_point(true);
+  const LabelAnswer every = label_cloud(*server.stub, cloud, header);  // unary alike
+  ASSERT_TRUE(every.status.ok()) << every.status.error_message();
+  const pipeline::LabelingResult without = in_process(false);
+  EXPECT_EQ(every.summary->cascaded_points(), 0u);
+  EXPECT_EQ(without.cascaded_points, 0u);
+  EXPECT_EQ(every.labels, without.labels);
+  // The random weights call many table points something else: the cascade really decided.
+  EXPECT_NE(every.labels, cascaded.labels);
+
+  // Descriptors asked for: every point is described, so the cascade stands aside by itself.
+  header = header_for("cascade");
+  header.mutable_options()->set_return_descriptors(true);
+  const LabelAnswer described = label_cloud(*server.stub, cloud, header);
+  ASSERT_TRUE(described.status.ok()) << described.status.error_message();
+  EXPECT_EQ(described.summary->cascaded_points(), 0u);
+  EXPECT_EQ(described.labels, without.labels);
+}
+
+// A model without a plane class has no label for the cascade's points: it describes them all,
+// as with every_point (none is left unknown).
+TEST(LabelService, AModelWithoutAPlaneClassDescribesEveryPoint) {
+  const PointCloud cloud = noisy_table_with_box();
+  LabelModel model = random_label_model("planeless", "1");
+  model.weights = crf::CrfModel::zeros({2, 4, 5, 6}, kFpfhSize);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  model.weights.node_weights =
+      model.weights.node_weights.unaryExpr([&](float) { return uniform(rng); });
+  model.training.roughness_max = measure_signature(cloud.xyz, cloud.viewpoint.origin).roughness;
+  TestServer server({model});
+  const LabelAnswer answer = label_cloud(*server.stub, cloud, header_for("planeless"));
+  ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+  EXPECT_EQ(answer.summary->cascaded_points(), 0u);
+  PointCloud local = cloud;
+  const pipeline::LabelingResult exact = pipeline::label_cloud(model, local, {});
+  EXPECT_EQ(answer.labels, exact.labels);
+  EXPECT_EQ(answer.summary->points_labeled(), exact.labeled_points);
 }
 
 TEST(LabelService, DescriptorsProbabilitiesAndSmallResponseChunks) {

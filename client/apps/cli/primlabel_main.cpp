@@ -69,6 +69,9 @@ int main(int argc, char** argv) {
   label->add_flag("--tabletop", label_args.options.tabletop_only,
                   "Label only the table and the objects on it");
   label->add_option("--voxel-size", label_args.options.voxel_size, "Downsample first (m)");
+  label->add_flag("--every-point", label_args.options.every_point,
+                  "Describe and infer every point: no plane cascade, the model's exact labels "
+                  "everywhere (slower)");
   label->add_option("--chunk-points", label_args.options.chunk_points, "Points per message")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

@@ -86,6 +86,8 @@ int main(int argc, char** argv) {
   app.add_option("--chunk-points", spec.label.chunk_points, "Points per streamed message")
       ->capture_default_str();
   app.add_flag("--descriptors", spec.label.descriptors, "Ask for the descriptors too");
+  app.add_flag("--every-point", spec.label.every_point,
+               "Describe and infer every point: no plane cascade (slower)");
   app.add_flag("--strict", strict,
                "Exit 4 when the server rejected calls at admission (RESOURCE_EXHAUSTED) too");
   app.add_option("--format", format, "text | csv | json")

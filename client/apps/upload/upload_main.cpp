@@ -234,6 +234,8 @@ int main(int argc, char** argv) {
   app.add_flag("--descriptors", options.label.descriptors, "Keep the FPFH descriptors");
   app.add_flag("--probabilities", options.label.probabilities, "Keep the class probabilities");
   app.add_flag("--tabletop", options.label.tabletop_only, "Label only the table top");
+  app.add_flag("--every-point", options.label.every_point,
+               "Describe and infer every point: no plane cascade (slower)");
   app.add_flag("-q,--quiet", quiet, "Only errors and the summary on stderr");
   try {
     app.parse(argc, argv);

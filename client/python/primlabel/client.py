@@ -315,7 +315,9 @@ class Client:
         INVALID_ARGUMENT); primitives, True to group the labels into same-class segments fitted
         with their class's model (Result.segments, Result.primitives); objects, True (with
         tabletop_only) for the table and its objects as instances (Result.table,
-        Result.objects, per point Result.object_ids); chunk_points,
+        Result.objects, per point Result.object_ids); every_point, True to describe and infer
+        every point: no plane cascade (summary.cascaded_points stays 0), the model's exact labels
+        everywhere, slower; chunk_points,
         response_chunk_points; deadline (seconds).
         """
         call, timeout = self._prepare(xyz, normals, model, voxel_size, probabilities, descriptors,
@@ -393,6 +395,7 @@ class Client:
         non_finite: str = "drop",
         primitives: bool = False,
         objects: bool = False,
+        every_point: bool = False,
         chunk_points: int = DEFAULT_CHUNK_POINTS,
         response_chunk_points: int = 0,
         deadline: float | None = None,
@@ -436,6 +439,7 @@ class Client:
                 response_chunk_points=int(response_chunk_points),
                 return_primitives=bool(primitives),
                 return_objects=bool(objects),
+                every_point=bool(every_point),
             ),
             layout=labeling_pb2.PointLayout(normals=sent_normals is not None,
                                             width=frame[0] if frame[1] > 1 else 0,

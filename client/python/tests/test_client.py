@@ -23,6 +23,15 @@ def cli_labels(server, scan, work):
 
 
 @pytest.fixture(scope="session")
+def cli_every_point(server, scan, work):
+    """The CLI's labels and probabilities with --every-point (no plane cascade)."""
+    out = work / "cli_every_point.pcd"
+    run(binary("primlabel"), "--server", server.address, "label", scan, "-o", out,
+        "--probabilities", "--every-point")
+    return primlabel.pcd.read(out)
+
+
+@pytest.fixture(scope="session")
 def cloud(scan):
     return primlabel.pcd.read(scan)
 
@@ -50,6 +59,19 @@ def test_labels_equal_the_cli_point_for_point(client, cloud, cli_labels):
     assert len(np.unique(result.labels)) >= 3
 
 
+def test_the_plane_cascade_by_default_and_every_point(client, cloud, cli_labels, cli_every_point):
+    # The tiny model recorded its training scan's noise: the server labels most of the table
+    # plane without describing it, unless every_point asks for every point to be described.
+    cascaded = client.label(cloud)
+    assert cascaded.summary.cascaded_points > len(cloud) // 10
+    np.testing.assert_array_equal(cascaded.labels, cli_labels.label)
+    exact = client.label(cloud, every_point=True)
+    assert exact.summary.cascaded_points == 0
+    np.testing.assert_array_equal(exact.labels, cli_every_point.label)
+    # The cascade's points are labeled plane, as the model itself labels nearly all of them.
+    assert (cascaded.labels != exact.labels).mean() < 0.05
+
+
 def test_small_chunks_each_way_give_the_same_labels(client, cloud, cli_labels):
     result = client.label(cloud, chunk_points=7777, response_chunk_points=5000)
     np.testing.assert_array_equal(result.labels, cli_labels.label)
@@ -60,8 +82,11 @@ def test_float64_input_is_sent_as_float32(client, cloud, cli_labels):
     np.testing.assert_array_equal(result.labels, cli_labels.label)
 
 
-def test_probability_rows_sum_to_one_in_the_order_of_classes(client, cloud, cli_labels):
+def test_probability_rows_sum_to_one_in_the_order_of_classes(client, cloud, cli_every_point):
+    # Descriptors describe every point: the server's plane cascade stands aside, as the CLI's
+    # --every-point has it.
     result = client.label(cloud, probabilities=True, descriptors=True)
+    assert result.summary.cascaded_points == 0
     names = [c.name for c in client.model_metadata("tiny").classes]
     assert [c.name for c in result.classes] == names
     assert result.probabilities.shape == (len(cloud), len(result.classes))
@@ -73,7 +98,7 @@ def test_probability_rows_sum_to_one_in_the_order_of_classes(client, cloud, cli_
     # the classes in the summary's order.
     np.testing.assert_array_equal(result.class_ids[rows.argmax(axis=1)],
                                   result.labels[described])
-    np.testing.assert_allclose(result.probabilities, cli_labels.fields["probability"], atol=0)
+    np.testing.assert_allclose(result.probabilities, cli_every_point.fields["probability"], atol=0)
     assert result.descriptors.shape == (len(cloud), result.summary.descriptor_dim)
     assert result.summary.descriptor_dim == 33
     # Points without a descriptor are the ones labeled unknown.

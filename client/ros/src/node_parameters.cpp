@@ -54,6 +54,7 @@ NodeParameters read_parameters(const ros::NodeHandle& node) {
   read(node, "model", p.model);
   read(node, "model_version", p.model_version);
   read(node, "voxel_size", p.voxel_size);
+  read(node, "every_point", p.every_point);
   if (node.hasParam("viewpoint")) {
     std::vector<double> xyz;
     if (!node.getParam("viewpoint", xyz) || xyz.size() != 3 || !std::isfinite(xyz[0]) ||
@@ -116,6 +117,7 @@ client::LabelOptions label_options(const NodeParameters& p) {
   options.model = p.model;
   options.model_version = p.model_version;
   options.voxel_size = static_cast<float>(p.voxel_size);
+  options.every_point = p.every_point;
   if (p.viewpoint)
     options.viewpoint =
         Vec3f(static_cast<float>((*p.viewpoint)[0]), static_cast<float>((*p.viewpoint)[1]),

@@ -25,6 +25,9 @@ struct NodeParameters {
   std::string model;          // empty = the server's default model
   std::string model_version;  // empty = the latest loaded
   double voxel_size = 0.0;    // > 0: downsample first (m); 0 = the model's setting
+  // Describe and infer every point: no plane cascade (the summary's cascaded_points stays 0),
+  // the model's exact labels everywhere, slower.
+  bool every_point = false;
   // The sensor's position in the cloud's frame, for orienting normals; unset = the frame's
   // origin (right for a cloud in its camera's own frame, wrong for one in base_link or map).
   std::optional<std::array<double, 3>> viewpoint;

@@ -54,7 +54,7 @@ void label_cascaded_planes(const std::vector<std::uint8_t>& cascaded,
   const std::uint32_t plane = class_id(PrimitiveClass::kPlane);
   const std::vector<std::uint32_t>& ids = result.class_ids;
   const auto column = std::find(ids.begin(), ids.end(), plane);
-  if (column == ids.end()) return;  // a model without planes: the CRF labeled every point
+  if (column == ids.end()) return;  // a model without planes: no cascade (label_described)
   if (options.want_probabilities) {
     Eigen::VectorXd mean = Eigen::VectorXd::Zero(result.probabilities.cols());
     std::size_t counted = 0;
@@ -92,7 +92,10 @@ LabelingResult label_described(const LabelModel& model, const FeatureSettings& f
   DescribeOptions describe_options;
   describe_options.use_cloud_normals = options.use_cloud_normals;
   describe_options.share_neighbor_lists = options.share_neighbor_lists;
-  describe_options.plane_cascade = options.plane_cascade && !options.want_descriptors;
+  // A model without a plane class has no label for the cascade's points: they are described.
+  const bool has_planes = std::find(result.class_ids.begin(), result.class_ids.end(),
+                                    class_id(PrimitiveClass::kPlane)) != result.class_ids.end();
+  describe_options.plane_cascade = options.plane_cascade && !options.want_descriptors && has_planes;
   describe_options.trained_roughness = model.training.roughness_max;
   describe_options.trained_surface_variation = model.training.surface_variation_max;
   DescribedCloud described = describe_cloud(cloud, features, describe_options, context);

@@ -16,6 +16,10 @@ pipeline::LabelingOptions labeling_options(const v1::ScanHeader& header) {
   labeling.use_cloud_normals = header.layout().normals();
   labeling.want_primitives = options.return_primitives();
   labeling.want_objects = options.return_objects();
+  // The plane cascade by default; the pipeline stands it aside where it cannot apply (descriptors
+  // asked for, the client's own normals, models that recorded no training noise or have no
+  // plane class).
+  labeling.plane_cascade = !options.every_point();
   return labeling;
 }
 

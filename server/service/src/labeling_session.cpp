@@ -115,11 +115,13 @@ std::optional<ServiceError> LabelingSession::outcome() {
   const double prefilter = seconds.voxels + seconds.tabletop + seconds.duplicates;
   stages.prefilter = seconds_between(scan_complete_, job_start_) + plan_.choice_seconds + prefilter;
   // The neighbour index and shared search go to the first stage that searches: the normals, or
-  // the features when the client sent its own normals (normals then stay 0).
+  // the features when the client sent its own normals (normals then stay 0). The plane cascade's
+  // split counts with the features: it decides which points get a descriptor (0 when it stands
+  // aside), so "features" stays the time from normals to descriptors, whichever points they cover.
   const double search = seconds.index + seconds.lists;
   const bool own_normals = plan_.options.use_cloud_normals;
   stages.normals = seconds.normals + (own_normals ? 0.0 : search);
-  stages.features = seconds.descriptors + (own_normals ? search : 0.0);
+  stages.features = seconds.cascade + seconds.descriptors + (own_normals ? search : 0.0);
   if (result_.primitives) stages.primitives = seconds.primitives;
   // The rest of the job: graph, inference and the fan-out (never below 0 by rounding).
   stages.inference =

@@ -66,6 +66,9 @@ struct LabelOptions {
   // and every point's object id (LabelResult::object_ids).
   bool objects = false;
   float voxel_size = 0;  // > 0: downsample before features
+  // Describe and infer every point: no plane cascade (summary.cascaded_points() stays 0), the
+  // model's exact labels everywhere, slower.
+  bool every_point = false;
   float normal_radius = 0;
   float feature_radius = 0;
   bool reject_non_finite = false;     // NaN/Inf points fail the call instead of being labeled 0

@@ -112,7 +112,9 @@ struct LabelingOptions {
   // a table-top scene); those within the feature radius of a point that is not planar are
   // described and inferred as before. Their probabilities are the mean of the points the model
   // labeled plane. Off with want_descriptors or use_cloud_normals (every point is then
-  // described), and for models that recorded no surface variation of their training scenes.
+  // described), for models that recorded no surface variation of their training scenes, and
+  // for models without a plane class. The service turns it on unless a request asks for
+  // every_point.
   bool plane_cascade = false;
 };
 
