@@ -6,11 +6,14 @@
 // Prints, never asserts; the last line is JSON. With --repeat: p50 / p90 wall and p50 CPU ms,
 // frames/s at the p50, and label_cloud's per-stage ms of the run nearest the p50 (points/s of
 // the fastest run, as before).
+// With --scans FILE... (and --model) it labels those files instead, each a row named by its file
+// (accuracy against its `label` field when it has one): a real frame held out from the model.
 // With --stop-latency N it instead stops label_cloud N times at random moments of a run on the
 // LMS400 scene and on hostile inputs (100k coincident points, 20k points in a 1 mm cube, both on
 // a small table) and prints the p50 / p99 / max time from the stop request to the return.
 //
 //   primlabel-bench pipeline --threads 1,2 --repeat 3
+//   primlabel-bench pipeline --model FOLD.plm --scans learn1_truth.pcd --compare-cascade
 //   primlabel-bench pipeline --stop-latency 20
 
 #include <sys/resource.h>
@@ -19,6 +22,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -32,7 +36,9 @@
 
 #include "bench_commands.hpp"
 #include "label_stages.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
@@ -44,6 +50,7 @@ using namespace primlabel;
 struct Arguments {
   std::string model;
   std::vector<std::string> sensors = {"lms400", "kinect"};
+  std::vector<std::string> scans;  // files to label instead of the synthetic scenes
   std::vector<int> threads = {2};
   std::vector<float> voxel_sizes = {-1.0f};  // < 0: the model's own
   int repeat = 1;
@@ -260,6 +267,10 @@ int run_stop_latency(const Arguments& args) {
 
 int run_pipeline_bench(const Arguments& args) {
   if (args.stop_latency > 0) return run_stop_latency(args);
+  if (!args.scans.empty() && args.model.empty()) {
+    std::fprintf(stderr, "primlabel-bench pipeline: --scans needs --model\n");
+    return 2;
+  }
   std::optional<LabelModel> given;
   if (!args.model.empty()) given = load_model(args.model);
   std::vector<Row> rows;
@@ -273,10 +284,19 @@ int run_pipeline_bench(const Arguments& args) {
   for (const pipeline::LabelingStage& c : pipeline::kLabelingStages)
     std::printf(" %*s", bench::stage_column_width(c), c.name);
   std::printf("\n");
-  for (const std::string& name : args.sensors) {
-    const synth::SensorKind sensor = *synth::sensor_from_name(name);
-    const PointCloud scene = synth::synthetic_scene(synth::SceneSet::kTest, 0, sensor);
-    const LabelModel model = given ? *given : quick_model(sensor);
+  // (row name, scene): the files asked for, else one synthetic test scene per sensor.
+  std::vector<std::pair<std::string, PointCloud>> scenes;
+  for (const std::string& path : args.scans) {
+    PointCloud scene = read_cloud(path);
+    if (scene.has_labels()) scene = load_labeled_cloud(path);  // the labels as class ids
+    scenes.emplace_back(std::filesystem::path(path).stem().string(), std::move(scene));
+  }
+  if (args.scans.empty())
+    for (const std::string& name : args.sensors)
+      scenes.emplace_back(name, synth::synthetic_scene(synth::SceneSet::kTest, 0,
+                                                       *synth::sensor_from_name(name)));
+  for (const auto& [name, scene] : scenes) {
+    const LabelModel model = given ? *given : quick_model(*synth::sensor_from_name(name));
     const std::string model_name =
         given ? "file" : std::string(model.kind == ModelKind::kCrf ? "crf" : "node") + "-quick";
     for (float voxel : args.voxel_sizes)
@@ -336,6 +356,9 @@ BenchCommand add_pipeline_command(CLI::App& parent) {
       "pipeline",
       "End-to-end labeling throughput (label_cloud) on synthetic LMS400 and Kinect scenes.");
   cmd->add_option("--model", args->model, "model file (default: a quick model per sensor)");
+  cmd->add_option("--scans", args->scans,
+                  "label these files instead (needs --model; accuracy from their label field)")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--sensors", args->sensors, "lms400 and/or kinect (default both)")
       ->delimiter(',')
       ->check(CLI::IsMember({"lms400", "kinect"}));

@@ -75,6 +75,32 @@ TEST_F(NeighborListsTest, WhatIsKeptChangesNeitherTheSetsNorTheirOrder) {
   }
 }
 
+TEST_F(NeighborListsTest, ListsForASubsetAndItsNeighboursAnswerEveryPointAlike) {
+  const Neighborhood hood = Neighborhood::Hybrid(0.05f, 50);
+  // A corner of the box is wanted: its points and their neighbours are searched up front.
+  std::vector<std::uint8_t> wanted(cloud_.size(), 0);
+  for (std::size_t i = 0; i < cloud_.size(); ++i)
+    wanted[i] = is_finite(cloud_.xyz[i]) && cloud_.xyz[i].x() < -0.1f && cloud_.xyz[i].y() < 0.0f;
+  const NeighborLists all(cloud_.xyz, *search_, hood, 1 << 30, RunContext{2});
+  const NeighborLists some(cloud_.xyz, *search_, hood, 1 << 30, wanted, RunContext{2});
+  const NeighborLists one(cloud_.xyz, *search_, hood, 1 << 30, wanted, RunContext{1});
+  std::size_t wanted_count = 0;
+  for (std::uint8_t flag : wanted) wanted_count += flag;
+  EXPECT_GT(some.kept_points(), wanted_count);  // their neighbours too
+  EXPECT_LT(some.kept_points(), all.kept_points() / 2);
+  EXPECT_EQ(some.kept_points(), one.kept_points());
+  NeighborList a, b;
+  for (std::size_t i = 0; i < cloud_.size(); ++i) {
+    all.find(i, Neighborhood::Radius(0.04f), a);
+    some.find(i, Neighborhood::Radius(0.04f), b);
+    ASSERT_EQ(a.indices, b.indices) << i;  // kept or searched again: the same list, same order
+    ASSERT_EQ(a.sq_dists, b.sq_dists) << i;
+  }
+  EXPECT_THROW(NeighborLists(cloud_.xyz, *search_, hood, 1 << 30,
+                             std::vector<std::uint8_t>(cloud_.size() - 1, 1)),
+               std::invalid_argument);
+}
+
 TEST_F(NeighborListsTest, NearestMatchesTheTreeAmongAllowedPoints) {
   const NeighborLists lists(cloud_.xyz, *search_, Neighborhood::Hybrid(0.08f, 50), 1 << 30);
   std::vector<std::uint8_t> allowed(cloud_.size(), 1);

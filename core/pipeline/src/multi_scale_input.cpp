@@ -77,8 +77,9 @@ Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
   float widest = settings.features.radius;
   for (float radius : settings.extra_feature_radii) widest = std::max(widest, radius);
   if (settings.surface_variation_features) widest = std::max(widest, settings.normals.radius);
+  // Only the described points' lists and their neighbours' (the plane cascade leaves most out).
   const NeighborLists lists(cloud.xyz, search, capped(Neighborhood::Radius(widest)), kListBytes,
-                            context);
+                            wanted, context);
 
   std::vector<Descriptors> blocks;
   blocks.push_back(std::move(descriptors));

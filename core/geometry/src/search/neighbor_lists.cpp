@@ -25,14 +25,52 @@ bool is_cut(const Neighborhood& hood, const NeighborList& found) {
 NeighborLists::NeighborLists(const std::vector<Vec3f>& points, const NeighborSearch& search,
                              const Neighborhood& hood, std::size_t budget_bytes,
                              const RunContext& context)
+    : NeighborLists(points, search, hood, budget_bytes, {}, context) {}
+
+NeighborLists::NeighborLists(const std::vector<Vec3f>& points, const NeighborSearch& search,
+                             const Neighborhood& hood, std::size_t budget_bytes,
+                             std::span<const std::uint8_t> wanted, const RunContext& context)
     : points_(points), search_(search), hood_(hood) {
   if (!hood.valid() || !(hood.radius > 0.0f))
     throw std::invalid_argument("neighbour lists need a radius neighbourhood, got " +
                                 hood.describe());
-  const std::stop_token& stop = context.stop;
   const std::size_t n = points.size();
+  if (!wanted.empty() && wanted.size() != n)
+    throw std::invalid_argument("neighbour lists: " + std::to_string(wanted.size()) +
+                                " wanted flags for " + std::to_string(n) + " points");
   blocks_.resize((n + kBlock - 1) / kBlock);
+  for (std::size_t b = 0; b < blocks_.size(); ++b) {
+    const std::size_t size = std::min(n, (b + 1) * kBlock) - b * kBlock;
+    blocks_[b].begin.assign(size, kNotKept);
+    blocks_[b].end.assign(size, kNotKept);
+  }
   const std::size_t block_budget = blocks_.empty() ? 0 : budget_bytes / blocks_.size();
+  if (wanted.empty()) {
+    fill([](std::size_t) { return true; }, block_budget, context);
+    return;
+  }
+  fill([&](std::size_t i) { return wanted[i] != 0; }, block_budget, context);
+  // The wanted points' neighbours, from the lists just kept (or searched again).
+  std::vector<std::uint8_t> needed(wanted.begin(), wanted.end());
+  NeighborList scratch;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!wanted[i]) continue;
+    const std::uint32_t* indices = nullptr;
+    const float* sq_dists = nullptr;
+    std::size_t count = 0;
+    if (!shared(i, scratch, indices, sq_dists, count)) {  // cut: its nearest are searched anew
+      search.find(points[i], hood, scratch, /*sorted=*/false);
+      indices = scratch.indices.data(), count = scratch.size();
+    }
+    for (std::size_t p = 0; p < count; ++p) needed[indices[p]] = 1;
+  }
+  fill([&](std::size_t i) { return needed[i] != 0; }, block_budget, context);
+}
+
+template <typename Take>
+void NeighborLists::fill(const Take& take, std::size_t block_budget, const RunContext& context) {
+  const std::stop_token& stop = context.stop;
+  const std::size_t n = points_.size();
   std::atomic<std::size_t> kept{0};
   detail::for_each_block(
       static_cast<std::ptrdiff_t>(blocks_.size()), context, [] { return NeighborList(); },
@@ -40,20 +78,19 @@ NeighborLists::NeighborLists(const std::vector<Vec3f>& points, const NeighborSea
         Block& block = blocks_[std::size_t(b)];
         const std::size_t first = std::size_t(b) * kBlock;
         const std::size_t last = std::min(n, first + kBlock);
-        block.begin.assign(last - first, kNotKept);
-        block.end.assign(last - first, kNotKept);
         std::size_t block_kept = 0;
         for (std::size_t i = first; i < last; ++i) {
           if (stop.stop_requested()) return;  // per point: within one neighbourhood's time
           const std::size_t slot = i - first;
-          if (!is_finite(points[i])) {
+          if (block.begin[slot] != kNotKept || !take(i)) continue;
+          if (!is_finite(points_[i])) {
             block.begin[slot] = kNoPoint;
             continue;
           }
           // Over this block's share: the rest of it is searched again when asked for.
           if ((block.indices.size() + 1) * kEntryBytes > block_budget) break;
-          search.find(points[i], hood, found, /*sorted=*/false);
-          if (is_cut(hood, found)) {
+          search_.find(points_[i], hood_, found, /*sorted=*/false);
+          if (is_cut(hood_, found)) {
             block.begin[slot] = kCut;
             continue;
           }
@@ -67,7 +104,7 @@ NeighborLists::NeighborLists(const std::vector<Vec3f>& points, const NeighborSea
         kept += block_kept;
       });
   throw_if_stopped(stop, "neighbour lists");
-  kept_points_ = kept.load();
+  kept_points_ += kept.load();
 }
 
 bool NeighborLists::shared(std::size_t i, NeighborList& scratch, const std::uint32_t*& indices,

@@ -30,6 +30,13 @@ class NeighborLists {
   NeighborLists(const std::vector<Vec3f>& points, const NeighborSearch& search,
                 const Neighborhood& hood, std::size_t budget_bytes, const RunContext& context = {});
 
+  // The same for a stage that needs only the points with wanted[i] != 0 and their neighbours
+  // (an FPFH of a subset): only those lists are searched up front, wanted points first; the
+  // others are searched when asked for, with the same answer. An empty `wanted` means all.
+  NeighborLists(const std::vector<Vec3f>& points, const NeighborSearch& search,
+                const Neighborhood& hood, std::size_t budget_bytes,
+                std::span<const std::uint8_t> wanted, const RunContext& context = {});
+
   const Neighborhood& neighborhood() const { return hood_; }
   std::size_t kept_points() const { return kept_points_; }
 
@@ -63,6 +70,11 @@ class NeighborLists {
   // search is cut by its cap at i.
   bool shared(std::size_t i, NeighborList& scratch, const std::uint32_t*& indices,
               const float*& sq_dists, std::size_t& count) const;
+
+  // Searches and keeps, within each block's share of the budget, the lists of the block's
+  // points that `take` accepts and that have none yet.
+  template <typename Take>
+  void fill(const Take& take, std::size_t block_budget, const RunContext& context);
 
   const std::vector<Vec3f>& points_;
   const NeighborSearch& search_;
