@@ -48,7 +48,7 @@ namespace {
 using namespace primlabel;
 
 struct Arguments {
-  std::string model;
+  std::vector<std::string> models;  // each a set of rows (a release's model beside a new one)
   std::vector<std::string> sensors = {"lms400", "kinect"};
   std::vector<std::string> scans;  // files to label instead of the synthetic scenes
   std::vector<int> threads = {2};
@@ -227,8 +227,8 @@ std::vector<double> stop_latencies(const LabelModel& model, const PointCloud& in
 int run_stop_latency(const Arguments& args) {
   const PointCloud scene =
       synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400);
-  const LabelModel model =
-      args.model.empty() ? quick_model(synth::SensorKind::kLms400) : load_model(args.model);
+  const LabelModel model = args.models.empty() ? quick_model(synth::SensorKind::kLms400)
+                                               : load_model(args.models.front());
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> mm(0.0f, 0.001f);
   std::vector<Vec3f> cube(20000);
@@ -267,12 +267,14 @@ int run_stop_latency(const Arguments& args) {
 
 int run_pipeline_bench(const Arguments& args) {
   if (args.stop_latency > 0) return run_stop_latency(args);
-  if (!args.scans.empty() && args.model.empty()) {
+  if (!args.scans.empty() && args.models.empty()) {
     std::fprintf(stderr, "primlabel-bench pipeline: --scans needs --model\n");
     return 2;
   }
-  std::optional<LabelModel> given;
-  if (!args.model.empty()) given = load_model(args.model);
+  // (row name, model); none given: a quick model per sensor, made below.
+  std::vector<std::pair<std::string, LabelModel>> given;
+  for (const std::string& path : args.models)
+    given.emplace_back(std::filesystem::path(path).stem().string(), load_model(path));
   std::vector<Row> rows;
   std::printf("%-7s %-18s %3s %6s %8s %8s %8s %8s %8s %7s %8s %6s", "sensor", "model", "thr",
               "voxel", "points", "voxels", "cascaded", "p50 ms", "p90 ms", "frame/s", "cpu ms",
@@ -293,28 +295,33 @@ int run_pipeline_bench(const Arguments& args) {
   }
   if (args.scans.empty())
     for (const std::string& name : args.sensors)
-      scenes.emplace_back(name, synth::synthetic_scene(synth::SceneSet::kTest, 0,
-                                                       *synth::sensor_from_name(name)));
+      scenes.emplace_back(
+          name, synth::synthetic_scene(synth::SceneSet::kTest, 0, *synth::sensor_from_name(name)));
   for (const auto& [name, scene] : scenes) {
-    const LabelModel model = given ? *given : quick_model(*synth::sensor_from_name(name));
-    const std::string model_name =
-        given ? "file" : std::string(model.kind == ModelKind::kCrf ? "crf" : "node") + "-quick";
-    for (float voxel : args.voxel_sizes)
-      for (int threads : args.threads)
-        for (const auto& [share, cascade] : variants) {
-          Row row = measure(model, scene, threads, args.repeat, voxel, share, cascade);
-          row.sensor = name;
-          row.model = model_name + (share ? "" : "-unshared") + (cascade ? "-cascade" : "");
-          std::printf("%-7s %-18s %3d %6.3f %8zu %8zu %8zu %8.1f %8.1f %7.2f %8.1f %6.2f",
-                      row.sensor.c_str(), row.model.c_str(), row.threads, row.voxel, row.points,
-                      row.described, row.cascaded, row.p50_ms, row.p90_ms, 1e3 / row.p50_ms,
-                      row.cpu_p50_ms, 100 * row.accuracy);
-          for (const pipeline::LabelingStage& c : pipeline::kLabelingStages)
-            std::printf(" %*.1f", bench::stage_column_width(c), bench::stage_ms(row.stages, c));
-          std::printf("\n");
-          std::fflush(stdout);
-          rows.push_back(std::move(row));
-        }
+    std::vector<std::pair<std::string, LabelModel>> models = given;
+    if (models.empty()) {
+      LabelModel quick = quick_model(*synth::sensor_from_name(name));
+      const std::string quick_name =
+          std::string(quick.kind == ModelKind::kCrf ? "crf" : "node") + "-quick";
+      models.emplace_back(quick_name, std::move(quick));
+    }
+    for (const auto& [model_name, model] : models)
+      for (float voxel : args.voxel_sizes)
+        for (int threads : args.threads)
+          for (const auto& [share, cascade] : variants) {
+            Row row = measure(model, scene, threads, args.repeat, voxel, share, cascade);
+            row.sensor = name;
+            row.model = model_name + (share ? "" : "-unshared") + (cascade ? "-cascade" : "");
+            std::printf("%-7s %-18s %3d %6.3f %8zu %8zu %8zu %8.1f %8.1f %7.2f %8.1f %6.2f",
+                        row.sensor.c_str(), row.model.c_str(), row.threads, row.voxel, row.points,
+                        row.described, row.cascaded, row.p50_ms, row.p90_ms, 1e3 / row.p50_ms,
+                        row.cpu_p50_ms, 100 * row.accuracy);
+            for (const pipeline::LabelingStage& c : pipeline::kLabelingStages)
+              std::printf(" %*.1f", bench::stage_column_width(c), bench::stage_ms(row.stages, c));
+            std::printf("\n");
+            std::fflush(stdout);
+            rows.push_back(std::move(row));
+          }
   }
   namespace json = primlabel::json;
   json::Json out_rows = json::Json::array();
@@ -355,7 +362,11 @@ BenchCommand add_pipeline_command(CLI::App& parent) {
   CLI::App* cmd = parent.add_subcommand(
       "pipeline",
       "End-to-end labeling throughput (label_cloud) on synthetic LMS400 and Kinect scenes.");
-  cmd->add_option("--model", args->model, "model file (default: a quick model per sensor)");
+  cmd->add_option("--model", args->models,
+                  "model files, each its rows in the same run (a release's beside a new one; "
+                  "default: a quick model per sensor)")
+      ->delimiter(',')
+      ->check(CLI::ExistingFile);
   cmd->add_option("--scans", args->scans,
                   "label these files instead (needs --model; accuracy from their label field)")
       ->check(CLI::ExistingFile);
