@@ -91,12 +91,14 @@ build() {
 # The default model repository: one CRF + FPFH model per sensor, each from 8 synthetic table
 # scenes (fixed seeds), so the same commands make the same models. Kept when they exist.
 #
-# tabletop-lms400: normals over 15 mm, FPFH over 30 mm and class balance 0.25 (rare classes such
-#   as corners weigh more), each scene also scanned once more with other noise, density, range
-#   and incidence (seeded by the scene). Held out (tools/robustness_sweep.sh): 98.42% at 1x noise,
-#   97.25% at 4x, 97.39% at 25% density, corner recall 0.59 / 0.68 / 0.56 (the worst class;
-#   0.42 / 0.45 / 0.32 with 25 mm FPFH and no class balance: 98.35%, 97.45%, 97.22%); without
-#   augmentation and with 10 mm normals 98.5%, 78.9%, 91.8%. About 112 s and 1.03 GB peak.
+# tabletop-lms400: trained and served on 3 mm voxels (1.8x faster than full resolution: a scan's
+#   ~500 points within 25 mm made every FPFH pass expensive), normals over 15 mm, FPFH over 30 mm
+#   and class balance 0.25 (rare classes such as corners weigh more), each scene also scanned once
+#   more with other noise, density, range and incidence (seeded by the scene). Held out
+#   (tools/robustness_sweep.sh, 2026-12-05): 98.21% at 1x noise, 97.30% at 4x, 97.28% at 25%
+#   density, corner recall 0.55 / 0.67 / 0.51 (full resolution: 98.42%, 97.26%, 97.39%, corners
+#   0.58 / 0.67 / 0.55; 4 mm voxels lost 0.36 points at 1x and corners at low density). About
+#   45 s and 0.78 GB peak.
 # tabletop-kinect: trained and served on 5 mm voxels (the model records the size and the server
 #   applies it, so a 640x480 frame is labeled in a fraction of a second), normals over 30 mm,
 #   class balance 0.25, multi-scale input (FPFH also at 15 and 40 mm, surface variation at every
@@ -107,8 +109,8 @@ build() {
 #   recipe in scene-level cross-validation (bench/real_crossval.sh). A fresh clone has no
 #   ../shared/data/mosd, so every machine gets the committed deploy/models/tabletop-kinect.plm
 #   (checked against its .sha256); `deploy/setup.sh kinect-model OUT` retrains it. docs/models.md "The default models" has its figures, time and memory.
-LMS400_RECIPE=(--sensor lms400 --normal-radius 0.015 --feature-radius 0.03 --class-balance 0.25
-  --augment "$DEFAULT_AUGMENT")
+LMS400_RECIPE=(--sensor lms400 --voxel-size 0.003 --normal-radius 0.015 --feature-radius 0.03
+  --class-balance 0.25 --augment "$DEFAULT_AUGMENT")
 KINECT_RECIPE=(--sensor kinect --voxel-size 0.005 --normal-radius 0.03 --class-balance 0.25
   --extra-radii 0.015,0.04 --surface-variation --synth-train 8)
 MOSD_DIR=${MOSD_DIR:-$ROOT/../shared/data/mosd}
