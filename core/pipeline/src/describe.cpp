@@ -125,10 +125,11 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
     const auto cascade_start = std::chrono::steady_clock::now();
     const CascadeScale scale{std::max(normal_hood.radius, feature_hood.radius),
                              normal_hood.radius >= feature_hood.radius};
-    const std::vector<float> variation =
-        scale.is_normal_radius
-            ? cloud.curvature
-            : surface_variations(cloud.xyz, scale.radius, *out.search, out.lists.get(), stage);
+    // At the normal radius the normals' own curvature is the variation: no copy, no search.
+    std::vector<float> measured;
+    if (!scale.is_normal_radius)
+      measured = surface_variations(cloud.xyz, scale.radius, *out.search, out.lists.get(), stage);
+    const std::vector<float>& variation = scale.is_normal_radius ? cloud.curvature : measured;
     const CascadeNoise noise{options.trained_roughness, options.trained_surface_variation};
     const float max_variation =
         cascade_max_variation(median_surface_variation(variation), noise, scale);

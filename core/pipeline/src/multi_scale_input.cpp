@@ -2,7 +2,6 @@
 
 #include "multi_scale_input.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -50,13 +49,7 @@ std::vector<std::vector<float>> scaled_variations(const std::vector<Vec3f>& xyz,
               moments[r].add(xyz[list.indices[j]], xyz[i]);
             }
           for (std::size_t r = 0; r < scales; ++r) {
-            if (moments[r].count < 3) continue;
-            const Eigen::Matrix3d cov = moments[r].covariance();
-            const double trace = cov.trace();
-            if (!(trace > 0.0)) continue;
-            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-            solver.computeDirect(cov, Eigen::EigenvaluesOnly);
-            const double variation = std::max(solver.eigenvalues()(0), 0.0) / trace;
+            const double variation = moments[r].surface_variation();
             if (std::isfinite(variation)) out[r][i] = float(variation) * kSurfaceVariationScale;
           }
         }

@@ -2,7 +2,6 @@
 
 #include "plane_cascade.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -50,13 +49,7 @@ std::vector<float> variations_of(const std::vector<Vec3f>& points, const Neighbo
           neighbors_within(points, p, hood, search, lists, list);
           PointMoments moments;
           for (std::uint32_t q : list.indices) moments.add(points[q], points[p]);
-          if (moments.count < 3) continue;
-          const Eigen::Matrix3d cov = moments.covariance();
-          const double trace = cov.trace();
-          if (!(trace > 0.0)) continue;
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-          solver.computeDirect(cov, Eigen::EigenvaluesOnly);
-          out[p] = float(std::max(solver.eigenvalues()(0), 0.0) / trace);
+          out[p] = float(moments.surface_variation());  // NaN: undefined
         }
       });
   throw_if_stopped(context.stop, "the plane cascade");

@@ -4,6 +4,10 @@
 // are in double around the point, which keeps them small and the covariance accurate.
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "primlabel/geometry/point_cloud.hpp"
 
@@ -36,6 +40,18 @@ struct PointMoments {
     cov(2, 0) = cov(0, 2);
     cov(2, 1) = cov(1, 2);
     return cov;
+  }
+
+  // The surface variation (Pauly et al.): the covariance's smallest eigenvalue over their sum,
+  // from 0 on a plane to 1/3 for isotropic scatter. NaN for fewer than 3 points or no spread.
+  double surface_variation() const {
+    if (count < 3) return std::numeric_limits<double>::quiet_NaN();
+    const Eigen::Matrix3d cov = covariance();
+    const double trace = cov.trace();
+    if (!(trace > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(cov, Eigen::EigenvaluesOnly);
+    return std::max(solver.eigenvalues()(0), 0.0) / trace;
   }
 };
 
