@@ -3,19 +3,11 @@
 // benchmark's own file: it binds the subcommand's flags and returns how to run it, so
 // bench_main.cpp only wires them. (`features` keeps its options in features_bench.hpp.)
 
-#include <functional>
-
-namespace CLI {
-class App;
-}
+#include "primlabel/cli/subcommands.hpp"
 
 namespace primlabel::bench {
 
-struct BenchCommand {
-  CLI::App* command = nullptr;
-  // Runs the benchmark with the parsed flags; returns the exit code (0 ok, 1 failure, 2 usage).
-  std::function<int()> run;
-};
+using BenchCommand = cli::Subcommand;  // a benchmark: its flags and how to run it
 
 BenchCommand add_crf_command(CLI::App& parent);         // crf_bench.cpp
 BenchCommand add_pipeline_command(CLI::App& parent);    // pipeline_bench.cpp

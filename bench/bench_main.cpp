@@ -2,25 +2,13 @@
 // wires them: every benchmark binds its flags and runs in its own file (bench_commands.hpp).
 
 #include <CLI/CLI.hpp>
-#include <cstdio>
-#include <exception>
 #include <string>
 #include <vector>
 
 #include "bench_commands.hpp"
 #include "features_bench.hpp"
 #include "primlabel/build_version.hpp"
-#include "primlabel/cli/exit_codes.hpp"
-
-namespace {
-
-// "primlabel-bench crf" once the command line named a benchmark, so messages say which one.
-std::string command_name(const CLI::App& app) {
-  const auto chosen = app.get_subcommands();
-  return chosen.empty() ? app.get_name() : app.get_name() + " " + chosen.front()->get_name();
-}
-
-}  // namespace
+#include "primlabel/cli/subcommands.hpp"
 
 int main(int argc, char** argv) {
   using namespace primlabel::bench;
@@ -33,36 +21,16 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   FeaturesBenchOptions features_options;
-  const std::vector<BenchCommand> commands = {
-      {add_features_command(app, features_options),
-       [&features_options] { return run_features_bench(features_options); }},
-      add_crf_command(app),
-      add_pipeline_command(app),
-      add_server_command(app),
-      add_tabletop_command(app),
-      add_primitives_command(app),
-      add_can_radii_command(app),
-  };
   // Each benchmark was a binary of its own with --version; they keep it.
-  for (const BenchCommand& bench : commands) bench.command->set_version_flag("--version", version);
-
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version
-    std::fprintf(stderr, "%s: usage error: %s (see --help)\n", command_name(app).c_str(),
-                 error.what());
-    return primlabel::kExitUsage;
-  }
-
-  for (const BenchCommand& bench : commands) {
-    if (!bench.command->parsed()) continue;
-    try {
-      return bench.run();
-    } catch (const std::exception& error) {
-      std::fprintf(stderr, "%s: error: %s\n", command_name(app).c_str(), error.what());
-      return primlabel::kExitFailure;
-    }
-  }
-  return primlabel::kExitUsage;
+  return primlabel::cli::run_subcommands(
+      app,
+      {{add_features_command(app, features_options),
+        [&features_options] { return run_features_bench(features_options); }},
+       add_crf_command(app),
+       add_pipeline_command(app),
+       add_server_command(app),
+       add_tabletop_command(app),
+       add_primitives_command(app),
+       add_can_radii_command(app)},
+      version, argc, argv);
 }

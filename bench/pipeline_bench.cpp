@@ -267,10 +267,8 @@ int run_stop_latency(const Arguments& args) {
 
 int run_pipeline_bench(const Arguments& args) {
   if (args.stop_latency > 0) return run_stop_latency(args);
-  if (!args.scans.empty() && args.models.empty()) {
-    std::fprintf(stderr, "primlabel-bench pipeline: --scans needs --model\n");
-    return 2;
-  }
+  if (!args.scans.empty() && args.models.empty())
+    throw cli::UsageError("--scans needs --model (a held-out file needs a model to label it)");
   // (row name, model); none given: a quick model per sensor, made below.
   std::vector<std::pair<std::string, LabelModel>> given;
   for (const std::string& path : args.models)

@@ -3,25 +3,14 @@
 // add_*_command is defined in its subcommand's own file: it binds the flags and returns how to
 // run it, so research_main.cpp only wires them (the pattern of primlabel-bench).
 
-#include <functional>
-#include <stdexcept>
-
-namespace CLI {
-class App;
-}
+#include "primlabel/cli/subcommands.hpp"
 
 namespace primlabel::research_tool {
 
-struct ResearchCommand {
-  CLI::App* command = nullptr;
-  // Runs the subcommand with the parsed flags; returns the exit code (0 ok, 1 failure, 2 usage).
-  std::function<int()> run;
-};
+using ResearchCommand = cli::Subcommand;  // a study: its flags and how to run it
 
 // A combination of flags the parser cannot check on its own: reported as bad usage (exit 2).
-struct UsageError : std::invalid_argument {
-  using std::invalid_argument::invalid_argument;
-};
+using cli::UsageError;
 
 ResearchCommand add_table1_command(CLI::App& parent);            // table1_command.cpp
 ResearchCommand add_fig4_command(CLI::App& parent);              // fig4_command.cpp
