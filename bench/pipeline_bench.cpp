@@ -367,6 +367,7 @@ BenchCommand add_pipeline_command(CLI::App& parent) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--scans", args->scans,
                   "label these files instead (needs --model; accuracy from their label field)")
+      ->delimiter(',')
       ->check(CLI::ExistingFile);
   cmd->add_option("--sensors", args->sensors, "lms400 and/or kinect (default both)")
       ->delimiter(',')

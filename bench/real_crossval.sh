@@ -34,8 +34,9 @@ BIN=$BUILD_DIR/bin
 MOSD=${MOSD:-$ROOT/../shared/data/mosd}
 FOLDS=5
 # The shipped depth-camera recipe (deploy/setup.sh KINECT_RECIPE) and its 8 synthetic scenes.
-# (Until 2026-12-05 it had no multi-scale input; docs/results.md keeps that recipe's figures.)
-RECIPE=(--kind crf --sensor kinect --voxel-size 0.005 --normal-radius 0.03 --class-balance 0.25
+# (Until 2026-12-05 it had no multi-scale input, then 5 mm voxels; docs/results.md keeps those
+# recipes' figures.)
+RECIPE=(--kind crf --sensor kinect --voxel-size 0.007 --normal-radius 0.03 --class-balance 0.25
   --extra-radii 0.015,0.04 --surface-variation)
 SYNTH_SCENES=8
 read -r -a VARIANT <<<"${VARIANT_RECIPE:-}"

@@ -5,8 +5,9 @@
 //   table : a 22k-point LMS400 table scene (the paper's object + table size)
 //   kinect: a 640x480 synthetic Kinect frame (307,200 points, NaN where the ray missed)
 //   cancel: a 5M-point request cancelled while it is being labeled, at several moments
-//   --frame SENSOR=MODEL (repeatable): the first held-out synthetic scene of that sensor (a
-//     640x480 Kinect frame, a ~87k-point LMS400 scan) labeled with that model file at its own
+//   --frame SENSOR=MODEL or FILE=MODEL (repeatable): the first held-out synthetic scene of that
+//     sensor (a 640x480 Kinect frame, a ~87k-point LMS400 scan), or that cloud file (a real frame
+//     the model never trained on), labeled with that model file at its own
 //     voxel size; prints frames/s, p50 / p90 and per-stage ms (the server's stages from the
 //     summary, label_cloud's finer split in process) instead of table / kinect.
 //
@@ -35,6 +36,7 @@
 #include "bench_commands.hpp"
 #include "label_stages.hpp"
 #include "primlabel/cli/exit_codes.hpp"
+#include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/ops/logging.hpp"
 #include "primlabel/pipeline/labeling.hpp"
@@ -304,22 +306,27 @@ int run_server_bench(const Arguments& args) {
   // Each --frame model under its own name (frame0, frame1, ...).
   struct Frame {
     std::string label, name;
-    synth::SensorKind sensor;
+    PointCloud cloud;
     LabelModel model;
   };
   std::vector<Frame> frame_cases;
   for (const std::string& spec : args.frames) {
     const std::size_t eq = spec.find('=');
-    const auto sensor =
-        eq == std::string::npos ? std::nullopt : synth::sensor_from_name(spec.substr(0, eq));
-    if (!sensor) {
-      std::fprintf(stderr, "primlabel-bench server: usage error: --frame %s: want SENSOR=MODEL\n",
+    const std::string input = spec.substr(0, eq);
+    const auto sensor = eq == std::string::npos ? std::nullopt : synth::sensor_from_name(input);
+    if (eq == std::string::npos || (!sensor && !fs::is_regular_file(input))) {
+      std::fprintf(stderr,
+                   "primlabel-bench server: usage error: --frame %s: want SENSOR=MODEL or "
+                   "FILE=MODEL (an existing cloud file)\n",
                    spec.c_str());
       return primlabel::kExitUsage;
     }
     const std::string file = spec.substr(eq + 1);
-    Frame frame{spec.substr(0, eq) + "/" + fs::path(file).stem().string(),
-                "frame" + std::to_string(frame_cases.size()), *sensor, load_model(file)};
+    Frame frame{
+        fs::path(input).stem().string() + "/" + fs::path(file).stem().string(),
+        "frame" + std::to_string(frame_cases.size()),
+        sensor ? synth::synthetic_scene(synth::SceneSet::kTest, 0, *sensor) : read_cloud(input),
+        load_model(file)};
     fs::create_directories(repo / frame.name / "1");
     fs::copy_file(file, repo / frame.name / "1" / "model.plm");
     frame_cases.push_back(std::move(frame));
@@ -343,9 +350,8 @@ int run_server_bench(const Arguments& args) {
   PointCloud kinect;
   std::vector<FrameFigures> frame_rows;
   for (const Frame& f : frame_cases)
-    frame_rows.push_back(frame_figures(f.label, f.name, f.model,
-                                       synth::synthetic_scene(synth::SceneSet::kTest, 0, f.sensor),
-                                       *stub, args.reps_frame, args.threads));
+    frame_rows.push_back(
+        frame_figures(f.label, f.name, f.model, f.cloud, *stub, args.reps_frame, args.threads));
   if (!args.cancel_only && frame_cases.empty()) {
     table = compare("table", model, table_scene(22000), *stub, args.reps_table, args.threads);
     kinect = synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kKinect);

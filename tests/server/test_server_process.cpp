@@ -143,7 +143,7 @@ TEST_F(ServerBinary, LabelsServesMetricsAndStopsCleanlyOnSigterm) {
   EXPECT_TRUE(server.logged("event=signal signal=SIGTERM"));
   EXPECT_TRUE(server.logged("event=stopped"));
   const std::regex request_line(
-      R"(event=request method=Label request_id=\S+ scan_id=s1 model=tabletop version=1 points=\d+ .*duration_ms=\S+ status=OK)");
+      R"(event=request method=Label request_id=\S+ scan_id=s1 model=tabletop version=1 points=\d+ .*duration_ms=\S+ status=OK.* cascaded=\d+ )");
   EXPECT_TRUE(std::regex_search(server.log(), request_line)) << server.log();
 }
 

@@ -109,6 +109,7 @@ void LabelingSession::note_model() {
 std::optional<ServiceError> LabelingSession::outcome() {
   if (plan_.entry && !record_.model_resolved) note_model();  // chosen in the job
   if (job_error_) return job_error_;
+  record_.cascaded = result_.cascaded_points;
   StageTimes& stages = record_.stages;
   const pipeline::StageSeconds& seconds = result_.seconds;
   // The model choice, when it measured the cloud, counts with the work before the description.

@@ -50,6 +50,7 @@ void RequestRecord::finish(std::string_view code_name, std::string_view message)
       .kv("duration_ms", seconds * 1e3)
       .kv("status", code);
   if (!model_choice.empty()) line.kv("model_choice", model_choice);
+  if (ok) line.kv("cascaded", cascaded);
   for (const auto& [name, field] : kStages) {
     const double value = stages.*field;
     if (value < 0) continue;

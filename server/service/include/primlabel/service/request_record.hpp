@@ -33,6 +33,8 @@ class RequestRecord {
   // How the model was chosen ("named", "domain", "default"); empty until it is.
   std::string model_choice;
   std::uint64_t points = 0, dropped_non_finite = 0;
+  // Of the described points, those the plane cascade labeled plane (LabelSummary.cascaded_points).
+  std::uint64_t cascaded = 0;
   StageTimes stages;
 
   // Logs and counts the request once, with its outcome: the status code's name ("OK",
