@@ -98,6 +98,40 @@ TEST(ClientCli, LabelWritesLabelsDescriptorsProbabilitiesAndPng) {
   EXPECT_NE(r.output.find("300 points"), std::string::npos) << r.output;
 }
 
+// A label field of the input (its truth, its segments) is kept beside the predicted classes, and
+// the CLI says so.
+TEST(ClientCli, AnInputsOwnLabelFieldIsKeptAsInputLabel) {
+  FakeServer server;
+  test::TempDir dir;
+  PointCloud scan;
+  scan.resize_unorganized(300);
+  scan.labels.resize(300);
+  for (std::size_t i = 0; i < 300; ++i) {
+    scan.xyz[i] = Vec3f(float(i % 5), 0.01f * i, 0.3f);
+    scan.labels[i] = 20 + std::uint32_t(i % 3);
+  }
+  write_cloud(dir.file("truth.pcd"), scan);
+  const auto r = test::run_command(cli() + " --server " + server.address() + " label " +
+                                   dir.file("truth.pcd") + " -o " + dir.file("out.pcd"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("its own label field is kept as 'input_label'"), std::string::npos)
+      << r.output;
+  const PointCloud out = read_cloud(dir.file("out.pcd"));
+  const FloatField* kept = out.find_field("input_label");
+  ASSERT_NE(kept, nullptr);
+  for (std::size_t i = 0; i < 300; ++i) {
+    ASSERT_EQ(out.labels[i], i % 5);                     // the predicted classes
+    ASSERT_EQ(kept->values[i], float(20 + i % 3)) << i;  // the input's own
+  }
+  // Without a label field: no note, no extra field.
+  write_scan(dir.file("plain.pcd"));
+  const auto plain = test::run_command(cli() + " --server " + server.address() + " label " +
+                                       dir.file("plain.pcd") + " -o " + dir.file("plain_out.pcd"));
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_EQ(plain.output.find("input_label"), std::string::npos) << plain.output;
+  EXPECT_EQ(read_cloud(dir.file("plain_out.pcd")).find_field("input_label"), nullptr);
+}
+
 // The CLI sends an organised file's width and height (so a server can pick the camera's model)
 // and prints how the model was chosen.
 TEST(ClientCli, LabelSendsTheFramesShapeAndPrintsHowTheModelWasChosen) {
@@ -261,6 +295,29 @@ TEST(ClientCli, SeveralFilesGoToTheOutputDirectory) {
   EXPECT_EQ(read_cloud(dir.file("out/b_labeled.pcd")).labels.size(), 40u);
 }
 
+// Several inputs write one file each into a directory: a target naming a file (by its extension,
+// or an existing file) is refused before anything is sent, instead of becoming a directory.
+TEST(ClientCli, SeveralFilesAndAFileAsOutputIsAUsageError) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("a.pcd"));
+  write_scan(dir.file("b.pcd"));
+  std::ofstream(dir.file("existing")) << "x\n";
+  for (const std::string& target :
+       {"-o " + dir.file("single.pcd"), "-o " + dir.file("SINGLE.PLY"),
+        "-o " + dir.file("existing"), "--primitives " + dir.file("p.json")}) {
+    const auto r = test::run_command(cli() + " --server " + server.address() + " label " +
+                                     dir.file("a.pcd") + " " + dir.file("b.pcd") + " " + target);
+    EXPECT_EQ(r.exit_code, 2) << target << ": " << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("2 inputs write one file each into a directory"), std::string::npos)
+        << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("single.pcd")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("p.json")));
+  EXPECT_EQ(server.service.label_calls.load(), 0);
+}
+
 TEST(ClientCli, MissingOrBrokenInputExitsOne) {
   FakeServer server;
   test::TempDir dir;
@@ -320,20 +377,41 @@ TEST(ClientCli, ServerAddressWithoutAPortGetsTheServersDefaultPort) {
   EXPECT_EQ(server_address_with_port("::1"), "[::1]:50051");
   EXPECT_EQ(server_address_with_port("dns:///labeler:7000"), "dns:///labeler:7000");
   EXPECT_EQ(server_address_with_port("unix:/run/primlabel.sock"), "unix:/run/primlabel.sock");
-  for (const char* bad : {"", "labeler:", "labeler:0", "labeler:x", "labeler:70000", ":50051",
-                          "[::1", "[::1]x", "a b", "labeler:-1"})
+  for (const char* bad :
+       {"", "labeler:", "labeler:0", "labeler:x", "labeler:70000", ":50051", "[::1", "[::1]x",
+        "a b", "labeler:-1", "http://127.0.0.1:50731", "grpc://labeler", "labeler:7000:1"})
     EXPECT_THROW(server_address_with_port(bad), std::invalid_argument) << bad;
 }
 
+TEST(ClientCli, AMistypedCommandIsNamedWithTheNearestOne) {
+  auto r = test::run_command(cli() + " lable x.pcd");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+  EXPECT_NE(r.output.find("unknown command 'lable' (did you mean 'label'?)"), std::string::npos)
+      << r.output;
+  r = test::run_command(cli() + " frobnicate");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(
+      r.output.find("unknown command 'frobnicate'; the commands: health, models, info, label"),
+      std::string::npos)
+      << r.output;
+}
+
 TEST(ClientCli, ABadServerAddressIsAUsageErrorNamingIt) {
-  for (const std::string address : {"labeler:", "labeler:0", "labeler:http"}) {
+  for (const std::string address :
+       {"labeler:", "labeler:0", "labeler:http", "http://127.0.0.1:50731"}) {
     const auto r = test::run_command(cli() + " --server " + address + " health");
     EXPECT_EQ(r.exit_code, 2) << address << ": " << r.output;
     EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find("'" + address + "'"), std::string::npos) << r.output;
   }
-  const auto r = test::run_command("PRIMLABEL_SERVER=labeler: " + cli() + " health");
+  auto r = test::run_command("PRIMLABEL_SERVER=labeler: " + cli() + " health");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  // A URL says what to give instead, at once (no connection attempts).
+  r = test::run_command(cli() + " --server http://127.0.0.1:50731/ health");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("give HOST:PORT (e.g. '127.0.0.1:50731')"), std::string::npos)
+      << r.output;
 }
 
 // $PRIMLABEL_SERVER stands in for --server; the flag wins over it.

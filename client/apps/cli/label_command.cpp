@@ -2,18 +2,22 @@
 // A bad file or a rejected request is reported and the next file goes on; an unreachable server
 // ends the run at once (the remaining files would fail the same way).
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <initializer_list>
+#include <tuple>
 
 #include "commands.hpp"
 #include "common/labeled_output.hpp"
 #include "common/object_json.hpp"
 #include "common/primitive_json.hpp"
-#include "status_exit_codes.hpp"
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "status_exit_codes.hpp"
 
 namespace primlabel::client::tools {
 
@@ -53,9 +57,41 @@ bool make_json_directory(const LabelCommand& command, const std::string& target,
   return false;
 }
 
+// Several inputs write into a directory: a target that is a file, or that names one by its
+// extension (`-o single.pcd`), would silently become a directory. The one-line reason, or "".
+std::string not_a_directory_target(const LabelCommand& command, const std::string& flag,
+                                   const std::string& target,
+                                   std::initializer_list<const char*> file_extensions) {
+  if (command.inputs.size() <= 1 || target.empty()) return {};
+  const fs::path path(target);
+  std::error_code ec;
+  const bool exists = fs::exists(path, ec);
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  const bool looks_like_a_file = std::any_of(file_extensions.begin(), file_extensions.end(),
+                                             [&](const char* e) { return ext == e; });
+  if ((exists && !fs::is_directory(path, ec)) || (!exists && looks_like_a_file))
+    return flag + " " + target + ": " + std::to_string(command.inputs.size()) +
+           " inputs write one file each into a directory; give a directory (or one input)";
+  return {};
+}
+
 }  // namespace
 
 int run_label(Client& client, LabelCommand command) {
+  for (const auto& [flag, target, extensions] :
+       {std::tuple{std::string("-o"), command.output,
+                   std::initializer_list<const char*>{".pcd", ".ply"}},
+        std::tuple{std::string("--primitives"), command.primitives,
+                   std::initializer_list<const char*>{".json"}},
+        std::tuple{std::string("--objects"), command.objects,
+                   std::initializer_list<const char*>{".json"}}}) {
+    if (const std::string why = not_a_directory_target(command, flag, target, extensions);
+        !why.empty()) {
+      std::fprintf(stderr, "primlabel: %s\n", why.c_str());
+      return kExitUsage;
+    }
+  }
   if (command.inputs.size() > 1 && !command.output.empty()) {
     std::error_code ec;
     fs::create_directories(command.output, ec);
@@ -110,6 +146,7 @@ int run_label(Client& client, LabelCommand command) {
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const std::string out = output_path(command, input);
+    const bool had_labels = cloud.has_labels();
     try {
       PointCloud labeled = labeled_cloud(std::move(cloud), result);
       if (!result.object_ids.empty())
@@ -134,6 +171,11 @@ int run_label(Client& client, LabelCommand command) {
     if (!result.summary.domain_warning().empty())
       std::fprintf(stderr, "primlabel: warning: %s: %s\n", input.c_str(),
                    result.summary.domain_warning().c_str());
+    if (had_labels && !command.quiet)
+      std::fprintf(stderr,
+                   "primlabel: %s: its own label field is kept as '%s'; 'label' now holds "
+                   "the predicted classes\n",
+                   input.c_str(), kInputLabelField);
     if (!command.quiet)
       std::fprintf(stderr, "%s: %zu points -> %s in %.2f s, model %s %s %s (%s)\n", input.c_str(),
                    result.size(), out.c_str(), seconds, result.summary.model().c_str(),

@@ -14,8 +14,9 @@
 
 #include "commands.hpp"
 #include "common/client_flags.hpp"
-#include "status_exit_codes.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/cli/subcommands.hpp"
+#include "status_exit_codes.hpp"
 
 using namespace primlabel::client;
 using namespace primlabel::client::tools;
@@ -86,7 +87,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "primlabel: %s (see --help)\n", e.what());
+    // "primlabel lable x.pcd": the word taken for a command, and the nearest command.
+    const std::string unknown = primlabel::cli::unknown_command_message(app);
+    std::fprintf(stderr, "primlabel: %s (see --help)\n",
+                 unknown.empty() ? e.what() : unknown.c_str());
     return kExitUsage;
   }
 

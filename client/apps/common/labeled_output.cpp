@@ -38,6 +38,10 @@ CloudTags labeled_cloud_tags(const LabelResult& result) {
 }
 
 PointCloud labeled_cloud(PointCloud cloud, const LabelResult& result) {
+  if (cloud.has_labels() && cloud.labels.size() == cloud.size()) {
+    FloatField& kept = cloud.set_field(kInputLabelField, 1);
+    kept.values.assign(cloud.labels.begin(), cloud.labels.end());  // exact below 2^24
+  }
   cloud.labels = result.labels;
   if (result.descriptor_dim > 0)
     cloud.set_field(descriptor_field(result), result.descriptor_dim).values = result.descriptors;

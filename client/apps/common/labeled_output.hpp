@@ -11,8 +11,10 @@
 
 namespace primlabel::client::tools {
 
-// The input cloud with the result's labels (replacing any label field it had), descriptors and
-// probabilities as float fields.
+// The input cloud with the result's labels, descriptors and probabilities as float fields. A
+// label field the input had (its own truth or segments) is kept as the float field
+// kInputLabelField rather than lost.
+inline constexpr const char* kInputLabelField = "input_label";
 PointCloud labeled_cloud(PointCloud input, const LabelResult& result);
 
 // The descriptor field's name: the server's ("fpfh" is PCL's FPFH, "fpfh_paper" the paper's

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <stdexcept>
 #include <string_view>
 
@@ -38,6 +39,14 @@ std::string server_address_with_port(const std::string& address) {
     throw std::invalid_argument("server address '" + address +
                                 "' has blanks or control characters");
   if (is_grpc_uri(address)) return address;
+  // A web URL: gRPC takes HOST:PORT, and "http://h:p" would otherwise read as an IPv6 address
+  // and fail later, as a name lookup, after every retry.
+  if (const auto scheme = address.find("://"); scheme != std::string::npos) {
+    std::string rest = address.substr(scheme + 3);
+    rest = rest.substr(0, rest.find('/'));
+    throw std::invalid_argument("server address '" + address + "' is a URL; give HOST:PORT" +
+                                (rest.empty() ? std::string() : " (e.g. '" + rest + "')"));
+  }
   const std::string port_suffix = ":" + std::to_string(kDefaultServerPort);
   if (address.front() == '[') {
     const auto close = address.find(']');
@@ -51,7 +60,15 @@ std::string server_address_with_port(const std::string& address) {
   }
   const auto colons = std::count(address.begin(), address.end(), ':');
   if (colons == 0) return address + port_suffix;
-  if (colons > 1) return "[" + address + "]" + port_suffix;  // a bare IPv6 address
+  if (colons > 1) {  // a bare IPv6 address: hex digits, colons and a dotted IPv4 tail
+    if (!std::all_of(address.begin(), address.end(), [](char c) {
+          return std::isxdigit(static_cast<unsigned char>(c)) || c == ':' || c == '.';
+        }))
+      throw std::invalid_argument("server address '" + address +
+                                  "': more than one ':' but not an IPv6 address (give HOST:PORT, "
+                                  "or [IPV6]:PORT)");
+    return "[" + address + "]" + port_suffix;
+  }
   const auto colon = address.find(':');
   if (colon == 0) throw std::invalid_argument("server address '" + address + "': no host");
   check_port(address, std::string_view(address).substr(colon + 1));

@@ -4,6 +4,8 @@
 // and turns every failure into the exit-code scheme with a one-line reason naming it.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstddef>
 #include <cstdio>
 #include <exception>
 #include <functional>
@@ -32,6 +34,49 @@ inline std::string command_name(const CLI::App& app) {
   return chosen.empty() ? app.get_name() : app.get_name() + " " + chosen.front()->get_name();
 }
 
+// "health, models, info, label": the subcommands' names, in the order they were added.
+inline std::string command_names(const CLI::App& app) {
+  std::string out;
+  for (const CLI::App* sub : app.get_subcommands({}))
+    out += (out.empty() ? "" : ", ") + sub->get_name();
+  return out;
+}
+
+// " (did you mean 'label'?)" when a subcommand is within two edits of `word`, else "".
+inline std::string did_you_mean(const std::string& word, const CLI::App& app) {
+  const auto distance = [](const std::string& a, const std::string& b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+      std::size_t diagonal = row[0];
+      row[0] = i;
+      for (std::size_t j = 1; j <= b.size(); ++j) {
+        const std::size_t above = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+        diagonal = above;
+      }
+    }
+    return row[b.size()];
+  };
+  std::string best;
+  std::size_t best_distance = 3;
+  for (const CLI::App* sub : app.get_subcommands({}))
+    if (const std::size_t d = distance(word, sub->get_name()); d < best_distance)
+      best = sub->get_name(), best_distance = d;
+  return best.empty() ? std::string() : " (did you mean '" + best + "'?)";
+}
+
+// The usage error for a word taken where a subcommand was expected ("primlabel lable x.pcd"),
+// or "" when the parse failed otherwise: "unknown command 'lable' (did you mean 'label'?); the
+// commands: ...".
+inline std::string unknown_command_message(const CLI::App& app) {
+  if (!app.get_subcommands().empty()) return {};
+  const std::vector<std::string> left = app.remaining();
+  if (left.empty() || left.front().starts_with("-")) return {};
+  return "unknown command '" + left.front() + "'" + did_you_mean(left.front(), app) +
+         "; the commands: " + command_names(app);
+}
+
 // Gives every subcommand the binary's --version, parses, and runs the one named: --help and
 // --version exit 0; a parse error or UsageError is "NAME SUB: usage error: ..." and exit 2;
 // any other exception "NAME SUB: error: ..." and exit 1.
@@ -43,8 +88,9 @@ inline int run_subcommands(CLI::App& app, const std::vector<Subcommand>& command
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     if (error.get_exit_code() == 0) return app.exit(error);  // --help, --version
+    const std::string unknown = unknown_command_message(app);
     std::fprintf(stderr, "%s: usage error: %s (see --help)\n", command_name(app).c_str(),
-                 error.what());
+                 unknown.empty() ? error.what() : unknown.c_str());
     return kExitUsage;
   }
   for (const Subcommand& command : commands) {
