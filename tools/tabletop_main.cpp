@@ -96,9 +96,12 @@ int run(const Arguments& args) {
     report["cluster_sizes"] = std::move(sizes);
   }
   std::string title = name + ": " + to_string(result.status);
+  // With --json stdout is the JSON line alone (for jq and scripts); the human lines go to stderr.
+  FILE* human = args.json ? stderr : stdout;
   if (!args.quiet)
-    std::printf("%s: %s (%zu of %zu points valid), %.1f ms\n", name.c_str(), result.message.c_str(),
-                result.valid_points, cloud.size(), result.timings.total_ms);
+    std::fprintf(human, "%s: %s (%zu of %zu points valid), %.1f ms\n", name.c_str(),
+                 result.message.c_str(), result.valid_points, cloud.size(),
+                 result.timings.total_ms);
   if (args.eval && result.ok()) {
     const SegmentationScores scores = evaluate_segmentation(cloud, result);
     report["table_precision"] = measured(scores.table_precision);
@@ -115,7 +118,7 @@ int run(const Arguments& args) {
                   "%zu true)",
                   scores.table_precision, scores.table_recall, scores.table_f1,
                   scores.mean_object_iou, scores.objects_found, scores.objects_true);
-    if (!args.quiet) std::printf("%s: %s\n", name.c_str(), text);
+    if (!args.quiet) std::fprintf(human, "%s: %s\n", name.c_str(), text);
     char short_text[120];
     std::snprintf(short_text, sizeof short_text, " | table F1 %.3f, object IoU %.3f",
                   scores.table_f1, scores.mean_object_iou);
@@ -131,7 +134,7 @@ int run(const Arguments& args) {
 
   if (!args.png.empty()) {
     render(cloud, result, args, title);
-    if (!args.quiet) std::printf("%s: wrote %s\n", name.c_str(), args.png.c_str());
+    if (!args.quiet) std::fprintf(human, "%s: wrote %s\n", name.c_str(), args.png.c_str());
   }
   if (args.json) std::printf("%s\n", json::dump(report).c_str());
   if (!result.ok()) {
@@ -159,7 +162,8 @@ int main(int argc, char** argv) {
   app.add_option("input", args.input, "input cloud (.pcd or .ply)")->required();
   app.add_flag("--eval", args.eval,
                "score against the cloud's mOSD labels (1-9 table, 10k+ object k)");
-  app.add_flag("--json", args.json, "end with one JSON line of the results");
+  app.add_flag("--json", args.json,
+               "print one JSON line of the results on stdout (the human lines go to stderr)");
   app.add_option("--png", args.png, "render the segmentation to this PNG");
   app.add_option("--view", args.view, "PNG view: oblique, top or sensor")
       ->check(CLI::IsMember({"oblique", "top", "sensor"}));

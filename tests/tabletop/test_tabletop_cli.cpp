@@ -8,8 +8,8 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "test_util.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "test_util.hpp"
 
 namespace primlabel {
 namespace {
@@ -72,6 +72,19 @@ TEST(TabletopCli, HostileFileNamesStayValidJson) {
   EXPECT_EQ(file.substr(0, file.size() - 7), path.substr(0, path.size() - 5));  // up to the \xff
   EXPECT_NE(file.find("\xef\xbf\xbd"), std::string::npos) << file;              // replaced, U+FFFD
   EXPECT_EQ(line["status"], "no_valid_points");
+}
+
+// With --json, stdout is the JSON line alone: `primlabel-tabletop scan.pcd --json | jq` works.
+TEST(TabletopCli, WithJsonStdoutIsOneJsonLine) {
+  test::TempDir dir;
+  const std::string path = dir.file("plane.pcd");
+  write_pcd(path, test::plane_grid(0, 0, 0.5f, 0.01f));
+  const Result r = test::run_command("(" + test::binary("primlabel-tabletop") + " " + path +
+                                     " --json 2>/dev/null)");
+  ASSERT_EQ(test::count_lines(r.output), 1) << r.output;
+  EXPECT_NO_THROW(nlohmann::json::parse(r.output)) << r.output;
+  const Result human = run(path + " --json");  // both streams: the human line is still there
+  EXPECT_GE(test::count_lines(human.output), 2) << human.output;
 }
 
 TEST(TabletopCli, EvalWithoutLabelsFails) {
