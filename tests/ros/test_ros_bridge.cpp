@@ -286,6 +286,26 @@ TEST(NodeParameters, EveryPointGoesIntoTheLabelOptions) {
   EXPECT_TRUE(rosnode::label_options(parameters).every_point);
 }
 
+// The start-up line names every labeling setting with its value, so a ~tabletop_only the
+// parameter server kept from an earlier run is seen at once.
+TEST(NodeParameters, TheStartUpLineNamesEverySetting) {
+  rosnode::NodeParameters parameters;
+  std::string text = rosnode::settings_text(parameters);
+  for (const char* part :
+       {"tabletop_only false", "every_point false", "voxel_size the model's",
+        "viewpoint the frame's origin", "objects false", "primitives false", "confidence false",
+        "probabilities false", "model (the one whose domain fits each cloud)"})
+    EXPECT_NE(text.find(part), std::string::npos) << part << " in: " << text;
+  parameters.model = "tabletop-kinect";
+  parameters.tabletop_only = true;
+  parameters.voxel_size = 0.007;
+  parameters.viewpoint = std::array<double, 3>{0.0, 0.0, 1.5};
+  text = rosnode::settings_text(parameters);
+  for (const char* part :
+       {"model tabletop-kinect", "tabletop_only true", "voxel_size 0.007 m", "viewpoint 0,0,1.5"})
+    EXPECT_NE(text.find(part), std::string::npos) << part << " in: " << text;
+}
+
 TEST(NodeParameters, TheViewpointGoesIntoTheLabelOptionsOnlyWhenSet) {
   rosnode::NodeParameters parameters;
   EXPECT_FALSE(rosnode::label_options(parameters).viewpoint.has_value());  // the frame's origin

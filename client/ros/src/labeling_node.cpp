@@ -20,11 +20,10 @@ LabelingNode::LabelingNode(ros::NodeHandle& node, const NodeParameters& paramete
   // Queue size 1: roscpp drops the oldest queued cloud when a newer one arrives.
   subscriber_ = node.subscribe(parameters.input_topic, 1, &LabelingNode::on_cloud, this,
                                ros::TransportHints().tcpNoDelay());
-  ROS_INFO("primlabel-ros: labeling %s -> %s (summary %s) through %s, model %s",
+  ROS_INFO("primlabel-ros: labeling %s -> %s (summary %s) through %s: %s",
            subscriber_.getTopic().c_str(), cloud_publisher_.getTopic().c_str(),
            summary_publisher_.getTopic().c_str(), parameters.server.c_str(),
-           parameters.model.empty() ? "(the one whose domain fits each cloud)"
-                                    : parameters.model.c_str());
+           settings_text(parameters).c_str());
 }
 
 void LabelingNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& cloud) {

@@ -129,4 +129,25 @@ client::LabelOptions label_options(const NodeParameters& p) {
   return options;
 }
 
+std::string settings_text(const NodeParameters& p) {
+  const auto flag = [](bool value) { return value ? "true" : "false"; };
+  std::ostringstream out;
+  out << "model " << (p.model.empty() ? "(the one whose domain fits each cloud)" : p.model);
+  if (!p.model_version.empty()) out << " version " << p.model_version;
+  out << ", tabletop_only " << flag(p.tabletop_only) << ", every_point " << flag(p.every_point)
+      << ", voxel_size ";
+  if (p.voxel_size > 0.0)
+    out << p.voxel_size << " m";
+  else
+    out << "the model's";
+  out << ", viewpoint ";
+  if (p.viewpoint)
+    out << (*p.viewpoint)[0] << "," << (*p.viewpoint)[1] << "," << (*p.viewpoint)[2];
+  else
+    out << "the frame's origin";
+  out << ", objects " << flag(p.objects) << ", primitives " << flag(p.primitives) << ", confidence "
+      << flag(p.confidence) << ", probabilities " << flag(p.probabilities);
+  return out.str();
+}
+
 }  // namespace primlabel::rosnode

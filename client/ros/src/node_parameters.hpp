@@ -60,4 +60,10 @@ client::ClientOptions client_options(const NodeParameters& parameters);
 // What every cloud is labeled with; probabilities are asked for when either output needs them.
 client::LabelOptions label_options(const NodeParameters& parameters);
 
+// The labeling settings for the start-up line, every one named with its value ("model
+// tabletop-kinect, tabletop_only false, every_point false, voxel_size the model's, ..."): a
+// parameter server keeps private parameters from the last run, so a stale ~tabletop_only must
+// show.
+std::string settings_text(const NodeParameters& parameters);
+
 }  // namespace primlabel::rosnode
