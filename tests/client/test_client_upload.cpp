@@ -335,6 +335,27 @@ TEST(Uploader, ARefusedScanMovesToFailedAndTheRestGoOn) {
   EXPECT_TRUE(fs::exists(dir.file("spool/failed/" + empty_id + ".pcd")));
 }
 
+// A model the server does not serve (a typo) fails the scan for good with the server's reason,
+// instead of retrying it forever and wedging the spool.
+TEST(Uploader, AModelTheServerDoesNotHaveFailsTheScanForGood) {
+  FakeServer server;
+  test::TempDir dir;
+  client::Client client(fast_client(server.address()));
+  client::upload::UploaderOptions options = uploader_options(dir);
+  options.label.model = "faek";
+  Uploader uploader(client, options);
+  uploader.start();
+  std::string id;
+  uploader.submit(scan_bytes(8), ".pcd", &id);
+  ASSERT_TRUE(wait_idle(uploader));
+  EXPECT_EQ(uploader.counters().failed, 1u);
+  EXPECT_EQ(uploader.counters().retries, 0u);
+  EXPECT_EQ(server.service.label_calls, 1);
+  EXPECT_TRUE(fs::exists(dir.file("spool/failed/" + id + ".pcd")));
+  EXPECT_NE(read_text(dir.file("spool/failed/" + id + ".error")).find("no model 'faek'"),
+            std::string::npos);
+}
+
 TEST(Uploader, ACorruptSpoolEntryIsNeverUploaded) {
   FakeServer server;
   test::TempDir dir;
@@ -521,6 +542,24 @@ TEST(UploadCli, AFullSpoolDiskRejectsWithExitFiveAndARestartDrainsBeforeTakingMo
   EXPECT_EQ(files_in(dir.file("out")), 8u) << r.output;
   EXPECT_EQ(server.service.label_calls, 8);
   EXPECT_EQ(files_in(disk.path("spool/scans")), 0u);
+}
+
+// The same through the tool: the run ends at once with exit 4 (scans moved to SPOOL/failed), the
+// refusal naming the file.
+TEST(UploadCli, AModelTypoExitsFourAtOnceNamingTheModel) {
+  FakeServer server;
+  test::TempDir dir;
+  write_bytes(dir.file("s.pcd"), scan_bytes(9));
+  const auto r = test::run_command("timeout 20 " + upload_tool() + " -q --model faek --server " +
+                                   server.address() + " --spool " + dir.file("spool") + " -o " +
+                                   dir.file("out") + " " + dir.file("s.pcd"));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("no model 'faek'"), std::string::npos) << r.output;
+  // Named by its file, not only by its hash.
+  EXPECT_NE(r.output.find("primlabel-upload: " + dir.file("s.pcd") + " (id "), std::string::npos)
+      << r.output;
+  EXPECT_EQ(files_in(dir.file("spool/scans")), 0u);
+  EXPECT_EQ(server.service.label_calls, 1);
 }
 
 // A file of the caller's that does not parse is an input error (1, as documented), named in one

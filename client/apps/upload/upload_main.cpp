@@ -41,7 +41,8 @@ constexpr const char* kFooter =
     "before new input is read. Exit codes (the highest that applies): 0 every scan labeled (or "
     "--watch stopped by a signal), 1 an input could not be read, 2 usage, 3 --timeout passed "
     "with scans still spooled, 4 scans were moved to SPOOL/failed (refused by the server for "
-    "good, or corrupt in the spool), 5 scans were not accepted: the spool was full, its disk "
+    "good, e.g. a --model it does not serve, or corrupt in the spool), 5 scans were not accepted: "
+    "the spool was full, its disk "
     "short of --spool-min-free-mb, or the write failed (one line on stderr names the file and "
     "the reason).";
 
@@ -75,7 +76,7 @@ struct Intake {
   // Submits one scan and acknowledges it on stdout; false when the spool could not take it.
   bool submit(std::string_view bytes, const std::string& ext, const std::string& source) {
     std::string id, reason;
-    const auto result = uploader.submit(bytes, ext, &id, &reason);
+    const auto result = uploader.submit(bytes, ext, &id, &reason, source);
     static const char* const kState[] = {"accepted", "queued", "labeled", "rejected", "rejected"};
     std::printf("%s %s %s\n", kState[static_cast<int>(result)], id.c_str(), source.c_str());
     std::fflush(stdout);

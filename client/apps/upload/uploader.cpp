@@ -14,12 +14,14 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-// Statuses that say "this scan will never be labeled": retrying cannot help. Everything else
-// (UNAVAILABLE, DEADLINE_EXCEEDED, RESOURCE_EXHAUSTED, a missing model while the server starts,
-// a bad token an operator will fix, ...) is retried with backoff.
+// Statuses that say "this scan will never be labeled": retrying cannot help. NOT_FOUND is a
+// model or version the server does not serve (a typo in --model): the server loads its
+// repository before it listens, so retrying would wedge the spool on it. Everything else
+// (UNAVAILABLE, DEADLINE_EXCEEDED, RESOURCE_EXHAUSTED, a bad token an operator will fix, ...) is
+// retried with backoff.
 bool permanent(grpc::StatusCode code) {
   return code == grpc::StatusCode::INVALID_ARGUMENT || code == grpc::StatusCode::OUT_OF_RANGE ||
-         code == grpc::StatusCode::UNIMPLEMENTED;
+         code == grpc::StatusCode::UNIMPLEMENTED || code == grpc::StatusCode::NOT_FOUND;
 }
 
 // Temp files of output writes a crash interrupted (core's atomic_write_file).
@@ -65,8 +67,15 @@ void Uploader::finish_from_output(const std::string& id) {
   ++counters_.already_labeled;
 }
 
+std::string Uploader::name_of(const std::string& id) const {
+  std::lock_guard lock(mutex_);
+  const auto source = sources_.find(id);
+  return source == sources_.end() ? "spooled scan " + id : source->second + " (id " + id + ")";
+}
+
 Uploader::Submitted Uploader::submit(std::string_view bytes, const std::string& ext,
-                                     std::string* id_out, std::string* reason) {
+                                     std::string* id_out, std::string* reason,
+                                     const std::string& source) {
   const std::string id = scan_id(bytes);
   if (id_out) *id_out = id;
   std::error_code ec;  // an unreadable output directory means "not labeled yet"
@@ -91,6 +100,8 @@ Uploader::Submitted Uploader::submit(std::string_view bytes, const std::string& 
     return Submitted::kWriteFailed;
   }
   std::lock_guard lock(mutex_);
+  // Named until it is labeled or failed (the first source, when the same bytes come twice).
+  if (!source.empty()) sources_.emplace(id, source);
   if (accepted == Spool::Accepted::kAlreadyQueued) {
     ++counters_.already_queued;
     return Submitted::kAlreadyQueued;
@@ -135,13 +146,14 @@ void Uploader::work() {
     try {
       done = upload(scan);
     } catch (const std::exception& e) {  // the output or spool disk failed: try again later
-      std::fprintf(stderr, "primlabel-upload: %s: %s\n", scan.id.c_str(), e.what());
+      std::fprintf(stderr, "primlabel-upload: %s: %s\n", name_of(scan.id).c_str(), e.what());
     }
     lock.lock();
     --in_flight_;
     if (done) {
       backoff_.reset();
       server_down_ = false;
+      sources_.erase(scan.id);  // labeled or failed: never named again
     } else {
       queue_.push_front(scan);
       ++counters_.retries;
@@ -161,8 +173,8 @@ bool Uploader::upload(const SpooledScan& scan) {
     cloud = read_cloud(scan.path.string());
   } catch (const std::exception& e) {
     spool_.fail(scan.id, e.what());
-    std::fprintf(stderr, "primlabel-upload: %s: unreadable scan moved to %s: %s\n", scan.id.c_str(),
-                 (spool_.dir() / "failed").c_str(), e.what());
+    std::fprintf(stderr, "primlabel-upload: %s: unreadable scan moved to %s: %s\n",
+                 name_of(scan.id).c_str(), (spool_.dir() / "failed").c_str(), e.what());
     std::lock_guard lock(mutex_);
     ++counters_.failed;
     return true;
@@ -192,8 +204,9 @@ bool Uploader::upload(const SpooledScan& scan) {
     }
     if (permanent(status.code)) {
       spool_.fail(scan.id, status.message);
-      std::fprintf(stderr, "primlabel-upload: %s: refused, moved to %s: %s\n", scan.id.c_str(),
-                   (spool_.dir() / "failed").c_str(), status.message.c_str());
+      std::fprintf(stderr, "primlabel-upload: %s: refused, moved to %s: %s\n",
+                   name_of(scan.id).c_str(), (spool_.dir() / "failed").c_str(),
+                   status.message.c_str());
       std::lock_guard lock(mutex_);
       ++counters_.failed;
       return true;
@@ -206,7 +219,7 @@ bool Uploader::upload(const SpooledScan& scan) {
                  std::chrono::duration_cast<std::chrono::seconds>(client_.options().deadline)
                      .count()) +
              " s; raise it for large scans)";
-    std::fprintf(stderr, "primlabel-upload: %s: %s%s; will retry\n", scan.id.c_str(),
+    std::fprintf(stderr, "primlabel-upload: %s: %s%s; will retry\n", name_of(scan.id).c_str(),
                  status.message.c_str(), hint.c_str());
     return false;
   }

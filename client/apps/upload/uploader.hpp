@@ -11,6 +11,7 @@
 #include <deque>
 #include <filesystem>
 #include <list>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -54,8 +55,9 @@ class Uploader {
   enum class Submitted { kAccepted, kAlreadyQueued, kAlreadyLabeled, kSpoolFull, kWriteFailed };
   // Takes one scan (its file bytes). Thread-safe. A scan the spool cannot take (full, or its
   // write failed) is not accepted and `reason` says why; nothing of it stays in the spool.
+  // `source` (a file name, "stdin#3") names the scan in later messages about it.
   Submitted submit(std::string_view bytes, const std::string& ext, std::string* id = nullptr,
-                   std::string* reason = nullptr);
+                   std::string* reason = nullptr, const std::string& source = {});
 
   void start();  // the worker threads
   // Blocks until every queued scan is uploaded or failed, `stop` becomes true, or `until` passes.
@@ -79,6 +81,8 @@ class Uploader {
   // Uploads one scan; returns false when it should be tried again later.
   bool upload(const SpooledScan& scan);
   void finish_from_output(const std::string& id);  // output exists: just leave the spool
+  // "scan.pcd (id 1f2e...)" for a scan submitted in this run, else "spooled scan 1f2e...".
+  std::string name_of(const std::string& id) const;
 
   Client& client_;
   UploaderOptions options_;
@@ -90,7 +94,8 @@ class Uploader {
   std::deque<SpooledScan> queue_;
   std::size_t in_flight_ = 0;
   UploadCounters counters_;
-  std::list<CallHandle> calls_;  // in flight, for stop()
+  std::list<CallHandle> calls_;                 // in flight, for stop()
+  std::map<std::string, std::string> sources_;  // id -> source, for scans submitted this run
   std::chrono::steady_clock::time_point paused_until_{};
   std::atomic<bool> server_down_{false};
   bool stopping_ = false;
