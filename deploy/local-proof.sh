@@ -366,9 +366,11 @@ done
 missing=()
 mismatched=()
 for scan in "$WORK"/scans/*.pcd; do
-  id=$(sha256sum "$scan" | cut -c1-32)  # the uploader's scan id: the content hash
-  out="$WORK/out/$id.pcd"
-  if [[ ! -f "$out" ]]; then
+  # Outputs are named after their scan file: <stem>.<key>.pcd, one per scan.
+  stem=$(basename "$scan" .pcd)
+  found=("$WORK/out/$stem".*.pcd)
+  out=${found[0]}
+  if [[ ${#found[@]} -ne 1 || ! -f "$out" ]]; then
     missing+=("$(basename "$scan")")
   elif [[ $(grep -a -m1 '^POINTS' "$scan") != $(grep -a -m1 '^POINTS' "$out") ]]; then
     mismatched+=("$(basename "$scan")")

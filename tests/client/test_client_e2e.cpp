@@ -18,6 +18,7 @@
 #include "random_label_model.hpp"
 #include "test_util.hpp"
 #include "upload/spool.hpp"
+#include "upload/uploader.hpp"
 
 namespace primlabel {
 namespace {
@@ -152,7 +153,7 @@ TEST_F(ClientE2e, StreamedInSmallChunksAndUnaryGiveTheSameLabels) {
 
 // The acceptance test: kill -9 the server while the uploader is mid-way, restart it on
 // the same port; later kill -9 the uploader itself and start it again. Every scan ends up
-// labeled exactly once, in <out>/<id>.pcd, and the spool is empty.
+// labeled exactly once, in <out>/<scan file stem>.<key>.pcd, and the spool is empty.
 TEST_F(ClientE2e, UploaderSurvivesServerAndUploaderKillsWithEveryScanLabeledOnce) {
   const std::string spool = file("up-spool"), out = file("up-out");
   std::vector<std::string> args{test::binary("primlabel-upload"),
@@ -169,9 +170,13 @@ TEST_F(ClientE2e, UploaderSurvivesServerAndUploaderKillsWithEveryScanLabeledOnce
                                 "--deadline",
                                 "60"};
   for (int i = 0; i < kScans; ++i) args.push_back(scan(i));
+  // Each output named after its scan file, keyed by its content and the (default) options.
+  const auto output_of = [&](int i) {
+    return client::upload::output_name(client::upload::scan_id(read_bytes(scan(i))), {},
+                                       std::filesystem::path(scan(i)).stem().string());
+  };
   std::set<std::string> expected;
-  for (int i = 0; i < kScans; ++i)
-    expected.insert(client::upload::scan_id(read_bytes(scan(i))) + ".pcd");
+  for (int i = 0; i < kScans; ++i) expected.insert(output_of(i));
 
   auto server = std::make_unique<ServerProcess>(models(), file("up-server1.log"));
   const int port = server->port();
@@ -202,8 +207,7 @@ TEST_F(ClientE2e, UploaderSurvivesServerAndUploaderKillsWithEveryScanLabeledOnce
   EXPECT_TRUE(file_names(spool + "/scans").empty());
   EXPECT_TRUE(file_names(spool + "/failed").empty());
   for (int i = 0; i < kScans; ++i) {
-    const PointCloud labeled =
-        read_cloud(out + "/" + client::upload::scan_id(read_bytes(scan(i))) + ".pcd");
+    const PointCloud labeled = read_cloud(out + "/" + output_of(i));
     EXPECT_EQ(labeled.labels.size(), read_cloud(scan(i)).size());
   }
   EXPECT_NE(first_log.find("will retry"), std::string::npos) << first_log;

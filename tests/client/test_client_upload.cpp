@@ -265,7 +265,7 @@ TEST(Uploader, LabelsEachScanOnceIntoItsOwnOutput) {
   EXPECT_EQ(uploader.submit(scan_bytes(1), ".pcd", &id), Uploader::Submitted::kAccepted);
   uploader.submit(scan_bytes(2), ".pcd");
   ASSERT_TRUE(wait_idle(uploader));
-  const PointCloud out = read_cloud(dir.file("out/" + id + ".pcd"));
+  const PointCloud out = read_cloud(uploader.output_path(id).string());
   ASSERT_EQ(out.labels.size(), 200u);
   for (std::size_t i = 0; i < 200; ++i) ASSERT_EQ(out.labels[i], (i + 1) % 4);
   EXPECT_EQ(files_in(dir.file("out")), 2u);
@@ -290,7 +290,7 @@ TEST(Uploader, RetriesWithBackoffWhileTheServerIsUnavailable) {
   ASSERT_TRUE(wait_idle(uploader));
   EXPECT_EQ(uploader.counters().retries, 4u);
   EXPECT_EQ(uploader.counters().uploaded, 1u);
-  EXPECT_TRUE(fs::exists(dir.file("out/" + id + ".pcd")));
+  EXPECT_TRUE(fs::exists(uploader.output_path(id)));
   EXPECT_NE(uploader.status_line().find("retries 4"), std::string::npos) << uploader.status_line();
 }
 
@@ -303,10 +303,12 @@ TEST(Uploader, StartupResumesTheSpoolAndSkipsScansAlreadyWritten) {
   const std::string todo_id = client::upload::scan_id(scan_bytes(5));
   {
     Spool spool(options.spool_dir, {});
-    spool.accept(done_id, scan_bytes(4), ".pcd");
-    spool.accept(todo_id, scan_bytes(5), ".pcd");
+    spool.accept(done_id, scan_bytes(4), ".pcd", nullptr, "scan_4");
+    spool.accept(todo_id, scan_bytes(5), ".pcd", nullptr, "scan_5");
     fs::create_directories(options.output_dir);
-    write_bytes((options.output_dir / (done_id + ".pcd")).string(), scan_bytes(4));
+    write_bytes((options.output_dir / client::upload::output_name(done_id, options.label, "scan_4"))
+                    .string(),
+                scan_bytes(4));
     write_bytes((options.output_dir / ("." + todo_id + ".pcd.tmp.1.0")).string(), "partial");
   }
   client::Client client(fast_client(server.address()));
@@ -318,6 +320,9 @@ TEST(Uploader, StartupResumesTheSpoolAndSkipsScansAlreadyWritten) {
   EXPECT_EQ(uploader.counters().already_labeled, 1u);
   EXPECT_EQ(files_in(options.output_dir), 2u);  // the crash's temp file is gone
   EXPECT_EQ(files_in(options.spool_dir / "scans"), 0u);
+  // The resumed scan's output is still named after its source file.
+  EXPECT_TRUE(fs::exists(options.output_dir /
+                         client::upload::output_name(todo_id, options.label, "scan_5")));
 }
 
 TEST(Uploader, ARefusedScanMovesToFailedAndTheRestGoOn) {
@@ -560,6 +565,42 @@ TEST(UploadCli, AModelTypoExitsFourAtOnceNamingTheModel) {
       << r.output;
   EXPECT_EQ(files_in(dir.file("spool/scans")), 0u);
   EXPECT_EQ(server.service.label_calls, 1);
+}
+
+// The output is named after its source, and its key covers the labeling options: the same scan
+// with another --model or --probabilities is labeled anew into its own output, never answered
+// with the old one; the same scan with the same options is not uploaded again.
+TEST(UploadCli, OutputsAreNamedAfterTheirSourceAndKeyedByTheOptions) {
+  FakeServer server;
+  test::TempDir dir;
+  write_bytes(dir.file("kitchen scan.pcd"), scan_bytes(40));
+  const std::string common = upload_tool() + " -q --server " + server.address() + " --spool " +
+                             dir.file("spool") + " -o " + dir.file("out") + " '" +
+                             dir.file("kitchen scan.pcd") + "'";
+  auto r = test::run_command(common);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("accepted "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" -> " + dir.file("out/kitchen_scan.")), std::string::npos) << r.output;
+  r = test::run_command(common);  // same scan, same options: its output exists
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("labeled "), std::string::npos) << r.output;
+  EXPECT_EQ(server.service.label_calls, 1);
+  r = test::run_command(common + " --probabilities");  // other options: labeled anew
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("accepted "), std::string::npos) << r.output;
+  EXPECT_EQ(server.service.label_calls, 2);
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir.file("out")))
+    names.push_back(entry.path().filename().string());
+  ASSERT_EQ(names.size(), 2u);
+  for (const std::string& name : names) EXPECT_EQ(name.rfind("kitchen_scan.", 0), 0u) << name;
+  for (const std::string& name : names) {
+    const PointCloud out = read_cloud(dir.file("out/" + name));
+    EXPECT_EQ(out.find_field("probability") != nullptr,
+              name == client::upload::output_name(client::upload::scan_id(scan_bytes(40)),
+                                                  {.probabilities = true}, "kitchen scan"))
+        << name;
+  }
 }
 
 // A file of the caller's that does not parse is an input error (1, as documented), named in one

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -75,6 +76,17 @@ std::string scan_id_of_file(const fs::path& path) {
 
 }  // namespace
 
+std::string safe_source_name(const std::string& stem) {
+  std::string out;
+  for (char c : stem) {
+    if (out.size() == 80) break;
+    const bool safe =
+        std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '_';
+    out.push_back(safe ? c : '_');
+  }
+  return out;
+}
+
 std::string scan_id(std::string_view bytes) {
   unsigned char digest[SHA256_DIGEST_LENGTH];
   SHA256(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size(), digest);
@@ -92,8 +104,9 @@ Spool::Spool(fs::path dir, SpoolLimits limits) : dir_(std::move(dir)), limits_(l
     fs::remove(entry.path(), ec);
     ++removed_temp_files_;
   }
-  // Files are "<sequence>_<id><ext>": the sequence keeps the acceptance order across restarts
-  // (modification times are too coarse to order scans accepted in the same millisecond).
+  // Files are "<sequence>_<id>[_<source name>]<ext>": the sequence keeps the acceptance order
+  // across restarts (modification times are too coarse to order scans accepted in the same
+  // millisecond); ids have no '_'.
   std::vector<std::pair<std::uint64_t, SpooledScan>> found;
   for (const auto& entry : fs::directory_iterator(dir_ / kScans)) {
     if (!entry.is_regular_file() || !is_scan_file(entry.path())) continue;
@@ -106,7 +119,11 @@ Spool::Spool(fs::path dir, SpoolLimits limits) : dir_(std::move(dir)), limits_(l
     } catch (const std::exception&) {
       continue;
     }
-    const std::string id = stem.substr(underscore + 1);
+    const std::string rest = stem.substr(underscore + 1);
+    const auto name_start = rest.find('_');
+    const std::string id = rest.substr(0, name_start);
+    const std::string source_name =
+        name_start == std::string::npos ? std::string() : rest.substr(name_start + 1);
     next_sequence_ = std::max(next_sequence_, sequence + 1);  // corrupt entries included
     // A bit flipped on disk would otherwise be labeled under the original scan's id.
     std::string reason;
@@ -127,7 +144,7 @@ Spool::Spool(fs::path dir, SpoolLimits limits) : dir_(std::move(dir)), limits_(l
       corrupt_.push_back(std::move(corrupt));
       continue;
     }
-    found.push_back({sequence, {id, entry.path(), entry.file_size()}});
+    found.push_back({sequence, {id, entry.path(), entry.file_size(), source_name}});
   }
   std::sort(found.begin(), found.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -143,7 +160,7 @@ std::vector<SpooledScan>::const_iterator Spool::find(const std::string& id) cons
 }
 
 Spool::Accepted Spool::accept(const std::string& id, std::string_view bytes, const std::string& ext,
-                              SpooledScan* stored) {
+                              SpooledScan* stored, const std::string& source_name) {
   std::lock_guard lock(mutex_);
   if (const auto it = find(id); it != scans_.end()) {
     if (stored) *stored = *it;
@@ -157,7 +174,8 @@ Spool::Accepted Spool::accept(const std::string& id, std::string_view bytes, con
   char sequence[24];
   std::snprintf(sequence, sizeof sequence, "%016llu_",
                 static_cast<unsigned long long>(next_sequence_));
-  const fs::path target = dir_ / kScans / (sequence + id + ext);
+  const std::string name = safe_source_name(source_name);
+  const fs::path target = dir_ / kScans / (sequence + id + (name.empty() ? "" : "_" + name) + ext);
   try {
     atomic_write_file(target, bytes, {.temp_dir = dir_ / kTemp});
   } catch (const std::exception& e) {
@@ -168,7 +186,7 @@ Spool::Accepted Spool::accept(const std::string& id, std::string_view bytes, con
     throw SpoolWriteFailed(std::string("cannot spool the scan: ") + e.what());
   }
   ++next_sequence_;
-  scans_.push_back({id, target, bytes.size()});
+  scans_.push_back({id, target, bytes.size(), name});
   if (stored) *stored = scans_.back();
   bytes_ += bytes.size();
   return Accepted::kNew;

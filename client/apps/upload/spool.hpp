@@ -1,5 +1,6 @@
 #pragma once
-// The uploader's durable spool: every accepted scan lives in <dir>/scans/<seq>_<id>.<ext> until its
+// The uploader's durable spool: every accepted scan lives in <dir>/scans/<seq>_<id>[_<name>].<ext>
+// (name: its source file's stem, so that its output is named after it after a restart) until its
 // labels are safely in the output directory. A scan is accepted only once its bytes are on disk:
 // written to <dir>/tmp/, fsynced, renamed into scans/ and the directory fsynced, so a crash or
 // power loss at any moment leaves either no trace of an unacknowledged scan (a leftover temp
@@ -63,7 +64,12 @@ struct SpooledScan {
   std::string id;
   std::filesystem::path path;
   std::uint64_t bytes = 0;
+  std::string source_name;  // the source file's stem, made safe (safe_source_name); may be empty
 };
+
+// A source file's stem as a spool and output file name part: letters, digits, '.', '-' and '_'
+// kept, anything else '_', at most 80 characters; "" for none.
+std::string safe_source_name(const std::string& stem);
 
 class Spool {
  public:
@@ -74,10 +80,11 @@ class Spool {
 
   enum class Accepted { kNew, kAlreadyQueued };
 
-  // Stores the scan durably under `id` with extension `ext` (".pcd" or ".ply") and tells where
-  // (`stored`). Throws SpoolFull when it does not fit, SpoolWriteFailed when the write fails.
+  // Stores the scan durably under `id` (no '_' in it) with extension `ext` (".pcd" or ".ply")
+  // and its source's name, and tells where (`stored`). Throws SpoolFull when it does not fit,
+  // SpoolWriteFailed when the write fails.
   Accepted accept(const std::string& id, std::string_view bytes, const std::string& ext,
-                  SpooledScan* stored = nullptr);
+                  SpooledScan* stored = nullptr, const std::string& source_name = {});
 
   // Scans waiting, oldest accepted first (as indexed at start, then in acceptance order).
   std::vector<SpooledScan> pending() const;

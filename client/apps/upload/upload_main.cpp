@@ -35,9 +35,11 @@ constexpr int kExitRefused = 4;
 constexpr int kExitNotAccepted = 5;  // full spool, full disk or a failed spool write
 
 constexpr const char* kFooter =
-    "Each accepted scan is acknowledged on stdout as '<state> <id> <source>' (state: accepted, "
-    "queued = already in the spool, labeled = output exists, rejected = the spool could not take "
-    "it) and labeled into OUT/<id>.pcd, id = content hash. Scans already spooled are uploaded "
+    "Each scan is acknowledged on stdout as '<state> <id> <source> -> <output>' (state: "
+    "accepted, queued = already in the spool, labeled = its output exists, rejected = the spool "
+    "could not take it; id = content hash) and labeled into OUT/<file stem>.<key>.pcd, the key "
+    "covering the content and the labeling options (--model, --probabilities, ...): the same "
+    "scan with other options is labeled anew. Scans already spooled are uploaded "
     "before new input is read. Exit codes (the highest that applies): 0 every scan labeled (or "
     "--watch stopped by a signal), 1 an input could not be read, 2 usage, 3 --timeout passed "
     "with scans still spooled, 4 scans were moved to SPOOL/failed (refused by the server for "
@@ -74,11 +76,15 @@ struct Intake {
   void raise(int code) { exit_code = std::max(exit_code, code); }
 
   // Submits one scan and acknowledges it on stdout; false when the spool could not take it.
-  bool submit(std::string_view bytes, const std::string& ext, const std::string& source) {
+  bool submit(std::string_view bytes, const std::string& ext, const std::string& source,
+              const std::string& source_name = {}) {
     std::string id, reason;
-    const auto result = uploader.submit(bytes, ext, &id, &reason, source);
+    const auto result = uploader.submit(bytes, ext, &id, &reason, source, source_name);
     static const char* const kState[] = {"accepted", "queued", "labeled", "rejected", "rejected"};
-    std::printf("%s %s %s\n", kState[static_cast<int>(result)], id.c_str(), source.c_str());
+    const bool taken =
+        result != Uploader::Submitted::kSpoolFull && result != Uploader::Submitted::kWriteFailed;
+    std::printf("%s %s %s%s\n", kState[static_cast<int>(result)], id.c_str(), source.c_str(),
+                taken ? (" -> " + uploader.output_path(id, source_name).string()).c_str() : "");
     std::fflush(stdout);
     if (result == Uploader::Submitted::kSpoolFull || result == Uploader::Submitted::kWriteFailed) {
       std::fprintf(stderr, "primlabel-upload: %s: %s\n", source.c_str(), reason.c_str());
@@ -114,7 +120,7 @@ struct Intake {
       raise(kExitInput);
       return true;
     }
-    if (!submit(bytes, ext, path.string())) return false;
+    if (!submit(bytes, ext, path.string(), path.stem().string())) return false;
     if (remove_source) {
       std::error_code ec;
       fs::remove(path, ec);

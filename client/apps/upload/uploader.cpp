@@ -35,6 +35,24 @@ void remove_output_temp_files(const fs::path& dir) {
 
 }  // namespace
 
+std::string options_fingerprint(const LabelOptions& o) {
+  std::string line = "model=" + o.model + ";version=" + o.model_version;
+  line += ";descriptors=" + std::to_string(int(o.descriptors));
+  line += ";probabilities=" + std::to_string(int(o.probabilities));
+  line += ";tabletop=" + std::to_string(int(o.tabletop_only));
+  line += ";every_point=" + std::to_string(int(o.every_point));
+  char voxel[32];
+  std::snprintf(voxel, sizeof voxel, ";voxel=%.9g", double(o.voxel_size));
+  return line + voxel;
+}
+
+std::string output_name(const std::string& content_id, const LabelOptions& options,
+                        const std::string& source_name) {
+  const std::string key = scan_id(content_id + "\n" + options_fingerprint(options));
+  const std::string name = safe_source_name(source_name);
+  return name.empty() ? key + ".pcd" : name + "." + key.substr(0, 12) + ".pcd";
+}
+
 Uploader::Uploader(Client& client, UploaderOptions options)
     : client_(client),
       options_(std::move(options)),
@@ -47,7 +65,7 @@ Uploader::Uploader(Client& client, UploaderOptions options)
     throw std::runtime_error(options_.output_dir.string() + ": cannot create: " + ec.message());
   remove_output_temp_files(options_.output_dir);
   for (const SpooledScan& scan : spool_.pending()) {
-    if (fs::exists(output_path(scan.id))) {
+    if (fs::exists(output_path(scan.id, scan.source_name))) {
       finish_from_output(scan.id);  // crashed after writing the output, before forgetting it
     } else {
       queue_.push_back(scan);
@@ -57,8 +75,8 @@ Uploader::Uploader(Client& client, UploaderOptions options)
 
 Uploader::~Uploader() { stop(); }
 
-fs::path Uploader::output_path(const std::string& id) const {
-  return options_.output_dir / (id + ".pcd");
+fs::path Uploader::output_path(const std::string& id, const std::string& source_name) const {
+  return options_.output_dir / output_name(id, options_.label, source_name);
 }
 
 void Uploader::finish_from_output(const std::string& id) {
@@ -75,11 +93,11 @@ std::string Uploader::name_of(const std::string& id) const {
 
 Uploader::Submitted Uploader::submit(std::string_view bytes, const std::string& ext,
                                      std::string* id_out, std::string* reason,
-                                     const std::string& source) {
+                                     const std::string& source, const std::string& source_name) {
   const std::string id = scan_id(bytes);
   if (id_out) *id_out = id;
   std::error_code ec;  // an unreadable output directory means "not labeled yet"
-  if (fs::exists(output_path(id), ec)) {
+  if (fs::exists(output_path(id, source_name), ec)) {
     std::lock_guard lock(mutex_);
     ++counters_.already_labeled;
     return Submitted::kAlreadyLabeled;
@@ -87,7 +105,7 @@ Uploader::Submitted Uploader::submit(std::string_view bytes, const std::string& 
   Spool::Accepted accepted;
   SpooledScan stored;
   try {
-    accepted = spool_.accept(id, bytes, ext, &stored);
+    accepted = spool_.accept(id, bytes, ext, &stored, source_name);
   } catch (const SpoolFull& e) {
     if (reason) *reason = e.what();
     std::lock_guard lock(mutex_);
@@ -164,7 +182,8 @@ void Uploader::work() {
 }
 
 bool Uploader::upload(const SpooledScan& scan) {
-  if (fs::exists(output_path(scan.id))) {
+  const fs::path output = output_path(scan.id, scan.source_name);
+  if (fs::exists(output)) {
     finish_from_output(scan.id);
     return true;
   }
@@ -224,7 +243,7 @@ bool Uploader::upload(const SpooledScan& scan) {
     return false;
   }
   const std::size_t points = result.size();
-  write_tagged_cloud(output_path(scan.id).string(), tools::labeled_cloud(std::move(cloud), result),
+  write_tagged_cloud(output.string(), tools::labeled_cloud(std::move(cloud), result),
                      tools::labeled_cloud_tags(result));
   // write_pcd returns once the file and its directory entry are durable (atomic_write_file), so
   // the spool may forget the scan now.

@@ -1,9 +1,11 @@
 #pragma once
 // The uploader's engine: takes scans into the spool, uploads them on worker threads, writes each
-// scan's labels to <output>/<id>.pcd (atomic rename, then fsync) and only then removes it from
-// the spool. While the server is away (UNAVAILABLE, deadline, overload, ...) the workers pause
-// with exponential backoff and resume when it answers again; nothing accepted is ever dropped.
-// A scan whose output already exists is never uploaded again (exactly one output per scan id).
+// scan's labels to <output>/<source name>.<key>.pcd (atomic rename, then fsync; output_name) and
+// only then removes it from the spool. While the server is away (UNAVAILABLE, deadline,
+// overload, ...) the workers pause with exponential backoff and resume when it answers again;
+// nothing accepted is ever dropped. The key covers the scan's content and the labeling options
+// (model, version, descriptors, ...), so a scan whose output for these options exists is never
+// uploaded again, and the same scan with other options is labeled anew.
 
 #include <atomic>
 #include <chrono>
@@ -45,6 +47,15 @@ struct UploadCounters {
   std::uint64_t points = 0;           // points labeled
 };
 
+// The labeling options that change an output, as one canonical line ("model=...;version=...;
+// descriptors=0;..."): part of every output's key.
+std::string options_fingerprint(const LabelOptions& options);
+
+// "<source name>.<first 12 hex of the key>.pcd", or "<key>.pcd" without a name; the key is the
+// SHA-256 of the content id and the options' fingerprint.
+std::string output_name(const std::string& content_id, const LabelOptions& options,
+                        const std::string& source_name);
+
 class Uploader {
  public:
   // Opens the spool (recovering from a crash, setting corrupt entries aside) and queues what it
@@ -55,9 +66,11 @@ class Uploader {
   enum class Submitted { kAccepted, kAlreadyQueued, kAlreadyLabeled, kSpoolFull, kWriteFailed };
   // Takes one scan (its file bytes). Thread-safe. A scan the spool cannot take (full, or its
   // write failed) is not accepted and `reason` says why; nothing of it stays in the spool.
-  // `source` (a file name, "stdin#3") names the scan in later messages about it.
+  // `source` (a file name, "stdin#3") names the scan in later messages about it, and a file's
+  // stem names its output (source_name; empty: the output is named by its key alone).
   Submitted submit(std::string_view bytes, const std::string& ext, std::string* id = nullptr,
-                   std::string* reason = nullptr, const std::string& source = {});
+                   std::string* reason = nullptr, const std::string& source = {},
+                   const std::string& source_name = {});
 
   void start();  // the worker threads
   // Blocks until every queued scan is uploaded or failed, `stop` becomes true, or `until` passes.
@@ -74,7 +87,9 @@ class Uploader {
   // "queued 3, in flight 1, uploaded 10, failed 0, rejected 0, retries 2, spool 1.2/1024.0 MB,
   // server up"
   std::string status_line() const;
-  std::filesystem::path output_path(const std::string& id) const;
+  // Where the labels of the scan with content id `id` from a source named `source_name` go.
+  std::filesystem::path output_path(const std::string& id,
+                                    const std::string& source_name = {}) const;
 
  private:
   void work();
