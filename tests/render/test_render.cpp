@@ -41,6 +41,42 @@ TEST(Render, WritesAPngOfTheRequestedSizeWithPointsAndLegend) {
   EXPECT_GT(png.count(0x202020, 0, 0, 100, 30), 20u);
 }
 
+// crop_to_points: a wide scene leaves no empty band; the height never drops below the legend's.
+TEST(Render, CropToPointsFitsTheHeightToTheScene) {
+  test::TempDir dir;
+  PointCloud strip;  // 1.0 x 0.2 m seen from the top (the sensor at the origin): an aspect of 5
+  for (float x = -0.5f; x <= 0.5f; x += 0.01f)
+    for (float y = 0; y <= 0.2f; y += 0.01f) strip.xyz.emplace_back(x, y, 0.0f);
+  strip.width = std::uint32_t(strip.size());
+  const std::vector<std::uint32_t> colors(strip.size(), 0xFF0000);
+  RenderOptions options;
+  options.width = 640;
+  options.height = 480;
+  options.view = RenderView::kTop;
+  options.crop_to_points = true;
+  render_png(strip, colors, options, dir.file("strip.png"));
+  const Decoded cropped = decode_png(dir.file("strip.png"));
+  EXPECT_EQ(cropped.width, 640);
+  EXPECT_LT(cropped.height, 200);  // ~628 / 5 plus margins, not 480
+  EXPECT_GT(cropped.count(0xFF0000, 0, 0, 640, cropped.height) +
+                cropped.count_mostly(16, 0, 0, 640, cropped.height),
+            10000u);
+  options.legend.assign(12, {"a class 10.0%", 0x00FF00});  // 12 rows need more than the strip
+  render_png(strip, colors, options, dir.file("legend.png"));
+  EXPECT_GT(decode_png(dir.file("legend.png")).height, 12 * 20);
+}
+
+// A camera's organised frame is seen from the sensor (upright: its y points down); an
+// unorganised scan obliquely.
+TEST(Render, OrganisedFramesAreSeenFromTheSensor) {
+  PointCloud frame;
+  frame.xyz.assign(12, Vec3f(0, 0, 1));
+  frame.width = 4, frame.height = 3;
+  EXPECT_EQ(natural_view(frame), RenderView::kSensor);
+  frame.width = 12, frame.height = 1;
+  EXPECT_EQ(natural_view(frame), RenderView::kOblique);
+}
+
 TEST(Render, ViewsDifferAndNearPointsHideFarOnes) {
   test::TempDir dir;
   // Two squares, red above blue: from the top only red is seen.
@@ -213,6 +249,16 @@ TEST(Colorize, ClassesSegmentsAndValues) {
   EXPECT_EQ(classes.legend[0].name, "plane 50.0%");
   EXPECT_EQ(classes.legend[1].name, "corner 25.0%");
   EXPECT_EQ(classes.legend[2].name, "label 42 25.0%");
+
+  // Shares are of every point: one without a position (a NaN pixel) has an entry of its own, so
+  // the legend agrees with the labels' own counts.
+  PointCloud with_nan = cloud;
+  with_nan.xyz.push_back(Vec3f::Constant(NAN));
+  with_nan.labels.push_back(0);
+  const Coloring counted = color_by_class(with_nan, ClassMap::taxonomy());
+  ASSERT_EQ(counted.legend.size(), 4u);
+  EXPECT_EQ(counted.legend[0].name, "plane 40.0%");
+  EXPECT_EQ(counted.legend[3].name, "no point (NaN) 20.0%");
 
   const Coloring segments = color_by_segment(cloud);
   EXPECT_EQ(segments.rgb[0], segments.rgb[1]);

@@ -57,6 +57,8 @@ void write_label_png(const PointCloud& cloud, const std::string& path, const std
   RenderOptions options;
   options.title = title;
   options.legend = coloring.legend;
+  options.view = natural_view(cloud);  // a camera frame as the camera saw it, upright
+  options.crop_to_points = true;
   render_png(cloud, coloring.rgb, options, path);
 }
 

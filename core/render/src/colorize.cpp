@@ -11,6 +11,7 @@ namespace primlabel {
 namespace {
 
 constexpr std::uint32_t kUnmappedColor = 0x505050;
+constexpr std::uint32_t kBackgroundSwatch = 0xFFFFFF;  // points without a position: not drawn
 
 std::string percent(std::size_t n, std::size_t total) {
   char text[32];
@@ -33,13 +34,18 @@ Coloring color_by_class(const PointCloud& cloud, const ClassMap& map) {
   if (!cloud.has_labels()) throw std::invalid_argument("the cloud has no 'label' field");
   Coloring out;
   out.rgb.resize(cloud.size(), kUnmappedColor);
-  std::map<std::uint32_t, std::size_t> counts;  // by label
-  std::size_t valid = 0;
+  // Shares of every point, so they agree with the labels' own counts (the CLI's line): the
+  // points without a position (NaN pixels of a frame) get an entry of their own.
+  std::map<std::uint32_t, std::size_t> counts;  // by label, points with a position
+  std::size_t no_position = 0;
+  const std::size_t total = cloud.size();
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const auto cls = map.class_of(cloud.labels[i]);
     if (cls) out.rgb[i] = color(*cls);
-    if (!is_finite(cloud.xyz[i])) continue;
-    ++valid;
+    if (!is_finite(cloud.xyz[i])) {
+      ++no_position;
+      continue;
+    }
     ++counts[cloud.labels[i]];
   }
   // Legend in taxonomy order (several labels may share a class).
@@ -53,10 +59,12 @@ Coloring color_by_class(const PointCloud& cloud, const ClassMap& map) {
   }
   for (const auto& [id, n] : by_class) {
     const PrimitiveClass cls = *class_from_id(id);
-    out.legend.push_back({std::string(name(cls)) + percent(n, valid), color(cls)});
+    out.legend.push_back({std::string(name(cls)) + percent(n, total), color(cls)});
   }
   for (const auto& [label, n] : unmapped)
-    out.legend.push_back({"label " + std::to_string(label) + percent(n, valid), kUnmappedColor});
+    out.legend.push_back({"label " + std::to_string(label) + percent(n, total), kUnmappedColor});
+  if (no_position > 0)
+    out.legend.push_back({"no point (NaN)" + percent(no_position, total), kBackgroundSwatch});
   return out;
 }
 

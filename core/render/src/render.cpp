@@ -121,6 +121,10 @@ void draw_overlays(Raster& image, const Camera& camera, const std::vector<Overla
 
 }  // namespace
 
+RenderView natural_view(const PointCloud& cloud) {
+  return cloud.organized() ? RenderView::kSensor : RenderView::kOblique;
+}
+
 void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point_rgb,
                 const RenderOptions& options, const std::string& path) {
   if (point_rgb.size() != cloud.size())
@@ -129,8 +133,6 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
   if (options.width < 64 || options.height < 64 || options.width > 16384 || options.height > 16384)
     throw std::invalid_argument("render: image size must be 64..16384 pixels a side");
 
-  Raster image(options.width, options.height, options.background);
-  std::vector<std::uint32_t>& pixels = image.pixels();
   const int text_scale = options.width >= 600 ? 2 : 1;
   const int line_height = Raster::text_height(text_scale) + 4 * text_scale;
   const int margin = 6 * text_scale;
@@ -142,8 +144,9 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
     legend_width = std::max(legend_width, Raster::text_width(entry.name, text_scale));
   if (!options.legend.empty()) legend_width += 3 * margin + line_height;
   const int plot_x = legend_width + margin, plot_y = title_height + margin;
-  const int plot_w = options.width - plot_x - margin, plot_h = options.height - plot_y - margin;
-  if (plot_w < 16 || plot_h < 16)
+  const int plot_w = options.width - plot_x - margin;
+  int height = options.height;
+  if (plot_w < 16 || height - plot_y - margin < 16)
     throw std::invalid_argument("render: image too small for the title and legend");
 
   // Project every finite point.
@@ -163,6 +166,17 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
     min_y = std::min(min_y, p.y), max_y = std::max(max_y, p.y);
     projected.push_back(p);
   }
+
+  if (options.crop_to_points && !projected.empty()) {
+    const float span_x = std::max(max_x - min_x, 1e-6f), span_y = std::max(max_y - min_y, 1e-6f);
+    const int legend_height =
+        options.legend.empty() ? 0 : int(options.legend.size()) * line_height + 2 * margin;
+    const int needed = plot_y + int(std::ceil(float(plot_w) * span_y / span_x / 0.98f)) + margin;
+    height = std::clamp(std::max(needed, title_height + legend_height + margin), 64, height);
+  }
+  const int plot_h = height - plot_y - margin;
+  Raster image(options.width, height, options.background);
+  std::vector<std::uint32_t>& pixels = image.pixels();
 
   if (!projected.empty()) {
     const float span_x = std::max(max_x - min_x, 1e-6f), span_y = std::max(max_y - min_y, 1e-6f);
@@ -228,7 +242,7 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
   if (!options.title.empty()) image.text(margin, margin, options.title, 0x202020, text_scale);
   if (!options.legend.empty()) {
     const int rows = static_cast<int>(options.legend.size());
-    int y = options.height - margin - rows * line_height;
+    int y = height - margin - rows * line_height;
     image.fill(margin / 2, y - margin / 2, legend_width, rows * line_height + margin, 0xF4F4F4);
     for (const LegendEntry& entry : options.legend) {
       const int swatch = line_height - 3 * text_scale;

@@ -41,7 +41,14 @@ struct RenderOptions {
   // Drawn over the points in the same projection; the picture is framed by the points only, so
   // an overlay beyond them is clipped at the image's edge.
   std::vector<Overlay> overlays;
+  // The picture's height shrinks to what the points need at `width` (never below what the title
+  // and legend need, never above `height`): no empty band above or below a wide scene.
+  bool crop_to_points = false;
 };
+
+// The view a labeled cloud is best seen from: the sensor's for an organised cloud (a camera's
+// frame: its own y points down, so a fixed "up" would show it upside down), else oblique.
+RenderView natural_view(const PointCloud& cloud);
 
 // Renders the finite points of `cloud` with colours `point_rgb` (0xRRGGBB, one per point) to a
 // PNG at `path`, nearer points drawn over farther ones. Throws std::runtime_error naming the path
