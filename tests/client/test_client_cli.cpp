@@ -92,8 +92,12 @@ TEST(ClientCli, LabelWritesLabelsDescriptorsProbabilitiesAndPng) {
   EXPECT_EQ(out.find_field("fpfh"), nullptr);
   ASSERT_NE(out.find_field("fpfh_paper"), nullptr);
   EXPECT_EQ(out.find_field("fpfh_paper")->count, 33);
-  ASSERT_NE(out.find_field("probability"), nullptr);
-  EXPECT_EQ(out.find_field("probability")->count, 3);
+  // One scalar field per class, named by the class (the fake names them class-0 .. class-2).
+  EXPECT_EQ(out.find_field("probability"), nullptr);
+  for (const char* name : {"prob_class_0", "prob_class_1", "prob_class_2"}) {
+    ASSERT_NE(out.find_field(name), nullptr) << name;
+    EXPECT_EQ(out.find_field(name)->count, 1) << name;
+  }
   EXPECT_TRUE(std::filesystem::exists(dir.file("out.png")));
   EXPECT_NE(r.output.find("300 points"), std::string::npos) << r.output;
 }

@@ -118,8 +118,10 @@ TEST_F(ClientE2e, CliHealthModelsInfoAndLabel) {
   ASSERT_EQ(out.labels.size(), in.size());
   for (auto l : out.labels) ASSERT_TRUE(l == 0 || l == 1 || l == 2 || l == 4 || l == 5 || l == 6);
   ASSERT_NE(out.find_field("fpfh"), nullptr);
-  ASSERT_NE(out.find_field("probability"), nullptr);
-  EXPECT_EQ(out.find_field("probability")->count, 5);
+  std::size_t prob_fields = 0;
+  for (const FloatField& f : out.fields) prob_fields += f.name.rfind("prob_", 0) == 0;
+  EXPECT_EQ(prob_fields, 5u);  // one per class of the model
+  EXPECT_NE(out.find_field("prob_plane"), nullptr);
   EXPECT_TRUE(fs::exists(file("cli-out.png")));
   r = test::run_command(cli + " label --model nope " + scan(0));
   EXPECT_EQ(r.exit_code, 4) << r.output;

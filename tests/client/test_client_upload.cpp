@@ -596,7 +596,7 @@ TEST(UploadCli, OutputsAreNamedAfterTheirSourceAndKeyedByTheOptions) {
   for (const std::string& name : names) EXPECT_EQ(name.rfind("kitchen_scan.", 0), 0u) << name;
   for (const std::string& name : names) {
     const PointCloud out = read_cloud(dir.file("out/" + name));
-    EXPECT_EQ(out.find_field("probability") != nullptr,
+    EXPECT_EQ(out.find_field("prob_class_0") != nullptr,
               name == client::upload::output_name(client::upload::scan_id(scan_bytes(40)),
                                                   {.probabilities = true}, "kitchen scan"))
         << name;

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <map>
 
+#include "class_fields.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/render/colorize.hpp"
 #include "primlabel/render/render.hpp"
@@ -45,9 +46,17 @@ PointCloud labeled_cloud(PointCloud cloud, const LabelResult& result) {
   cloud.labels = result.labels;
   if (result.descriptor_dim > 0)
     cloud.set_field(descriptor_field(result), result.descriptor_dim).values = result.descriptors;
+  // One scalar field per class, named by the class (as the ROS node names them): every reader
+  // (Open3D takes a COUNT > 1 field as one column, PLY has no COUNT) sees which is which.
   if (!result.probabilities.empty() && !result.labels.empty()) {
-    const int classes = static_cast<int>(result.probabilities.size() / result.labels.size());
-    cloud.set_field("probability", classes).values = result.probabilities;
+    const std::size_t n = result.labels.size();
+    const std::size_t classes = result.probabilities.size() / n;
+    for (std::size_t k = 0; k < classes; ++k) {
+      const std::uint32_t id = k < result.class_ids.size() ? result.class_ids[k] : std::uint32_t(k);
+      const std::string name = k < result.class_names.size() ? result.class_names[k] : "";
+      FloatField& field = cloud.set_field(probability_field_name(name, id), 1);
+      for (std::size_t i = 0; i < n; ++i) field.values[i] = result.probabilities[i * classes + k];
+    }
   }
   return cloud;
 }

@@ -11,7 +11,7 @@
 from . import pcd
 from ._version import __version__
 from .backoff import Backoff, BackoffPolicy
-from .client import ClassInfo, Client, HealthStatus, Result, Tls
+from .client import ClassInfo, Client, HealthStatus, Result, Tls, probability_field_name
 from .errors import DomainWarning, InvalidInput, PrimlabelError
 from .wire import NO_OBJECT, NO_SEGMENT
 
@@ -30,4 +30,5 @@ __all__ = [
     "Tls",
     "__version__",
     "pcd",
+    "probability_field_name",
 ]

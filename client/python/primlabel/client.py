@@ -60,6 +60,14 @@ class ClassInfo:
     name: str
 
 
+def probability_field_name(name: str, class_id: int) -> str:
+    """The per-class field name every primlabel output uses (PCD, PLY, the ROS node):
+    "prob_<class>" with characters outside [A-Za-z0-9_] as "_", "prob_<id>" without a name."""
+    if not name:
+        return f"prob_{class_id}"
+    return "prob_" + "".join(c if (c.isascii() and c.isalnum()) or c == "_" else "_" for c in name)
+
+
 @dataclass
 class Result:
     """The labels of one cloud, in the order of its points."""
@@ -95,6 +103,15 @@ class Result:
     @property
     def class_ids(self) -> np.ndarray:
         return np.array([c.id for c in self.classes], dtype=np.uint32)
+
+    def probability_fields(self) -> dict[str, np.ndarray]:
+        """The probabilities as one (N,) column per class, named as every primlabel output names
+        them ("prob_plane", ...): `cloud.fields.update(result.probability_fields())`. Empty
+        without probabilities."""
+        if self.probabilities is None:
+            return {}
+        return {probability_field_name(c.name, c.id): np.ascontiguousarray(self.probabilities[:, k])
+                for k, c in enumerate(self.classes)}
 
     @property
     def model_choice(self) -> str:

@@ -98,7 +98,8 @@ def test_probability_rows_sum_to_one_in_the_order_of_classes(client, cloud, cli_
     # the classes in the summary's order.
     np.testing.assert_array_equal(result.class_ids[rows.argmax(axis=1)],
                                   result.labels[described])
-    np.testing.assert_allclose(result.probabilities, cli_every_point.fields["probability"], atol=0)
+    for name, column in result.probability_fields().items():  # the CLI's file names them alike
+        np.testing.assert_allclose(column, cli_every_point.fields[name], atol=0)
     assert result.descriptors.shape == (len(cloud), result.summary.descriptor_dim)
     assert result.summary.descriptor_dim == 33
     # Points without a descriptor are the ones labeled unknown.
@@ -108,7 +109,8 @@ def test_probability_rows_sum_to_one_in_the_order_of_classes(client, cloud, cli_
 def test_unary_call_gives_the_streamed_answer(client, cloud, cli_labels):
     result = client.label_unary(cloud, probabilities=True, scan_id="one-message")
     np.testing.assert_array_equal(result.labels, cli_labels.label)
-    np.testing.assert_allclose(result.probabilities, cli_labels.fields["probability"], atol=0)
+    for name, column in result.probability_fields().items():
+        np.testing.assert_allclose(column, cli_labels.fields[name], atol=0)
     assert result.summary.scan_id == "one-message" and result.summary.points_received == len(cloud)
     with pytest.raises(primlabel.InvalidInput):
         client.label_unary(cloud, chunk_points=100)

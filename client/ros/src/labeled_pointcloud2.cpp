@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "byte_order.hpp"
+#include "common/class_fields.hpp"
 #include "pointcloud2_xyz.hpp"
 
 namespace primlabel::rosnode {
@@ -53,11 +54,7 @@ float highest(const float* probabilities, std::size_t classes) {
 }  // namespace
 
 std::string probability_field_name(const std::string& class_name, std::uint32_t class_id) {
-  if (class_name.empty()) return "prob_" + std::to_string(class_id);
-  std::string name = "prob_" + class_name;
-  for (char& c : name)
-    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) c = '_';
-  return name;
+  return client::tools::probability_field_name(class_name, class_id);
 }
 
 std_msgs::Header echoed_header(const std_msgs::Header& input, const v1::LabelSummary& summary) {
