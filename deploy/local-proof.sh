@@ -376,14 +376,16 @@ for scan in "$WORK"/scans/*.pcd; do
     mismatched+=("$(basename "$scan")")
   fi
 done
-outputs=$(find "$WORK/out" -mindepth 1 | wc -l)
+# Every labeled cloud has its .classes.json beside it; anything else in out/ is an extra output.
+outputs=$(find "$WORK/out" -mindepth 1 ! -name '*.classes.json' | wc -l)
+sidecars=$(find "$WORK/out" -mindepth 1 -name '*.classes.json' | wc -l)
 spooled=$(find "$WORK/spool" -type f 2>/dev/null | wc -l)
 retries=$(grep -o 'retries [0-9]*' "$WORK/upload.log" | tail -1 | cut -d' ' -f2)
 # Calls nginx could not complete (the killed replica's in-flight call: 502, which gRPC clients
 # read as UNAVAILABLE and retry).
 failed_calls=$(grep -c '" 50[0-9] ' "$WORK/nginx/access.log" || true)
-detail="exit $upload_status, $outputs outputs for $UPLOAD_SCANS scans, ${#missing[@]} missing, ${#mismatched[@]} with other point counts, $spooled files left in the spool; replica $VICTIM killed while $kill_state with $done_at_kill scans done; nginx failed $failed_calls call(s), retried by the client (uploader backoff retries: ${retries:-?})"
-if [[ $upload_status == 0 && ${#missing[@]} -eq 0 && ${#mismatched[@]} -eq 0 && $outputs -eq $UPLOAD_SCANS &&
+detail="exit $upload_status, $outputs outputs ($sidecars classes.json) for $UPLOAD_SCANS scans, ${#missing[@]} missing, ${#mismatched[@]} with other point counts, $spooled files left in the spool; replica $VICTIM killed while $kill_state with $done_at_kill scans done; nginx failed $failed_calls call(s), retried by the client (uploader backoff retries: ${retries:-?})"
+if [[ $upload_status == 0 && ${#missing[@]} -eq 0 && ${#mismatched[@]} -eq 0 && $outputs -eq $UPLOAD_SCANS && $sidecars -eq $UPLOAD_SCANS &&
       $spooled -eq 0 && $kill_state == busy && $done_at_kill -lt $UPLOAD_SCANS ]]; then
   record PASS "(c) no scan lost when a replica dies mid-upload: $detail"
 else

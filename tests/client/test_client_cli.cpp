@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "common/human_format.hpp"
@@ -282,6 +284,50 @@ TEST(ClientCli, LabeledFilesDescribeThemselvesInTheirHeader) {
     const std::string& columns = tags.at("probability_columns");
     EXPECT_EQ(std::count(columns.begin(), columns.end(), ':'), 3) << columns;
     EXPECT_EQ(read_cloud(dir.file(name)).labels.size(), 300u);
+  }
+}
+
+// Readers that drop header comments (PCL, Open3D) get the same facts from out.classes.json.
+TEST(ClientCli, LabeledFilesHaveTheirClassesInAJsonFileBeside) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  for (const char* name : {"out.pcd", "out.ply"}) {
+    std::filesystem::remove(dir.file("out.classes.json"));
+    const auto r = test::run_command(cli() + " -q --server " + server.address() + " label " +
+                                     dir.file("scan.pcd") + " -o " + dir.file(name) +
+                                     " --descriptors --probabilities");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream in(dir.file("out.classes.json"));
+    ASSERT_TRUE(in.good()) << name;
+    const nlohmann::json meta = nlohmann::json::parse(in);
+    EXPECT_EQ(meta.at("model"), "fake");
+    EXPECT_EQ(meta.at("label_field"), "label");
+    // Every class of the taxonomy, id 0 included, as the label field holds them.
+    const auto& classes = meta.at("classes");
+    ASSERT_EQ(classes.size(), ClassMap::taxonomy().entries().size());
+    for (std::size_t k = 0; k < classes.size(); ++k) {
+      EXPECT_EQ(classes[k].at("id"), ClassMap::taxonomy().entries()[k].id);
+      EXPECT_EQ(classes[k].at("name"), ClassMap::taxonomy().entries()[k].name);
+    }
+    // Each probability field it names is a column of the file, with the class the server gave.
+    std::ifstream file(dir.file(name), std::ios::binary);
+    const std::string header((std::istreambuf_iterator<char>(file)), {});
+    const auto& probabilities = meta.at("probability_fields");
+    ASSERT_EQ(probabilities.size(), 3u);
+    EXPECT_EQ(probabilities[1].at("field"), "prob_class_1");
+    EXPECT_EQ(probabilities[1].at("name"), "class-1");
+    for (const auto& p : probabilities) {
+      const std::string field = p.at("field").get<std::string>();
+      const bool pcd = std::string(name).ends_with(".pcd");
+      const std::string column = pcd ? " " + field + " " : "property float " + field + "\n";
+      EXPECT_NE(header.find(column), std::string::npos) << field << " in " << name;
+    }
+    const auto& descriptor = meta.at("descriptor");
+    EXPECT_EQ(descriptor.at("field"), "fpfh_paper");
+    EXPECT_EQ(descriptor.at("values"), 33);
+    ASSERT_EQ(descriptor.at("columns").size(), 33u);
+    EXPECT_EQ(descriptor.at("columns")[32], "fpfh_paper_32");
   }
 }
 

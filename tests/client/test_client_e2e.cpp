@@ -67,6 +67,14 @@ std::set<std::string> file_names(const fs::path& dir) {
   return names;
 }
 
+// The labeled clouds in an output directory (not their .classes.json files).
+std::set<std::string> cloud_names(const fs::path& dir) {
+  std::set<std::string> names;
+  for (const std::string& name : file_names(dir))
+    if (!name.ends_with(".classes.json")) names.insert(name);
+  return names;
+}
+
 class ClientE2e : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -178,25 +186,28 @@ TEST_F(ClientE2e, UploaderSurvivesServerAndUploaderKillsWithEveryScanLabeledOnce
                                        std::filesystem::path(scan(i)).stem().string());
   };
   std::set<std::string> expected;
-  for (int i = 0; i < kScans; ++i) expected.insert(output_of(i));
+  for (int i = 0; i < kScans; ++i) {
+    expected.insert(output_of(i));
+    expected.insert(fs::path(output_of(i)).replace_extension(".classes.json").string());
+  }
 
   auto server = std::make_unique<ServerProcess>(models(), file("up-server1.log"));
   const int port = server->port();
   args.insert(args.begin() + 1, {"--server", server->address()});
   auto uploader = std::make_unique<Process>(args, file("upload1.log"));
   ASSERT_TRUE(
-      test::eventually([&] { return file_names(out).size() >= 2; }, std::chrono::seconds(120)))
+      test::eventually([&] { return cloud_names(out).size() >= 2; }, std::chrono::seconds(120)))
       << uploader->log();
   server->process().kill(SIGKILL);  // mid-upload: no drain, no goodbye
   server.reset();
   // The uploader notices and backs off; nothing it accepted is lost meanwhile.
   EXPECT_TRUE(uploader->wait_for_log("server down", std::chrono::seconds(30))) << uploader->log();
-  EXPECT_EQ(file_names(spool + "/scans").size() + file_names(out).size(),
+  EXPECT_EQ(file_names(spool + "/scans").size() + cloud_names(out).size(),
             static_cast<std::size_t>(kScans));
   server = std::make_unique<ServerProcess>(models(), file("up-server2.log"), port);
-  const std::size_t before_uploader_kill = file_names(out).size();
+  const std::size_t before_uploader_kill = cloud_names(out).size();
   // Then the uploader itself dies (SIGKILL) part-way, if it has not finished yet.
-  test::eventually([&] { return file_names(out).size() >= before_uploader_kill + 2; },
+  test::eventually([&] { return cloud_names(out).size() >= before_uploader_kill + 2; },
                    std::chrono::seconds(120));
   uploader->kill(SIGKILL);
   const std::string first_log = uploader->log();

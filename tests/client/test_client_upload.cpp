@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 
+#include "common/labeled_output.hpp"
 #include "fake_labeler.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
@@ -49,6 +50,15 @@ std::string id_of(std::string_view bytes) { return client::upload::scan_id(bytes
 std::size_t files_in(const fs::path& dir) {
   if (!fs::exists(dir)) return 0;
   return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir), {}));
+}
+
+// Labeled clouds in an output directory (not the .classes.json files beside them).
+std::size_t clouds_in(const fs::path& dir) {
+  if (!fs::exists(dir)) return 0;
+  std::size_t clouds = 0;
+  for (const auto& entry : fs::directory_iterator(dir))
+    clouds += !entry.path().filename().string().ends_with(".classes.json");
+  return clouds;
 }
 
 client::ClientOptions fast_client(const std::string& address) {
@@ -268,7 +278,7 @@ TEST(Uploader, LabelsEachScanOnceIntoItsOwnOutput) {
   const PointCloud out = read_cloud(uploader.output_path(id).string());
   ASSERT_EQ(out.labels.size(), 200u);
   for (std::size_t i = 0; i < 200; ++i) ASSERT_EQ(out.labels[i], (i + 1) % 4);
-  EXPECT_EQ(files_in(dir.file("out")), 2u);
+  EXPECT_EQ(clouds_in(dir.file("out")), 2u);
   EXPECT_EQ(files_in(dir.file("spool/scans")), 0u);
   // The same scan again: its output exists, it is not uploaded twice.
   EXPECT_EQ(uploader.submit(scan_bytes(1), ".pcd"), Uploader::Submitted::kAlreadyLabeled);
@@ -318,7 +328,7 @@ TEST(Uploader, StartupResumesTheSpoolAndSkipsScansAlreadyWritten) {
   ASSERT_TRUE(wait_idle(uploader));
   EXPECT_EQ(server.service.label_calls, 1);
   EXPECT_EQ(uploader.counters().already_labeled, 1u);
-  EXPECT_EQ(files_in(options.output_dir), 2u);  // the crash's temp file is gone
+  EXPECT_EQ(clouds_in(options.output_dir), 2u);  // the crash's temp file is gone
   EXPECT_EQ(files_in(options.spool_dir / "scans"), 0u);
   // The resumed scan's output is still named after its source file.
   EXPECT_TRUE(fs::exists(options.output_dir /
@@ -380,7 +390,7 @@ TEST(Uploader, ACorruptSpoolEntryIsNeverUploaded) {
   EXPECT_EQ(server.service.label_calls, 1);
   EXPECT_EQ(server.service.scan_ids, std::vector{client::upload::scan_id(scan_bytes(53))});
   EXPECT_EQ(uploader.counters().corrupt, 1u);
-  EXPECT_EQ(files_in(options.output_dir), 1u);
+  EXPECT_EQ(clouds_in(options.output_dir), 1u);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -544,7 +554,7 @@ TEST(UploadCli, AFullSpoolDiskRejectsWithExitFiveAndARestartDrainsBeforeTakingMo
   r = test::run_command(upload_tool() + " -q --spool-min-free-mb 0 --server " + server.address() +
                         spool_out);
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(files_in(dir.file("out")), 8u) << r.output;
+  EXPECT_EQ(clouds_in(dir.file("out")), 8u) << r.output;
   EXPECT_EQ(server.service.label_calls, 8);
   EXPECT_EQ(files_in(disk.path("spool/scans")), 0u);
 }
@@ -591,8 +601,12 @@ TEST(UploadCli, OutputsAreNamedAfterTheirSourceAndKeyedByTheOptions) {
   EXPECT_EQ(server.service.label_calls, 2);
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir.file("out")))
-    names.push_back(entry.path().filename().string());
+    if (entry.path().extension() == ".pcd") names.push_back(entry.path().filename().string());
   ASSERT_EQ(names.size(), 2u);
+  // Each with the JSON that names its classes and fields (common/labeled_output.hpp).
+  for (const std::string& name : names)
+    EXPECT_TRUE(fs::exists(client::tools::classes_json_path(dir.file("out/" + name)))) << name;
+  EXPECT_EQ(files_in(dir.file("out")), 4u);
   for (const std::string& name : names) EXPECT_EQ(name.rfind("kitchen_scan.", 0), 0u) << name;
   for (const std::string& name : names) {
     const PointCloud out = read_cloud(dir.file("out/" + name));
@@ -620,7 +634,7 @@ TEST(UploadCli, AnUnreadableInputFileExitsOneWithOneLineAndIsNotSpooled) {
   EXPECT_NE(r.output.find(dir.file("broken.pcd") + ": not spooled, unreadable"), std::string::npos)
       << r.output;
   EXPECT_EQ(server.service.label_calls, 1);  // the good file only
-  EXPECT_EQ(files_in(dir.file("out")), 1u);
+  EXPECT_EQ(clouds_in(dir.file("out")), 1u);
   EXPECT_EQ(files_in(dir.file("spool/failed")), 0u);
 }
 
@@ -652,7 +666,7 @@ TEST(UploadCli, ACorruptSpoolEntryIsReportedAndExitsFour) {
       << r.output;
   EXPECT_NE(r.output.find("corrupt 1"), std::string::npos) << r.output;
   EXPECT_EQ(server.service.label_calls, 0);
-  EXPECT_EQ(files_in(dir.file("out")), 0u);
+  EXPECT_EQ(clouds_in(dir.file("out")), 0u);
 }
 
 TEST(UploadCli, TimeoutWithTheServerAwayExitsThreeThenALaterRunDrainsTheSpool) {
@@ -671,7 +685,7 @@ TEST(UploadCli, TimeoutWithTheServerAwayExitsThreeThenALaterRunDrainsTheSpool) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("resuming 1 scans"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("uploaded 1 (200 points)"), std::string::npos) << r.output;
-  EXPECT_EQ(files_in(dir.file("out")), 1u);
+  EXPECT_EQ(clouds_in(dir.file("out")), 1u);
   EXPECT_EQ(files_in(dir.file("spool/scans")), 0u);
 }
 
@@ -685,7 +699,7 @@ TEST(UploadCli, StdinFramesAreAcknowledgedAndLabeled) {
                         " --stdin -q --server " + server.address() + " --spool " +
                         dir.file("spool") + " -o " + dir.file("out"));
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(files_in(dir.file("out")), 3u);
+  EXPECT_EQ(clouds_in(dir.file("out")), 3u);
   EXPECT_NE(r.output.find("accepted " + client::upload::scan_id(scan_bytes(31)) + " stdin#1"),
             std::string::npos)
       << r.output;
@@ -711,7 +725,7 @@ TEST(UploadCli, WatchedDirectoryScansAreUploadedUntilASignal) {
   write_bytes(dir.file("in/direct.pcd"), scan_bytes(42));
   write_bytes(dir.file("in/notes.txt"), "ignored");
   EXPECT_TRUE(
-      test::eventually([&] { return files_in(dir.file("out")) == 3; }, std::chrono::seconds(30)))
+      test::eventually([&] { return clouds_in(dir.file("out")) == 3; }, std::chrono::seconds(30)))
       << uploader.log();
   EXPECT_TRUE(uploader.wait_for_log("status: queued 0", std::chrono::seconds(10)))
       << uploader.log();

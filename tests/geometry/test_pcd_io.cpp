@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -151,16 +152,69 @@ TEST(PcdWrite, HeaderListsFieldsLikePcl) {
   while (std::getline(in, line) && lines.size() < 11) lines.push_back(line);
   ASSERT_EQ(lines.size(), 11u);
   EXPECT_EQ(lines[1], "VERSION 0.7");
+  // fpfh as PCL has it (COUNT 33), then its values again as scalar columns for Open3D.
+  std::string copies, sizes, types, counts;
+  for (int e = 0; e < 33; ++e) {
+    copies += " fpfh_" + std::to_string(e);
+    sizes += " 4";
+    types += " F";
+    counts += " 1";
+  }
   EXPECT_EQ(lines[2],
-            "FIELDS x y z normal_x normal_y normal_z curvature label rgba fpfh intensity");
-  EXPECT_EQ(lines[3], "SIZE 4 4 4 4 4 4 4 4 4 4 4");
-  EXPECT_EQ(lines[4], "TYPE F F F F F F F U U F F");
-  EXPECT_EQ(lines[5], "COUNT 1 1 1 1 1 1 1 1 1 33 1");
+            "FIELDS x y z normal_x normal_y normal_z curvature label rgba fpfh intensity" + copies);
+  EXPECT_EQ(lines[3], "SIZE 4 4 4 4 4 4 4 4 4 4 4" + sizes);
+  EXPECT_EQ(lines[4], "TYPE F F F F F F F U U F F" + types);
+  EXPECT_EQ(lines[5], "COUNT 1 1 1 1 1 1 1 1 1 33 1" + counts);
   EXPECT_EQ(lines[6], "WIDTH 4");
   EXPECT_EQ(lines[7], "HEIGHT 3");
   EXPECT_EQ(lines[8], "VIEWPOINT 0.25 -1.5 3 0.5 0.5 -0.5 0.5");
   EXPECT_EQ(lines[9], "POINTS 12");
   EXPECT_EQ(lines[10], "DATA binary_compressed");
+}
+
+// The scalar columns of a multi-value field hold its values and fold back into it on reading.
+TEST(PcdWrite, MultiValueFieldsAlsoGoOutAsScalarColumns) {
+  test::TempDir dir;
+  PointCloud cloud;
+  cloud.xyz = {{0, 0, 0}, {1, 2, 3}};
+  cloud.set_field("fpfh", 3).values = {1, 2, 3, 4, 5, 6};
+  const std::string path = dir.file("cloud.pcd");
+  write_pcd(path, cloud, PcdEncoding::kAscii);
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(text.find("FIELDS x y z fpfh fpfh_0 fpfh_1 fpfh_2\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("\n0 0 0 1 2 3 1 2 3\n1 2 3 4 5 6 4 5 6\n"), std::string::npos) << text;
+  const PointCloud back = read_pcd(path);
+  ASSERT_EQ(back.fields.size(), 1u);
+  EXPECT_EQ(back.fields[0].name, "fpfh");
+  EXPECT_EQ(back.fields[0].values, cloud.fields[0].values);
+}
+
+TEST(PcdWrite, NoScalarColumnsWhereTheirNamesAreTaken) {
+  test::TempDir dir;
+  PointCloud cloud;
+  cloud.xyz = {{0, 0, 0}};
+  cloud.set_field("fpfh", 2).values = {1, 2};
+  cloud.set_field("fpfh_1", 1).values = {7};  // the user's own column of that name
+  const std::string path = dir.file("cloud.pcd");
+  write_pcd(path, cloud, PcdEncoding::kAscii);
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(text.find("FIELDS x y z fpfh fpfh_1\n"), std::string::npos) << text;
+}
+
+// A column named like a copy but beyond the field's COUNT is a field of its own.
+TEST(PcdRead, OnlyColumnsWithinTheCountAreFoldedBack) {
+  test::TempDir dir;
+  const std::string path = dir.file("cloud.pcd");
+  write_bytes(path,
+              "VERSION 0.7\nFIELDS x y z h h_1 h_2\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\n"
+              "COUNT 1 1 1 2 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n0 0 0 1 2 2 9\n");
+  const PointCloud cloud = read_pcd(path);
+  ASSERT_EQ(cloud.fields.size(), 2u);
+  EXPECT_EQ(cloud.fields[0].name, "h");
+  EXPECT_EQ(cloud.fields[1].name, "h_2");
+  EXPECT_EQ(cloud.fields[1].values, std::vector<float>{9});
 }
 
 TEST_P(PcdRoundTrip, HeaderCommentsFollowTheFirstLineAndAreSkippedByTheReader) {
@@ -486,8 +540,8 @@ TEST(PcdRead, ZeroAreaShapesAreOneEmptyRow) {
     for (const std::string data : {"ascii", "binary", "binary_compressed"}) {
       SCOPED_TRACE(shape + data);
       const std::string path = dir.file("empty.pcd");
-      write_bytes(path, "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n" + shape +
-                            "DATA " + data + "\n");
+      write_bytes(path, "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\n" + shape + "DATA " +
+                            data + "\n");
       const PointCloud cloud = read_pcd(path);
       EXPECT_EQ(cloud.size(), 0u);
       EXPECT_EQ(std::size_t{cloud.width} * cloud.height, cloud.size());

@@ -151,7 +151,7 @@ int run_label(Client& client, LabelCommand command) {
       PointCloud labeled = labeled_cloud(std::move(cloud), result);
       if (!result.object_ids.empty())
         labeled.set_field("object", 1).values = object_field(result.object_ids);
-      write_tagged_cloud(out, labeled, labeled_cloud_tags(result));
+      write_labeled_cloud(out, labeled, result);
       if (command.png)
         write_label_png(labeled, fs::path(out).replace_extension(".png").string(),
                         fs::path(input).filename().string() + " - " + result.summary.model() + " " +

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 
 #include "class_fields.hpp"
+#include "primlabel/geometry/atomic_file.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/render/colorize.hpp"
 #include "primlabel/render/render.hpp"
@@ -59,6 +62,51 @@ PointCloud labeled_cloud(PointCloud cloud, const LabelResult& result) {
     }
   }
   return cloud;
+}
+
+std::string labeled_cloud_classes_json(const PointCloud& labeled, const LabelResult& result) {
+  using json::Json;
+  Json out;
+  out["model"] = result.summary.model();
+  out["model_version"] = result.summary.model_version();
+  out["model_choice"] = model_choice_name(result.summary.model_choice());
+  out["label_field"] = "label";
+  Json classes = Json::array();
+  const ClassMap taxonomy = ClassMap::taxonomy();
+  for (const ClassMap::Entry& e : taxonomy.entries())
+    classes.push_back({{"id", e.id}, {"name", e.name}});
+  out["classes"] = std::move(classes);
+  Json probabilities = Json::array();
+  for (std::size_t k = 0; k < result.class_ids.size() && k < result.class_names.size(); ++k) {
+    const std::string field = probability_field_name(result.class_names[k], result.class_ids[k]);
+    if (labeled.find_field(field) == nullptr) continue;
+    probabilities.push_back(
+        {{"field", field}, {"id", result.class_ids[k]}, {"name", result.class_names[k]}});
+  }
+  if (!probabilities.empty()) out["probability_fields"] = std::move(probabilities);
+  if (result.descriptor_dim > 0) {
+    const std::string name = descriptor_field(result);
+    // PCD keeps PCL's one field of `values` floats; PLY and Open3D see one column per value.
+    Json columns = Json::array();
+    for (int e = 0; e < result.descriptor_dim; ++e)
+      columns.push_back(name + "_" + std::to_string(e));
+    out["descriptor"] = {{"field", name}, {"values", result.descriptor_dim}, {"columns", columns}};
+  }
+  if (labeled.find_field(kInputLabelField) != nullptr) out["input_label_field"] = kInputLabelField;
+  if (labeled.find_field("object") != nullptr) out["object_field"] = "object";
+  if (!result.summary.scan_id().empty()) out["scan_id"] = result.summary.scan_id();
+  if (!result.summary.request_id().empty()) out["request_id"] = result.summary.request_id();
+  return json::dump(out, 2) + "\n";
+}
+
+std::string classes_json_path(const std::string& cloud_path) {
+  return std::filesystem::path(cloud_path).replace_extension(".classes.json").string();
+}
+
+void write_labeled_cloud(const std::string& path, const PointCloud& labeled,
+                         const LabelResult& result) {
+  atomic_write_file(classes_json_path(path), labeled_cloud_classes_json(labeled, result));
+  write_tagged_cloud(path, labeled, labeled_cloud_tags(result));
 }
 
 void write_label_png(const PointCloud& cloud, const std::string& path, const std::string& title) {

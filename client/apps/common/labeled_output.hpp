@@ -26,6 +26,18 @@ std::string descriptor_field(const LabelResult& result);
 // probability columns in order ("id:name ..."), scan and request ids.
 CloudTags labeled_cloud_tags(const LabelResult& result);
 
+// What a labeled cloud's fields hold, for readers that drop header comments (PCL, Open3D, a
+// script): model, the class of every `label` value, the probability and descriptor fields and
+// their columns, as JSON. Written beside the cloud as classes_json_path(cloud path).
+std::string labeled_cloud_classes_json(const PointCloud& labeled, const LabelResult& result);
+// "dir/scan_labeled.pcd" -> "dir/scan_labeled.classes.json".
+std::string classes_json_path(const std::string& cloud_path);
+
+// Writes the labeled cloud with its header tags, and first the classes JSON beside it, so a cloud
+// that exists always has its JSON.
+void write_labeled_cloud(const std::string& path, const PointCloud& labeled,
+                         const LabelResult& result);
+
 // Renders `cloud` coloured by its labels with the taxonomy's colours and a legend.
 void write_label_png(const PointCloud& cloud, const std::string& path, const std::string& title);
 

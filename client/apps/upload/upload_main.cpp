@@ -86,7 +86,7 @@ struct Intake {
     std::printf("%s %s %s%s\n", kState[static_cast<int>(result)], id.c_str(), source.c_str(),
                 taken ? (" -> " + uploader.output_path(id, source_name).string()).c_str() : "");
     std::fflush(stdout);
-    if (result == Uploader::Submitted::kSpoolFull || result == Uploader::Submitted::kWriteFailed) {
+    if (!taken) {
       std::fprintf(stderr, "primlabel-upload: %s: %s\n", source.c_str(), reason.c_str());
       return false;
     }

@@ -243,8 +243,8 @@ bool Uploader::upload(const SpooledScan& scan) {
     return false;
   }
   const std::size_t points = result.size();
-  write_tagged_cloud(output.string(), tools::labeled_cloud(std::move(cloud), result),
-                     tools::labeled_cloud_tags(result));
+  tools::write_labeled_cloud(output.string(), tools::labeled_cloud(std::move(cloud), result),
+                             result);
   // write_pcd returns once the file and its directory entry are durable (atomic_write_file), so
   // the spool may forget the scan now.
   spool_.complete(scan.id);

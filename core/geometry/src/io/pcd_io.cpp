@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cstdint>
 #include <cstring>
 #include <memory>
@@ -50,6 +51,28 @@ struct PcdHeader {
   std::uint64_t unpadded_record_bytes = 0;  // one point in binary_compressed layout (no "_")
   std::uint64_t values_per_point = 0;       // ascii tokens per point (padding included)
 };
+
+// "fpfh", 3 -> "fpfh_3": the scalar columns a multi-value field is also written as.
+std::string scalar_column_name(const std::string& field, std::uint32_t element) {
+  return field + "_" + std::to_string(element);
+}
+
+// True for a COUNT 1 field name_e beside a field `name` with more than e values: the copy our
+// writer adds for readers that take one value per field, read back as part of `name`.
+bool is_scalar_copy(const PcdHeader& header, const PcdField& field) {
+  if (field.count != 1) return false;
+  const std::size_t underscore = field.name.rfind('_');
+  if (underscore == std::string::npos || underscore + 1 == field.name.size()) return false;
+  std::uint32_t element = 0;
+  const char* first = field.name.data() + underscore + 1;
+  const char* last = field.name.data() + field.name.size();
+  const auto [end, error] = std::from_chars(first, last, element);
+  if (error != std::errc() || end != last) return false;
+  const std::string base = field.name.substr(0, underscore);
+  for (const PcdField& other : header.fields)
+    if (other.name == base && other.count > element) return true;
+  return false;
+}
 
 // The entries of one header line, remembered with its line number for error messages.
 struct HeaderLine {
@@ -528,7 +551,7 @@ PointCloud assemble_cloud(const std::string& path, const PcdHeader& header,
 
   for (std::size_t f = 0; f < header.fields.size(); ++f) {
     const PcdField& field = header.fields[f];
-    if (consumed[f] || field.is_padding()) continue;
+    if (consumed[f] || field.is_padding() || is_scalar_copy(header, field)) continue;
     FloatField out{field.name, static_cast<int>(field.count), {}};
     out.values.resize(n * field.count);
     for (std::size_t e = 0; e < field.count; ++e)
@@ -599,6 +622,20 @@ std::vector<OutputField> output_fields(const PointCloud& cloud) {
   for (const FloatField& field : cloud.fields) {
     const auto count = static_cast<std::uint32_t>(field.count);
     out.push_back({field.name, 'F', count, bytes(field.values.data()), 0, 4 * std::size_t{count}});
+  }
+  // PCL reads a multi-value field (fpfh, COUNT 33) as one; Open3D keeps only its first value. So
+  // each also goes out as scalar columns name_0 .. name_k (views of the same values), which our
+  // reader folds back; skipped when the cloud already has a field of such a name.
+  for (const FloatField& field : cloud.fields) {
+    if (field.count < 2) continue;
+    const auto count = static_cast<std::uint32_t>(field.count);
+    bool taken = false;
+    for (std::uint32_t e = 0; e < count && !taken; ++e)
+      taken = cloud.find_field(scalar_column_name(field.name, e)) != nullptr;
+    if (taken) continue;
+    for (std::uint32_t e = 0; e < count; ++e)
+      out.push_back({scalar_column_name(field.name, e), 'F', 1, bytes(field.values.data()), 4 * e,
+                     4 * std::size_t{count}});
   }
   return out;
 }

@@ -10,6 +10,9 @@
 //   curvature -> curvature; label -> labels (must be integers in 0..2^32-1);
 //   PCD rgb/rgba (4 bytes, bit pattern kept) or PLY red green blue [alpha] uchar -> rgba;
 //   anything else -> a FloatField (PCD keeps COUNT; PLY name_0..name_k runs form one field).
+// Writing a multi-value field (fpfh, 33 values): PCD as one field with its COUNT (PCL's form)
+// and also as scalar columns name_0..name_k (Open3D reads one value per field), which reading
+// folds back into the field; PLY as the scalar columns only.
 //   PCD "_" padding fields are skipped. PLY clouds are read as one row (height 1).
 
 #include <stdexcept>
