@@ -30,7 +30,7 @@ namespace {
 using namespace primlabel;
 
 struct Arguments {
-  std::string input, output, field, palette = "classes", classes, view = "oblique", title;
+  std::string input, output, field, palette = "classes", classes, view = "auto", title;
   std::string primitives;  // JSON of primlabel label / primlabel-eval --primitives
   std::string objects;     // JSON of primlabel label / primlabel-eval --objects
   double min_confidence = 0;
@@ -146,9 +146,10 @@ int run(const Arguments& args) {
   options.width = args.width;
   options.height = args.height;
   options.point_radius_px = args.point_size;
-  options.view = args.view == "top"      ? RenderView::kTop
-                 : args.view == "sensor" ? RenderView::kSensor
-                                         : RenderView::kOblique;
+  options.view = args.view == "top"       ? RenderView::kTop
+                 : args.view == "sensor"  ? RenderView::kSensor
+                 : args.view == "oblique" ? RenderView::kOblique
+                                          : natural_view(cloud);  // as primlabel label --png
   if (!args.no_title)
     options.title = !args.title.empty()
                         ? args.title
@@ -194,8 +195,10 @@ int main(int argc, char** argv) {
   app.add_option("--classes", args.classes,
                  "class map '<id> <name>' per line naming the labels (default: the file's "
                  "classes tag, else the taxonomy ids)");
-  app.add_option("--view", args.view, "top, oblique (default) or sensor (from the VIEWPOINT)")
-      ->check(CLI::IsMember({"top", "oblique", "sensor"}));
+  app.add_option("--view", args.view,
+                 "auto (default: sensor for an organised camera frame, else oblique), top, "
+                 "oblique or sensor (from the VIEWPOINT)")
+      ->check(CLI::IsMember({"auto", "top", "oblique", "sensor"}));
   app.add_option("--width", args.width, "image width in pixels")->check(CLI::Range(64, 16384));
   app.add_option("--height", args.height, "image height in pixels")->check(CLI::Range(64, 16384));
   app.add_option("--point-size", args.point_size, "splat radius in pixels (0 = one pixel)")

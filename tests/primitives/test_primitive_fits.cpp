@@ -47,6 +47,30 @@ TEST(PrimitiveFit, PlaneNormalOffsetAndExtent) {
   EXPECT_NEAR(f->confidence, 3000.0 / 3600.0, 0.03);
 }
 
+// A near-square table seen with more points along a diagonal (as a sensor's density varies):
+// its principal axes run along the diagonal, but the drawn extent is the table's own rectangle,
+// not a box around it twice its area.
+TEST(PrimitiveFit, PlaneExtentIsTheSmallestRectangleNotThePrincipalAxesBox) {
+  SampleMaker m(2);
+  Samples s;
+  const V normal = V(0.1, -0.2, 0.97).normalized(), center(0.1, 0.3, 0.7);
+  const auto [u, v] = test::basis(normal);
+  for (int i = 0; i < 3000; ++i)
+    m.add(s, center + m.uniform(-0.3, 0.3) * u + m.uniform(-0.25, 0.25) * v, normal);
+  for (int i = 0; i < 3000; ++i) {
+    const double t = m.uniform(-0.25, 0.25);
+    m.add(s, center + (t + m.uniform(-0.02, 0.02)) * u + t * v, normal);
+  }
+  const auto f = fit(PrimitiveKind::kPlane, s);
+  ASSERT_TRUE(f);
+  const auto& plane = std::get<PlaneModel>(f->model);
+  EXPECT_NEAR(plane.extent_u, 0.6, 0.01);
+  EXPECT_NEAR(plane.extent_v, 0.5, 0.01);
+  EXPECT_LT(std::min(angle_deg(plane.axis_u, u), angle_deg(plane.axis_u, -u)), 2.0);
+  EXPECT_LT((plane.center - center).norm(), 0.01);
+  EXPECT_NEAR(plane.axis_u.cross(plane.axis_v).dot(plane.normal), 1.0, 1e-9);
+}
+
 TEST(PrimitiveFit, ConvexCylinderSeenOverHalfTurn) {
   SampleMaker m(2);
   Samples s;

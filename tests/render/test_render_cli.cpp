@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include "png_decode.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
@@ -201,6 +202,26 @@ TEST(RenderCliShared, MosdSegmentsFromTheSensor) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   int width = 0, height = 0;
   EXPECT_TRUE(png_size(dir.file("learn36.png"), width, height));
+}
+
+// Without --view, a camera frame is drawn from the camera (as primlabel label --png draws it) and
+// an unorganised scan obliquely.
+TEST(RenderCliShared, TheDefaultViewIsTheSensorsForACameraFrame) {
+  const std::string scan = test::shared_data("mosd/learn36.pcd");
+  if (!std::filesystem::exists(scan)) GTEST_SKIP() << scan << " not present";
+  test::TempDir dir;
+  const std::string base = render_tool() + " " + scan + " --width 320 --height 240 -o ";
+  const auto bytes = [&](const std::string& view) {
+    const std::string out = dir.file(view.empty() ? "default.png" : view + ".png");
+    const Result r = run(base + out + (view.empty() ? "" : " --view " + view));
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    std::ifstream in(out, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  const std::string by_default = bytes("");
+  ASSERT_FALSE(by_default.empty());
+  EXPECT_EQ(by_default, bytes("sensor"));
+  EXPECT_NE(by_default, bytes("oblique"));
 }
 
 }  // namespace

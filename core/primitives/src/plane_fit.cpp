@@ -1,8 +1,9 @@
 // Planes: MSAC over three-point hypotheses, then alternating inlier selection and the
-// least-squares (PCA) plane; the extent is the inliers' bounding rectangle along their principal
-// in-plane axes.
+// least-squares (PCA) plane; the extent is the inliers' minimum-area bounding rectangle, whose
+// longer side is axis_u.
 
 #include "fit_support.hpp"
+#include "primlabel/geometry/convex_hull.hpp"
 
 namespace primlabel::primitives {
 namespace detail {
@@ -93,23 +94,23 @@ std::optional<Fit> fit_plane(const SegmentPoints& points, const FitSettings& set
   if (!(u.norm() > 1e-9)) u = normal.unitOrthogonal();
   model.axis_u = u.normalized();
   model.axis_v = normal.cross(model.axis_u);
-  double lo_u = INFINITY, hi_u = -INFINITY, lo_v = INFINITY, hi_v = -INFINITY;
-  for (std::size_t i : inliers) {
-    const Vec3d q = pts.p[i] - axes.centroid;
-    lo_u = std::min(lo_u, q.dot(model.axis_u)), hi_u = std::max(hi_u, q.dot(model.axis_u));
-    lo_v = std::min(lo_v, q.dot(model.axis_v)), hi_v = std::max(hi_v, q.dot(model.axis_v));
+  // The smallest rectangle around the inliers, not the box along their principal axes: those
+  // are arbitrary for a near-square table (and tilted by uneven density), and such a box can be
+  // twice the table's area.
+  std::vector<Eigen::Vector2f> in_plane(inliers.size());
+  for (std::size_t k = 0; k < inliers.size(); ++k) {
+    const Vec3d q = pts.p[inliers[k]] - axes.centroid;
+    in_plane[k] = Eigen::Vector2d(q.dot(model.axis_u), q.dot(model.axis_v)).cast<float>();
   }
+  const Rectangle2 box = min_area_rectangle(convex_hull(std::move(in_plane)));
+  const Vec3d u_axis = box.axis_u.x() * model.axis_u + box.axis_u.y() * model.axis_v;
   const Vec3d middle =
-      axes.centroid + 0.5 * (lo_u + hi_u) * model.axis_u + 0.5 * (lo_v + hi_v) * model.axis_v;
+      axes.centroid + box.center.x() * model.axis_u + box.center.y() * model.axis_v;
   model.center = middle - (normal.dot(middle) + offset) * normal;
-  model.extent_u = hi_u - lo_u;
-  model.extent_v = hi_v - lo_v;
-  if (model.extent_v > model.extent_u) {
-    std::swap(model.extent_u, model.extent_v);
-    const Vec3d old_u = model.axis_u;
-    model.axis_u = model.axis_v;
-    model.axis_v = -old_u;  // keeps u x v = normal
-  }
+  model.axis_u = (u_axis - u_axis.dot(normal) * normal).normalized();
+  model.axis_v = normal.cross(model.axis_u);  // u x v = normal
+  model.extent_u = box.length;
+  model.extent_v = box.width;
   Fit fit;
   fit.model = model;
   fit.inliers = inliers.size();

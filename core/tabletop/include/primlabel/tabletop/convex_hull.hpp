@@ -1,18 +1,16 @@
 #pragma once
-// 2D convex hull (Andrew's monotone chain) and point-in-hull tests, for the table boundary in the
-// table plane's own coordinates.
+// Point-in-hull tests and plane bases, for the table boundary in the table plane's own
+// coordinates; the hull itself is primlabel::convex_hull (geometry/convex_hull.hpp).
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <vector>
 
+#include "primlabel/geometry/convex_hull.hpp"
+
 namespace primlabel::tabletop {
 
 using Vec2f = Eigen::Vector2f;
-
-// Vertices of the convex hull in counter-clockwise order, no collinear or duplicate vertices.
-// Fewer than three distinct non-collinear points give the (possibly degenerate) chain found.
-std::vector<Vec2f> convex_hull(std::vector<Vec2f> points);
 
 // True when p lies inside the CCW convex polygon or within `margin` outside any of its edges
 // (a negative margin shrinks the polygon). A polygon with fewer than 3 vertices contains nothing.
