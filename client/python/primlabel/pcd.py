@@ -114,6 +114,9 @@ def _parse_header(path: str, raw: bytes) -> _Header:
         if not tokens or tokens[0].startswith("#"):
             continue
         keyword, values = tokens[0], tokens[1:]
+        if line_number == 1 and tokens == ["ply"]:
+            raise PcdError(f"{path}: a PLY file, not a PCD file: read it with primlabel.ply.read "
+                           "(or primlabel.read, by the extension)")
         if keyword == "COLUMNS":
             keyword = "FIELDS"
         if keyword not in ("VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT",
@@ -319,7 +322,8 @@ def _compressed_columns(path: str, header: _Header, data: bytes) -> list:
 
 
 def read(path: str) -> PointCloud:
-    """Reads a PCD file; PcdError (a ValueError) says what is wrong with a malformed one."""
+    """Reads a PCD file; PcdError (a ValueError) says what is wrong with a malformed one. PLY
+    files: primlabel.ply.read, or primlabel.read for either by the extension."""
     path = os.fspath(path)
     try:
         with open(path, "rb") as f:
