@@ -46,12 +46,14 @@ PACKAGES=(
 # Only the tests need these: the deployment checks (YAML, nginx -t, promtool, the local
 # three-replica proof), TLS certificates made on the fly, clang with libFuzzer for the fuzz
 # targets (tests/fuzz), the Python client's runtime and pytest (client/python; its stubs come
-# from protoc and protobuf-compiler-grpc's grpc_python_plugin, above), Open3D for the
+# from protoc and protobuf-compiler-grpc's grpc_python_plugin, above) and what pip needs to
+# install it offline into a venv (setuptools, wheel, pip, venv), Open3D for the
 # interoperability check (tests/interop), CGAL for the Efficient RANSAC peer's test
 # (tests/test_cgal_peer), and ROS 1 (roscpp, sensor_msgs, std_msgs and rosmaster) for the ROS
 # node client/ros and its test ros.LabelsPointCloud2.
 TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl clang-14 libclang-rt-14-dev
   python3-grpcio python3-numpy python3-protobuf python3-pytest python3-open3d libcgal-dev
+  python3-setuptools python3-wheel python3-pip python3-venv
   libroscpp-dev libsensor-msgs-dev libstd-msgs-dev python3-rosmaster)
 # The benchmarks' peers: PCL (features, table-top) and CGAL's Efficient RANSAC (primitives).
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev libcgal-dev)

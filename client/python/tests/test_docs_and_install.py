@@ -1,5 +1,6 @@
-"""The README's Python example runs as written, and `cmake --install --component python` gives a
-package that works outside the build tree, with the .proto files beside it."""
+"""The README's Python example runs as written; `cmake --install --component python` gives a
+package that works outside the build tree, with the .proto files beside it; and pip installs the
+build's package offline into a venv over Debian's grpcio, numpy and protobuf."""
 
 from __future__ import annotations
 
@@ -67,3 +68,44 @@ def test_installed_package_works_outside_the_build(server, tmp_path):
     installed, health = result.stdout.splitlines()
     assert Path(installed).resolve().is_relative_to(prefix.resolve())
     assert health == "SERVING"
+
+
+def test_pip_installs_the_built_package_offline_into_a_venv(server, tmp_path):
+    # The build's python/ (package, stubs and the pyproject.toml CMake writes) installs with pip
+    # and nothing but Debian's packages: setuptools builds it, and the dependencies it declares
+    # (grpcio, numpy, protobuf) are satisfied by python3-grpcio, -numpy and -protobuf, seen
+    # through --system-site-packages. A copy, so pip's build files stay out of the build tree.
+    root = Path(os.environ.get("PRIMLABEL_PYTHON_ROOT") or Path(primlabel.__file__).parents[1])
+    if not (root / "pyproject.toml").exists():
+        pytest.fail(f"{root} has no pyproject.toml (client/python/CMakeLists.txt writes it)")
+    source = tmp_path / "python"
+    shutil.copytree(root, source, ignore=shutil.ignore_patterns("__pycache__", "build",
+                                                                "*.egg-info"))
+    venv = tmp_path / "venv"
+    run("/usr/bin/python3", "-m", "venv", "--system-site-packages", venv, timeout=120)
+    python = venv / "bin" / "python"
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH" and not k.startswith("PIP_")}
+    result = subprocess.run([str(python), "-m", "pip", "install", "--no-build-isolation",
+                             "--no-index", "--no-cache-dir", str(source)],
+                            cwd=tmp_path, env=env, timeout=180, capture_output=True, text=True)
+    assert result.returncode == 0, result.stdout + result.stderr
+    code = ("import primlabel, primlabel.v1.labeling_pb2 as pb, primlabel.v1.labeling_pb2_grpc; "
+            "print(primlabel.__file__); print(primlabel.__version__); "
+            "print(pb.LabelSummary.DESCRIPTOR.full_name); "
+            f"print(primlabel.Client({server.address!r}).health().name)")
+    result = subprocess.run([str(python), "-c", code], cwd=tmp_path, env=env, timeout=60,
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    installed, version, message, health = result.stdout.splitlines()
+    assert Path(installed).resolve().is_relative_to(venv.resolve())
+    assert version == primlabel.__version__ and re.fullmatch(r"\d+\.\d+\.\d+", version)
+    assert message == "primlabel.v1.LabelSummary" and health == "SERVING"
+    # pip records the declared dependencies, and finds them all installed (Debian's).
+    result = subprocess.run([str(python), "-m", "pip", "show", "primlabel"], env=env, timeout=60,
+                            capture_output=True, text=True)
+    requires = next(line for line in result.stdout.splitlines() if line.startswith("Requires:"))
+    assert {r.strip() for r in requires.split(":", 1)[1].split(",")} == {
+        "grpcio", "numpy", "protobuf"}
+    result = subprocess.run([str(python), "-m", "pip", "check"], env=env, timeout=60,
+                            capture_output=True, text=True)
+    assert "primlabel" not in result.stdout, result.stdout
