@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import enum
 import math
+import os
 import time
 import warnings
 from dataclasses import dataclass
@@ -22,6 +23,7 @@ from dataclasses import dataclass
 import grpc
 import numpy as np
 
+from . import files
 from .backoff import Backoff, BackoffPolicy
 from .errors import DomainWarning, InvalidInput, PrimlabelError, ProtocolError
 from .pcd import PointCloud
@@ -182,6 +184,36 @@ class _Call:
                               self.want_segments, self.want_objects)
 
 
+def _points_of(cloud):
+    """What label() sends for `cloud`: a pcd.PointCloud as it is, the file a path names read
+    into one (PCD or PLY, by the extension, as the CLI reads it), the points of an Open3D cloud
+    (open3d.geometry.PointCloud's .points, open3d.t.geometry.PointCloud's .point.positions; its
+    normals and colours are not sent), else the array itself. Open3D is never imported: any
+    object with such points will do."""
+    if isinstance(cloud, (str, os.PathLike)):
+        try:
+            return files.read(cloud)
+        except ValueError as e:  # PcdError, PlyError, UnsupportedFormat
+            raise InvalidInput(str(e)) from e
+    if isinstance(cloud, (np.ndarray, PointCloud)):
+        return cloud
+    attributes = getattr(cloud, "point", None)  # open3d.t.geometry.PointCloud: a tensor map
+    if attributes is not None and not isinstance(attributes, np.ndarray):
+        try:
+            positions = attributes["positions"] if "positions" in attributes else None
+        except TypeError:
+            positions = getattr(attributes, "positions", None)
+        if positions is None:  # a tensor cloud without points
+            return np.zeros((0, 3), np.float32)
+        if hasattr(positions, "cpu"):  # a tensor on another device
+            positions = positions.cpu()
+        return positions.numpy() if hasattr(positions, "numpy") else np.asarray(positions)
+    points = getattr(cloud, "points", None)  # open3d.geometry.PointCloud: Vector3dVector
+    if points is not None:
+        return np.asarray(points)
+    return cloud
+
+
 _MODEL_CHOICES = {
     labeling_pb2.MODEL_CHOICE_NAMED: "named",
     labeling_pb2.MODEL_CHOICE_DOMAIN: "domain",
@@ -317,13 +349,17 @@ class Client:
         """Streams the points (Labeler.Label) in messages of chunk_points and returns their
         labels in input order.
 
-        xyz: (N, 3) array, float32 or float64 (sent as float32), an (H, W, 3) organised frame, or
+        xyz: (N, 3) array, float32 or float64 (sent as float32), an (H, W, 3) organised frame,
         a pcd.PointCloud (its xyz, its VIEWPOINT unless viewpoint is given, and its WIDTH x
-        HEIGHT when organised). normals: (N, 3), sent so the server skips normal estimation.
-        model: None = the model whose training domain fits the cloud (the sensor and image size,
-        then spacing and noise), else the repository's default (Result.model_choice says which);
-        a named model used outside its domain warns (DomainWarning). voxel_size: > 0
-        downsamples before features (labels still cover every input point); None = the model's.
+        HEIGHT when organised), a path (str or pathlib.Path) to a .pcd or .ply file (read with
+        primlabel.read and sent as its PointCloud, as the CLI sends it), or an Open3D cloud
+        (open3d.geometry.PointCloud or open3d.t.geometry.PointCloud: its points only, from the
+        origin unless viewpoint is given). normals: (N, 3), sent so the server skips normal
+        estimation. model: None = the model whose training domain fits the cloud (the sensor and
+        image size, then spacing and noise), else the repository's default (Result.model_choice
+        says which); a named model used outside its domain warns (DomainWarning). voxel_size:
+        > 0 downsamples before features (labels still cover every input point); None = the
+        model's.
 
         Keyword-only options: model_version; viewpoint, the sensor origin (x, y, z) the normals
         face (default: the origin; it changes the labels, convex or concave, so pass the
@@ -419,6 +455,7 @@ class Client:
     ) -> tuple[_Call, float]:
         """The checked request of one labeling call, and its deadline in seconds."""
         frame = (0, 0)  # width, height of an organised frame: it lets the server pick the model
+        xyz = _points_of(xyz)
         if isinstance(xyz, PointCloud):  # its points, seen from its VIEWPOINT as the CLI does
             if viewpoint is None:
                 viewpoint = xyz.viewpoint[:3]
