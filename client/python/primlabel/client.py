@@ -14,6 +14,7 @@ of the request, so a retry is safe. Failures raise PrimlabelError with the gRPC 
 from __future__ import annotations
 
 import enum
+import functools
 import math
 import os
 import time
@@ -26,6 +27,7 @@ import numpy as np
 from . import files
 from .backoff import Backoff, BackoffPolicy
 from .errors import DomainWarning, InvalidInput, PrimlabelError, ProtocolError
+from .instances import Primitive, TabletopObject, TabletopTable
 from .pcd import PointCloud
 from .v1 import labeling_pb2, labeling_pb2_grpc
 from .wire import (
@@ -70,14 +72,20 @@ def probability_field_name(name: str, class_id: int) -> str:
     return "prob_" + "".join(c if (c.isascii() and c.isalnum()) or c == "_" else "_" for c in name)
 
 
+UNKNOWN_CLASS = ClassInfo(0, "unknown")  # label 0: no class (and dropped NaN points)
+
+
 @dataclass
 class Result:
     """The labels of one cloud, in the order of its points."""
 
     labels: np.ndarray  # (N,) uint32 taxonomy class id, 0 = unknown (and dropped NaN points)
-    probabilities: np.ndarray | None  # (N, len(classes)) float32 when asked for
+    probabilities: np.ndarray | None  # (N, len(model_classes)) float32 when asked for
     descriptors: np.ndarray | None  # (N, summary.descriptor_dim) float32, NaN rows: none
-    classes: list[ClassInfo]  # the model's classes: the columns of probabilities
+    # Every class a label can be, by id: 0 (unknown) and the model's, so classes[label] names
+    # any label: `result.classes[result.labels[i]].name`.
+    classes: dict[int, ClassInfo]
+    model_classes: list[ClassInfo]  # the model's classes: the columns of probabilities
     summary: labeling_pb2.LabelSummary  # model, version, counts, timings, domain warning
     # With primitives=True: (N,) uint32, the point's index into primitives, NO_SEGMENT if none.
     segments: np.ndarray | None = None
@@ -86,25 +94,34 @@ class Result:
     object_ids: np.ndarray | None = None
     attempts: int = 1  # calls made, including retries
 
-    @property
-    def primitives(self) -> list:
-        """The fitted instances (labeling_pb2.Primitive), primitives[s] for segment id s."""
-        return list(self.summary.primitives)
+    @functools.cached_property
+    def primitives(self) -> list[Primitive]:
+        """The fitted instances (instances.Primitive), primitives[s] for segment id s."""
+        names = {i: c.name for i, c in self.classes.items()}
+        return [Primitive.from_message(p, names) for p in self.summary.primitives]
 
-    @property
-    def objects(self) -> list:
-        """The table-top objects (labeling_pb2.TabletopObject), objects[k - 1] for object id k."""
-        return list(self.summary.objects)
+    @functools.cached_property
+    def objects(self) -> list[TabletopObject]:
+        """The table-top objects (instances.TabletopObject), objects[k - 1] for object id k."""
+        return [TabletopObject.from_message(o) for o in self.summary.objects]
 
-    @property
-    def table(self):
-        """The table the objects stand on (labeling_pb2.TabletopTable), None when none was found
+    @functools.cached_property
+    def table(self) -> TabletopTable | None:
+        """The table the objects stand on (instances.TabletopTable), None when none was found
         (summary.no_table_reason says why)."""
-        return self.summary.table if self.summary.HasField("table") else None
+        return TabletopTable.from_message(self.summary.table) if self.summary.HasField(
+            "table") else None
+
+    @property
+    def domain_warning(self) -> str:
+        """The summary's domain_warning ("" when none): set when the model labeled a cloud
+        outside its training domain; the call also warned (DomainWarning)."""
+        return self.summary.domain_warning
 
     @property
     def class_ids(self) -> np.ndarray:
-        return np.array([c.id for c in self.classes], dtype=np.uint32)
+        """The ids of model_classes: class_ids[k] is the class of probabilities[:, k]."""
+        return np.array([c.id for c in self.model_classes], dtype=np.uint32)
 
     def probability_fields(self) -> dict[str, np.ndarray]:
         """The probabilities as one (N,) column per class, named as every primlabel output names
@@ -113,7 +130,7 @@ class Result:
         if self.probabilities is None:
             return {}
         return {probability_field_name(c.name, c.id): np.ascontiguousarray(self.probabilities[:, k])
-                for k, c in enumerate(self.classes)}
+                for k, c in enumerate(self.model_classes)}
 
     @property
     def model_choice(self) -> str:
@@ -227,11 +244,17 @@ def _result(assembled_and_summary, attempts: int) -> Result:
     if summary.domain_warning:  # plausible-looking labels from a model of another sensor
         warnings.warn(f"model {summary.model}: {summary.domain_warning}", DomainWarning,
                       stacklevel=3)
+    model_classes = [ClassInfo(int(i), name) for i, name in classes]
+    by_id = {UNKNOWN_CLASS.id: UNKNOWN_CLASS}
+    by_id.update((c.id, c) for c in model_classes)
+    for count in summary.class_counts:  # a label outside the model's classes still has a name
+        by_id.setdefault(int(count.class_id), ClassInfo(int(count.class_id), count.name))
     return Result(
         labels=labels,
         probabilities=probability_rows,
         descriptors=descriptor_rows,
-        classes=[ClassInfo(int(i), name) for i, name in classes],
+        classes=by_id,
+        model_classes=model_classes,
         summary=summary,
         segments=segments,
         object_ids=objects,

@@ -57,6 +57,9 @@ def test_labels_equal_the_cli_point_for_point(client, cloud, cli_labels):
     assert result.attempts == 1
     # Not a constant answer: the scene has planes, edges and more.
     assert len(np.unique(result.labels)) >= 3
+    # Every label, 0 included, is a key of classes.
+    assert all(label in result.classes for label in np.unique(result.labels))
+    assert result.classes[0].name == "unknown"
 
 
 def test_the_plane_cascade_by_default_and_every_point(client, cloud, cli_labels, cli_every_point):
@@ -88,8 +91,11 @@ def test_probability_rows_sum_to_one_in_the_order_of_classes(client, cloud, cli_
     result = client.label(cloud, probabilities=True, descriptors=True)
     assert result.summary.cascaded_points == 0
     names = [c.name for c in client.model_metadata("tiny").classes]
-    assert [c.name for c in result.classes] == names
-    assert result.probabilities.shape == (len(cloud), len(result.classes))
+    assert [c.name for c in result.model_classes] == names
+    assert result.probabilities.shape == (len(cloud), len(result.model_classes))
+    # classes: the model's and 0 (unknown), by id, so every label has its name.
+    assert list(result.classes.values()) == [primlabel.UNKNOWN_CLASS, *result.model_classes]
+    assert {result.classes[label].name for label in result.labels} <= {"unknown", *names}
     described = result.labels != 0
     assert described.mean() > 0.99
     rows = result.probabilities[described]
@@ -136,9 +142,11 @@ def test_primitives_come_with_their_segments(client, cloud, call):
         # A segment is points of one class, the primitive's.
         np.testing.assert_array_equal(result.labels[members], primitive.class_id)
     # The scene's table is the largest plane, fitted as z = 0 within millimetres.
-    planes = [p for p in primitives if p.WhichOneof("model") == "plane"]
+    planes = [p for p in primitives if p.kind == "plane"]
+    assert all(p.message.WhichOneof("model") == "plane" for p in planes)
     table = max(planes, key=lambda p: p.point_count)
-    assert abs(abs(table.plane.normal.z) - 1) < 1e-3 and abs(table.plane.offset) < 5e-3
+    assert table.class_name == "plane"
+    assert abs(abs(table.model.normal[2]) - 1) < 1e-3 and abs(table.model.offset) < 5e-3
     assert client.label(cloud).segments is None  # not asked for: none
 
 
@@ -155,7 +163,8 @@ def test_objects_come_with_their_per_point_ids(client, cloud, call):
     assert ids.shape == (len(cloud),) and ids.dtype == np.uint32
     table = result.table
     assert table is not None, result.summary.no_table_reason
-    assert abs(abs(table.normal.y) - 1) < 0.05 and len(table.hull) >= 3
+    assert abs(abs(table.normal[1]) - 1) < 0.05 and len(table.hull) >= 3
+    assert table.hull.shape[1] == 3 and table.primitive_ids == tuple(table.message.primitive_ids)
     assert table.point_count == np.count_nonzero(ids == 0)
     objects = result.objects
     assert len(objects) >= 1
@@ -169,10 +178,9 @@ def test_objects_come_with_their_per_point_ids(client, cloud, call):
         assert obj.object_id == k and obj.point_count == len(members)
         points = xyz.astype(np.float32).astype(np.float64)[members]
         lo, hi = points.min(axis=0), points.max(axis=0)
-        np.testing.assert_allclose([obj.bounds_min.x, obj.bounds_min.y, obj.bounds_min.z], lo,
-                                   atol=1e-6)
-        np.testing.assert_allclose([obj.bounds_max.x, obj.bounds_max.y, obj.bounds_max.z], hi,
-                                   atol=1e-6)
+        np.testing.assert_allclose(obj.bounds_min, lo, atol=1e-6)
+        np.testing.assert_allclose(obj.bounds_max, hi, atol=1e-6)
+        np.testing.assert_allclose(obj.centroid, points.mean(axis=0), atol=1e-4)
         # Its primitives are segments mostly made of its points.
         for s in obj.primitive_ids:
             in_segment = result.segments == s
@@ -246,7 +254,7 @@ def test_empty_cloud_is_answered_cleanly(client):
         assert error.code == grpc.StatusCode.INVALID_ARGUMENT
     else:
         assert result.labels.shape == (0,)
-        assert result.probabilities.shape == (0, len(result.classes))
+        assert result.probabilities.shape == (0, len(result.model_classes))
 
 
 def free_port() -> int:

@@ -41,7 +41,7 @@ def test_readme_example_runs(server, scan, tmp_path):
         expected = client.label(primlabel.pcd.read(scan))
     np.testing.assert_array_equal(labeled.label, expected.labels)
     assert sorted(n for n in labeled.fields if n.startswith("prob_")) == sorted(
-        primlabel.probability_field_name(c.name, c.id) for c in expected.classes)
+        primlabel.probability_field_name(c.name, c.id) for c in expected.model_classes)
 
 
 def test_installed_package_works_outside_the_build(server, tmp_path):
