@@ -44,6 +44,20 @@ def test_readme_example_runs(server, scan, tmp_path):
         primlabel.probability_field_name(c.name, c.id) for c in expected.model_classes)
 
 
+def test_the_top_readme_s_python_example_runs(server, scan, tmp_path):
+    text = (SOURCE_DIR / "README.md").read_text().split("### Python", 1)[1]
+    example = re.search(r"```python\n(.*?)```", text, re.S).group(1)
+    assert "127.0.0.1:50051" in example
+    (tmp_path / "example.py").write_text(example.replace("127.0.0.1:50051", server.address))
+    shutil.copy(scan, tmp_path / "scan.pcd")
+    package_root = Path(primlabel.__file__).resolve().parents[1]
+    env = dict(os.environ, PYTHONPATH=str(package_root))
+    result = subprocess.run([sys.executable, "example.py"], cwd=tmp_path, env=env, timeout=60,
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("tiny default "), result.stdout
+
+
 def test_installed_package_works_outside_the_build(server, tmp_path):
     build = os.environ.get("PRIMLABEL_BUILD_DIR")
     cmake = os.environ.get("PRIMLABEL_CMAKE", "cmake")
