@@ -92,6 +92,11 @@ def test_pip_installs_the_built_package_offline_into_a_venv(server, tmp_path):
     root = Path(os.environ.get("PRIMLABEL_PYTHON_ROOT") or Path(primlabel.__file__).parents[1])
     if not (root / "pyproject.toml").exists():
         pytest.fail(f"{root} has no pyproject.toml (client/python/CMakeLists.txt writes it)")
+    missing = subprocess.run(["/usr/bin/python3", "-c", "import ensurepip, setuptools, wheel"],
+                             capture_output=True, text=True, timeout=60)
+    if missing.returncode != 0:
+        pytest.skip("needs python3-venv, python3-setuptools and python3-wheel "
+                    "(deploy/setup.sh test installs them)")
     source = tmp_path / "python"
     shutil.copytree(root, source, ignore=shutil.ignore_patterns("__pycache__", "build",
                                                                 "*.egg-info"))
