@@ -11,9 +11,8 @@
 
 #include <cstdint>
 
-#include "labeled_pointcloud2.hpp"
 #include "node_parameters.hpp"
-#include "primlabel/client/client.hpp"
+#include "ros_common/cloud_labeler.hpp"
 
 namespace primlabel::rosnode {
 
@@ -29,14 +28,11 @@ class LabelingNode {
 
  private:
   NodeParameters parameters_;
-  client::Client client_;
-  client::LabelOptions label_options_;
-  LabeledFields fields_;
+  roscommon::CloudLabeler labeler_;
   ros::Publisher cloud_publisher_;
   ros::Publisher summary_publisher_;
   ros::Subscriber subscriber_;
   std::uint64_t labeled_ = 0, failed_ = 0;
-  std::string last_model_;  // "name version" of the last answer, to log its choice once
 };
 
 }  // namespace primlabel::rosnode

@@ -1,50 +1,18 @@
 #pragma once
-// The node's private parameters (~server, ~model, ...; README: client/ros/README.md) and the
-// client options they make.
+// The node's private parameters (~server, ~model, ...; README: client/ros/README.md), read from
+// the parameter server.
 
 #include <ros/node_handle.h>
 
-#include <array>
-#include <optional>
-#include <string>
-
-#include "primlabel/client/client.hpp"
+#include "ros_common/node_parameters.hpp"
 
 namespace primlabel::rosnode {
 
-struct NodeParameters {
-  // The service.
-  std::string server = "127.0.0.1:50051";  // HOST[:PORT]; HOST alone means port 50051
-  std::string token;                       // bearer token; else ~token_file, else $PRIMLABEL_TOKEN
-  std::string token_file;                  // a file holding the token
-  bool tls = false;  // TLS with the system's roots (implied by ~tls_ca, ~tls_cert, ~tls_key)
-  std::string tls_ca, tls_cert, tls_key, tls_server_name;
-  double deadline = 10.0;  // seconds a call may take, its retries included
-  int retries = 4;         // attempts in all when the server is unavailable
-  // The labeling.
-  std::string model;          // empty = the server's default model
-  std::string model_version;  // empty = the latest loaded
-  double voxel_size = 0.0;    // > 0: downsample first (m); 0 = the model's setting
-  // Describe and infer every point: no plane cascade (the summary's cascaded_points stays 0),
-  // the model's exact labels everywhere, slower.
-  bool every_point = false;
-  // The sensor's position in the cloud's frame, for orienting normals; unset = the frame's
-  // origin (right for a cloud in its camera's own frame, wrong for one in base_link or map).
-  std::optional<std::array<double, 3>> viewpoint;
-  bool tabletop_only = false;
-  // With tabletop_only: the table and its objects as instances in the summary and a uint32
-  // `object` field per point (0 the table, k the summary's objects[k - 1]).
-  bool objects = false;
-  // Fitted primitive instances in the summary and a uint32 `segment` field per point (its index
-  // into the summary's primitives).
-  bool primitives = false;
-  bool confidence = false;     // publish a float32 `confidence` field (the highest probability)
-  bool probabilities = false;  // publish float32 `prob_<class>` fields
-  // Topics, resolved in the node's namespace.
-  std::string input_topic = "points";
-  std::string output_topic = "points_labeled";
-  std::string summary_topic = "points_labeled_summary";
-};
+// The parameters and what they make are the shared bridge's (ros_common/node_parameters.hpp).
+using roscommon::client_options;
+using roscommon::label_options;
+using roscommon::NodeParameters;
+using roscommon::settings_text;
 
 // Reads the parameters under `private_node` (a NodeHandle on "~"), defaults where unset. Throws
 // std::invalid_argument naming the parameter: a wrong type, a negative or non-finite voxel size,
@@ -52,18 +20,5 @@ struct NodeParameters {
 // a deadline <= 0, retries < 1, an empty topic, a malformed server address, ~objects without
 // ~tabletop_only.
 NodeParameters read_parameters(const ros::NodeHandle& private_node);
-
-// The connection: address, deadline, retries, TLS and the bearer token (read from ~token_file or
-// $PRIMLABEL_TOKEN when ~token is empty; throws std::runtime_error when the file is unreadable).
-client::ClientOptions client_options(const NodeParameters& parameters);
-
-// What every cloud is labeled with; probabilities are asked for when either output needs them.
-client::LabelOptions label_options(const NodeParameters& parameters);
-
-// The labeling settings for the start-up line, every one named with its value ("model
-// tabletop-kinect, tabletop_only false, every_point false, voxel_size the model's, ..."): a
-// parameter server keeps private parameters from the last run, so a stale ~tabletop_only must
-// show.
-std::string settings_text(const NodeParameters& parameters);
 
 }  // namespace primlabel::rosnode

@@ -1,36 +1,19 @@
 #pragma once
-// The points of a sensor_msgs/PointCloud2 read straight from its layout (the x, y and z fields'
-// offsets and datatypes, point_step, row_step, is_bigendian), without a PCL round trip, so a
-// robot's cloud of any point type is labeled as it arrives.
+// The points of a ROS 1 sensor_msgs/PointCloud2, read by the shared bridge
+// (ros_common/pointcloud2_xyz.hpp: the layout rules and what it refuses).
 
 #include <sensor_msgs/PointCloud2.h>
 
-#include <cstdint>
-
 #include "primlabel/geometry/point_cloud.hpp"
+#include "ros_common/pointcloud2_xyz.hpp"
 
 namespace primlabel::rosnode {
 
-// Where one coordinate sits inside a point.
-struct CoordinateField {
-  std::uint32_t offset = 0;
-  bool float64 = false;  // FLOAT64, else FLOAT32
-};
+using roscommon::CoordinateField;
+using roscommon::XyzLayout;
 
-struct XyzLayout {
-  CoordinateField x, y, z;
-  bool swap_bytes = false;  // is_bigendian differs from this machine's byte order
-};
-
-// The layout of x, y and z in `cloud`, checked against its sizes. Throws std::invalid_argument
-// naming the problem: no points, a missing x/y/z field, one that is neither FLOAT32 nor FLOAT64
-// or lies outside point_step, a row_step shorter than a row, data shorter than its rows.
+// As roscommon::xyz_layout and xyz_from_pointcloud2 on the message.
 XyzLayout xyz_layout(const sensor_msgs::PointCloud2& cloud);
-
-// The points of `cloud` in row-major order (point index = row * width + column), width and
-// height kept, so an organised cloud stays organised; NaN points (an organised cloud's invalid
-// pixels) stay NaN and the service labels them 0. Viewpoint: the frame's origin (a sensor frame).
-// Throws as xyz_layout.
 PointCloud xyz_from_pointcloud2(const sensor_msgs::PointCloud2& cloud);
 
 }  // namespace primlabel::rosnode

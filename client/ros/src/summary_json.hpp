@@ -1,15 +1,10 @@
 #pragma once
-// The LabelSummary as the node publishes it (std_msgs/String): protobuf's canonical JSON with
-// the .proto field names, every field present, e.g. {"request_id": "...", "frame_id": "camera",
-// "stamp_ns": "1700000000123456789", "class_counts": [...], ...} (64-bit integers are strings in
-// that mapping). No message package to generate, and any ROS tool or language reads it.
+// The summary JSON the node publishes, from the shared bridge (ros_common/summary_json.hpp).
 
-#include <string>
-
-#include "primlabel/v1/labeling.pb.h"
+#include "ros_common/summary_json.hpp"
 
 namespace primlabel::rosnode {
 
-std::string summary_json(const v1::LabelSummary& summary);
+using roscommon::summary_json;
 
 }  // namespace primlabel::rosnode

@@ -1,10 +1,10 @@
-#include "summary_json.hpp"
+#include "ros_common/summary_json.hpp"
 
 #include <google/protobuf/util/json_util.h>
 
 #include <stdexcept>
 
-namespace primlabel::rosnode {
+namespace primlabel::roscommon {
 
 std::string summary_json(const v1::LabelSummary& summary) {
   google::protobuf::util::JsonPrintOptions options;
@@ -16,4 +16,4 @@ std::string summary_json(const v1::LabelSummary& summary) {
   return json;
 }
 
-}  // namespace primlabel::rosnode
+}  // namespace primlabel::roscommon
