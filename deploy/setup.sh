@@ -49,12 +49,14 @@ PACKAGES=(
 # from protoc and protobuf-compiler-grpc's grpc_python_plugin, above) and what pip needs to
 # install it offline into a venv (setuptools, wheel, pip, venv), Open3D for the
 # interoperability check (tests/interop), CGAL for the Efficient RANSAC peer's test
-# (tests/test_cgal_peer), and ROS 1 (roscpp, sensor_msgs, std_msgs and rosmaster) for the ROS
-# node client/ros and its test ros.LabelsPointCloud2.
+# (tests/test_cgal_peer), ROS 1 (roscpp, sensor_msgs, std_msgs and rosmaster) for the ROS
+# node client/ros and its test ros.LabelsPointCloud2, and Cyclone DDS (the C library and the
+# idlc IDL compiler) for the ROS 2 node client/ros2 and its test ros2.LabelsPointCloud2.
 TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl clang-14 libclang-rt-14-dev
   python3-grpcio python3-numpy python3-protobuf python3-pytest python3-open3d libcgal-dev
   python3-setuptools python3-wheel python3-pip python3-venv
-  libroscpp-dev libsensor-msgs-dev libstd-msgs-dev python3-rosmaster)
+  libroscpp-dev libsensor-msgs-dev libstd-msgs-dev python3-rosmaster
+  cyclonedds-dev cyclonedds-tools)
 # The benchmarks' peers: PCL (features, table-top) and CGAL's Efficient RANSAC (primitives).
 [[ "${PRIMLABEL_WITH_PCL:-0}" == 1 ]] && PACKAGES+=(libpcl-dev libcgal-dev)
 [[ "${1:-}" == test ]] && PACKAGES+=("${TEST_PACKAGES[@]}")
