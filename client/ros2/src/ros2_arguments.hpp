@@ -1,6 +1,6 @@
 #pragma once
 // The node's command line as a ROS 2 user writes it for any node:
-//   primlabel-ros2 --ros-args -p server:=labeler:50051 -p model:=tabletop-kinect \
+//   primlabel-ros2 --ros-args -p server:=labeler:50051 -p model:=tabletop-kinect
 //       -r __ns:=/robot -r points:=/camera/depth/points -p domain_id:=7
 // `-p name:=value` sets a parameter (the ROS 1 node's, ros_common/node_parameters.hpp, plus
 // domain_id), `-r __ns:=/ns` and `-r __node:=name` set the namespace and node name, `-r from:=to`

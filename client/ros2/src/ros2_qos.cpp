@@ -9,9 +9,20 @@ Qos profile(dds_reliability_kind_t reliability, int depth) {
   dds_qset_reliability(qos.get(), reliability, DDS_MSECS(100));
   dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, depth);
   dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);
-  // Plain CDR (XCDR1), the representation rmw_cyclonedds uses for ROS 2 messages.
+  return qos;
+}
+
+// A writer sends plain CDR (XCDR1), as rmw_cyclonedds does for ROS 2 messages; a reader takes
+// that and XCDR2, so a peer on a newer DDS that offers XCDR2 still matches.
+Qos writing(Qos qos) {
   const dds_data_representation_id_t xcdr1[] = {DDS_DATA_REPRESENTATION_XCDR1};
   dds_qset_data_representation(qos.get(), 1, xcdr1);
+  return qos;
+}
+Qos reading(Qos qos) {
+  const dds_data_representation_id_t either[] = {DDS_DATA_REPRESENTATION_XCDR1,
+                                                 DDS_DATA_REPRESENTATION_XCDR2};
+  dds_qset_data_representation(qos.get(), 2, either);
   return qos;
 }
 
@@ -19,7 +30,7 @@ Qos profile(dds_reliability_kind_t reliability, int depth) {
 
 Qos sensor_data_qos() { return profile(DDS_RELIABILITY_BEST_EFFORT, 5); }
 Qos default_qos() { return profile(DDS_RELIABILITY_RELIABLE, 10); }
-Qos input_reader_qos() { return profile(DDS_RELIABILITY_BEST_EFFORT, 1); }
-Qos output_writer_qos() { return profile(DDS_RELIABILITY_RELIABLE, 1); }
+Qos input_reader_qos() { return reading(profile(DDS_RELIABILITY_BEST_EFFORT, 1)); }
+Qos output_writer_qos() { return writing(profile(DDS_RELIABILITY_RELIABLE, 1)); }
 
 }  // namespace primlabel::ros2node
