@@ -17,8 +17,10 @@ COMMAND_PACKAGES = {
     "rosnode": "python3-rosnode",
     "rosparam": "python3-rosparam",
     "rosmaster": "python3-rosmaster",
+    "idlc": "cyclonedds-tools",
+    "ddsperf": "cyclonedds-tools",
 }
-PAGES = ["client/ros/README.md"]
+PAGES = ["client/ros/README.md", "client/ros2/README.md"]
 
 
 def sh_lines(text):
