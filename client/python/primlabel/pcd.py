@@ -9,7 +9,9 @@ binary and binary_compressed; written as ascii, binary or binary_compressed (LZF
 Field mapping: x y z -> xyz; normal_x normal_y normal_z -> normals; curvature; label -> label
 (uint32; must be integers in 0..2^32-1); rgb / rgba -> rgb (uint32, the 4 bytes bit for bit, as
 PCL packs 0xAARRGGBB); every other field -> fields[name], (N,) for COUNT 1 and (N, COUNT)
-otherwise, in its stored type. "_" padding fields are skipped. Every size the header declares is
+otherwise, in its stored type; COUNT 1 columns name_0 .. name_k beside a field `name` of COUNT
+k + 1 are its copies for one-value-per-field readers (Open3D), which write() adds and read() folds
+back. "_" padding fields are skipped. Every size the header declares is
 checked against the bytes really in the file before anything proportional to it is allocated.
 """
 
@@ -361,8 +363,20 @@ def read(path: str) -> PointCloud:
         if colour in by_name:
             cloud.rgb = take(colour).view(np.uint32) if len(cloud.xyz) else np.zeros(0, np.uint32)
     for name, values in by_name.items():
+        if _is_scalar_copy(name, kinds):
+            continue
         cloud.fields[name] = values[:, 0] if kinds[name].count == 1 else values
     return cloud
+
+
+def _is_scalar_copy(name: str, kinds: dict) -> bool:
+    """name_e of COUNT 1 beside a field `name` of more than e values: one of the columns a
+    multi-value field is also written as (for readers such as Open3D that take one value per
+    field), read back as part of that field."""
+    base, _, element = name.rpartition("_")
+    if kinds[name].count != 1 or not base or not element.isdigit():
+        return False
+    return base in kinds and kinds[base].count > int(element)
 
 
 def _labels(path: str, values: np.ndarray) -> np.ndarray:
@@ -429,6 +443,12 @@ def _output_columns(path: str, cloud: PointCloud) -> list:
     for name in names:
         if names.count(name) > 1:
             raise PcdError(f"{path}: field '{name}' would be written twice")
+    # A multi-value field (fpfh, COUNT 33) also as columns fpfh_0 .. fpfh_32, as core/geometry
+    # writes it: Open3D keeps only the first value of a COUNT > 1 field.
+    for name, values in list(out):
+        copies = [f"{name}_{e}" for e in range(values.shape[1])]
+        if values.shape[1] > 1 and not any(c in names for c in copies):
+            out += [(c, values[:, e : e + 1]) for e, c in enumerate(copies)]
     return out
 
 

@@ -58,6 +58,23 @@ def test_round_trip_keeps_every_field_exactly(tmp_path, encoding):
     assert f"DATA {encoding}\n" in path.read_bytes().decode("latin-1")
 
 
+def test_multi_value_fields_are_also_written_as_columns_and_folded_back(tmp_path):
+    cloud = pcd.PointCloud(xyz=np.zeros((2, 3), np.float32))
+    cloud.fields["fpfh"] = np.arange(6, dtype=np.float32).reshape(2, 3)
+    path = tmp_path / "columns.pcd"
+    pcd.write(path, cloud, encoding="ascii")
+    text = path.read_text()
+    assert "FIELDS x y z fpfh fpfh_0 fpfh_1 fpfh_2\n" in text
+    assert "\n0 0 0 0 1 2 0 1 2\n0 0 0 3 4 5 3 4 5\n" in text
+    back = pcd.read(path)
+    assert list(back.fields) == ["fpfh"]
+    np.testing.assert_array_equal(back.fields["fpfh"], cloud.fields["fpfh"])
+    # A column beyond the field's COUNT is a field of its own.
+    path.write_text("VERSION 0.7\nFIELDS x y z h h_1 h_2\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\n"
+                    "COUNT 1 1 1 2 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n0 0 0 1 2 2 9\n")
+    assert list(pcd.read(path).fields) == ["h", "h_2"]
+
+
 def test_bun0_ascii_as_the_file_says():
     cloud = pcd.read(TEST_DATA / "samples" / "bun0.pcd")
     assert len(cloud) == 397 and not cloud.organized and cloud.width == 397
