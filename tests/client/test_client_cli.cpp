@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "common/class_fields.hpp"
 #include "common/human_format.hpp"
 #include "common/server_address.hpp"
 #include "fake_labeler.hpp"
@@ -45,6 +46,23 @@ std::string read_text(const std::string& path) {
 
 // An address nothing listens on.
 std::string dead_address() { return FakeServer().address(); }
+
+// The per-class field names, case by case as the Python client checks them too.
+TEST(ClassFields, ProbabilityFieldNamesAsTheSharedCasesSay) {
+  std::ifstream in(test::test_data("probability_field_names.tsv"));
+  ASSERT_TRUE(in.good());
+  int cases = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    const std::size_t a = line.find('\t'), b = line.find('\t', a + 1);
+    ASSERT_NE(b, std::string::npos) << line;
+    const std::string name = line.substr(0, a), expected = line.substr(b + 1);
+    const auto id = static_cast<std::uint32_t>(std::stoul(line.substr(a + 1, b - a - 1)));
+    EXPECT_EQ(client::tools::probability_field_name(name, id), expected) << line;
+    ++cases;
+  }
+  EXPECT_GE(cases, 5);
+}
 
 TEST(ClientCli, HelpListsTheExitCodes) {
   const auto r = test::run_command(cli() + " --help");

@@ -379,16 +379,25 @@ def _is_scalar_copy(name: str, kinds: dict) -> bool:
     return base in kinds and kinds[base].count > int(element)
 
 
-def _labels(path: str, values: np.ndarray) -> np.ndarray:
+def checked_labels(values: np.ndarray, fail) -> np.ndarray:
+    """`values` as uint32 labels; fail(i, value) raises for the first one that is not an integer
+    in 0..4294967295 (the PCD and the PLY readers word it their way)."""
     with np.errstate(invalid="ignore"):
         representable = (values >= 0) & (values <= 0xFFFFFFFF)
         if values.dtype.kind == "f":
             representable &= np.trunc(values) == values
     if not representable.all():
         i = int(np.argmin(representable))
-        raise PcdError(f"{path}: field 'label' of point {i}: value {values[i]} is not a label "
-                       "(an integer in 0..4294967295)")
+        fail(i, values[i])
     return values.astype(np.uint32)
+
+
+def _labels(path: str, values: np.ndarray) -> np.ndarray:
+    def fail(i, value):
+        raise PcdError(f"{path}: field 'label' of point {i}: value {value} is not a label "
+                       "(an integer in 0..4294967295)")
+
+    return checked_labels(values, fail)
 
 
 # ---------------------------------------------------------------------------------------------

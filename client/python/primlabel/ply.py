@@ -22,7 +22,7 @@ import re
 
 import numpy as np
 
-from .pcd import PointCloud
+from .pcd import PointCloud, checked_labels
 
 _TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
@@ -303,15 +303,11 @@ def _ascii_vertices(path: str, elements: list, vertex_index: int, data: bytes) -
 
 
 def _labels(path: str, values: np.ndarray) -> np.ndarray:
-    with np.errstate(invalid="ignore"):
-        representable = (values >= 0) & (values <= 0xFFFFFFFF)
-        if values.dtype.kind == "f":
-            representable &= np.trunc(values) == values
-    if not representable.all():
-        i = int(np.argmin(representable))
-        raise PlyError(f"{path}: property 'label' of vertex {i}: value {values[i]} is not a "
-                       "label (an integer in 0..4294967295)")
-    return values.astype(np.uint32)
+    def fail(i, value):
+        raise PlyError(f"{path}: property 'label' of vertex {i}: value {value} is not a label "
+                       "(an integer in 0..4294967295)")
+
+    return checked_labels(values, fail)
 
 
 def read(path) -> PointCloud:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import time
 import warnings
 from concurrent import futures
+from pathlib import Path
 
 import grpc
 import numpy as np
@@ -122,6 +123,19 @@ def fake():
 
 def points(n: int) -> np.ndarray:
     return np.random.default_rng(1).uniform(-1, 1, (n, 3))
+
+
+def test_probability_field_names_as_the_shared_cases_say():
+    """The cases tests/client/test_client_cli.cpp checks against the C++ spelling."""
+    cases = Path(__file__).resolve().parents[3] / "tests/data/probability_field_names.tsv"
+    checked = 0
+    for line in cases.read_text(encoding="utf-8").splitlines():
+        if not line or line.startswith("#"):
+            continue
+        name, class_id, expected = line.split("\t")
+        assert primlabel.probability_field_name(name, int(class_id)) == expected, line
+        checked += 1
+    assert checked >= 5
 
 
 def test_chunks_in_any_order_are_put_back_by_first_point(fake):

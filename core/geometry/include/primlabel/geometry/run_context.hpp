@@ -15,8 +15,10 @@ namespace primlabel {
 struct RunContext {
   int threads = 0;  // 0 = OpenMP default; results do not depend on it
   // Checked per block of work; a stopped call skips what is left and throws Cancelled.
-  std::stop_token stop;
-  ProgressFn progress;  // may be empty; called from one thread at a time
+  // Braced defaults: RunContext{threads} then leaves them empty without a missing-initializer
+  // warning.
+  std::stop_token stop{};
+  ProgressFn progress{};  // may be empty; called from one thread at a time
 
   bool stopped() const { return stop.stop_requested(); }
   // Throws Cancelled("<what> cancelled") once stopped.
