@@ -256,19 +256,26 @@ def _ascii_columns(path: str, header: _Header, data: bytes) -> list:
             columns.append(None)
             continue
         try:
-            if f.kind == "F":
-                values = text.astype(f.dtype)
-            else:  # via a wide integer, so out-of-range values are caught, not wrapped
-                wide = text.astype(np.int64 if f.kind == "I" else np.uint64)
-                info = np.iinfo(f.dtype)
-                if wide.size and (wide.min() < info.min or wide.max() > info.max):
-                    raise ValueError("out of range")
-                values = wide.astype(f.dtype)
+            values = ascii_values(text, f.dtype)
         except ValueError:
             raise PcdError(f"{path}: a value of field '{f.name}' is not a valid "
                            f"{f.kind} {f.size} number") from None
         columns.append(values)
     return columns
+
+
+def ascii_values(text: np.ndarray, dtype) -> np.ndarray:
+    """Byte-string tokens as numbers of `dtype`; ValueError for a token that is not one, or an
+    integer out of the type's range (read through a wide integer, so it is caught, not wrapped).
+    The PCD and the PLY readers' ascii bodies."""
+    dtype = np.dtype(dtype)
+    if dtype.kind == "f":
+        return text.astype(dtype)
+    wide = text.astype(np.int64 if dtype.kind == "i" else np.uint64)
+    info = np.iinfo(dtype)
+    if wide.size and (wide.min() < info.min or wide.max() > info.max):
+        raise ValueError("out of range")
+    return wide.astype(dtype)
 
 
 def _binary_columns(path: str, header: _Header, data: bytes) -> list:

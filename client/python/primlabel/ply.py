@@ -22,7 +22,7 @@ import re
 
 import numpy as np
 
-from .pcd import PointCloud, checked_labels
+from .pcd import PointCloud, ascii_values, checked_labels
 
 _TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
@@ -284,14 +284,7 @@ def _ascii_vertices(path: str, elements: list, vertex_index: int, data: bytes) -
     for i, p in enumerate(scalars):
         text = table[:, i]
         try:
-            if p.kind[0] == "f":
-                values = text.astype(p.kind)
-            else:  # via a wide integer, so out-of-range values are caught, not wrapped
-                wide = text.astype(np.int64 if p.kind[0] == "i" else np.uint64)
-                info = np.iinfo(p.kind)
-                if wide.size and (wide.min() < info.min or wide.max() > info.max):
-                    raise ValueError("out of range")
-                values = wide.astype(p.kind)
+            values = ascii_values(text, p.kind)
         except ValueError:
             raise PlyError(f"{path}: a value of vertex property '{p.name}' is not a valid "
                            f"{p.kind}") from None
