@@ -1,5 +1,5 @@
 // primlabel-bench can-radii: on real mOSD scenes, the radius of each can as the labeling service
-// would report it against the fitted ground truth (research/mosd_truth.hpp). Each scene is
+// would report it against the fitted ground truth (synth/fitted_truth.hpp). Each scene is
 // labeled table-top only with objects and primitives (what a robot asks for); each object segment
 // the truth fits as a cylinder is matched to the table-top object holding most of its points,
 // and that object's largest cylinder primitive gives our radius. Prints a row per can (scene,
@@ -24,7 +24,7 @@
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/pipeline/labeling.hpp"
-#include "primlabel/research/mosd_truth.hpp"
+#include "primlabel/synth/fitted_truth.hpp"
 
 namespace {
 
@@ -79,8 +79,8 @@ std::vector<CanRow> scene_cans(const LabelModel& model, const std::string& path,
                                const RunContext& context) {
   PointCloud cloud = read_cloud(path);
   if (!cloud.has_labels()) throw std::runtime_error(path + ": no label field");
-  const std::vector<int> segments = research::mosd_segments(cloud.labels);
-  const research::ObjectTruth truth = research::fit_object_truth(cloud, segments, {}, context);
+  const std::vector<int> segments = synth::mosd_segments(cloud.labels);
+  const synth::ObjectTruth truth = synth::fit_object_truth(cloud, segments, {}, context);
 
   pipeline::LabelingOptions options;
   options.tabletop_only = true;
@@ -91,14 +91,14 @@ std::vector<CanRow> scene_cans(const LabelModel& model, const std::string& path,
   const auto& primitives = result.primitives->primitives;
 
   std::vector<CanRow> rows;
-  for (const research::FittedObject& fitted : truth.objects) {
-    if (fitted.kind != research::FittedKind::kUprightCylinder &&
-        fitted.kind != research::FittedKind::kLyingCylinder)
+  for (const synth::FittedObject& fitted : truth.objects) {
+    if (fitted.kind != synth::FittedKind::kUprightCylinder &&
+        fitted.kind != synth::FittedKind::kLyingCylinder)
       continue;
     CanRow row;
     row.scene = std::filesystem::path(path).stem().string();
     row.segment = fitted.segment;
-    row.kind = std::string(research::fitted_kind_name(fitted.kind));
+    row.kind = std::string(synth::fitted_kind_name(fitted.kind));
     row.truth_radius = fitted.size.x();
     row.truth_length = fitted.size.y();
     row.truth_rms = fitted.rms;

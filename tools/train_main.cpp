@@ -41,6 +41,7 @@ struct Arguments {
   float feature_sample = 0.0f;     // > 0: FPFH against one point per voxel of this edge
   std::vector<float> extra_radii;  // --extra-radii: the descriptor at further scales
   bool surface_variation_features = false;  // --surface-variation
+  bool shape_evidence = false;              // --shape-evidence
   std::vector<std::string> train_files, val_files;
   std::string sensor_name;  // --sensor-name: the sensor of --train files
   // --train with an explicit --synth-train: the synthetic scenes are trained on beside the files.
@@ -126,6 +127,7 @@ int run(const Arguments& args) {
   features.feature_sample_size = args.feature_sample;
   features.extra_feature_radii = args.extra_radii;
   features.surface_variation_features = args.surface_variation_features;
+  features.shape_evidence = args.shape_evidence;
   crf::GraphSettings graph;
   graph.neighborhood = Neighborhood::Knn(args.graph_k);
 
@@ -288,6 +290,9 @@ int main(int argc, char** argv) {
   app.add_flag("--surface-variation", args.surface_variation_features,
                "multi-scale model input: also each point's surface variation at the normal, "
                "feature and extra radii (FPFH only)");
+  app.add_flag("--shape-evidence", args.shape_evidence,
+               "model input: also the class the box or cylinder fitted to each table-top object "
+               "gives its points (the taxonomy's rule on the fitted shape; zeros where none fits)");
   app.add_option("--graph-k", args.graph_k, "CRF graph: K nearest neighbours (default 8)")
       ->check(CLI::PositiveNumber);
   app.add_option("--augment", args.augment,

@@ -138,6 +138,7 @@ TEST(LabelModel, AFileWrittenBeforeTheRunContextLoadsUnchanged) {
   EXPECT_EQ(m.weights.node_weights(1, 2), 0.01f * float((37 + 22) % 23) - 0.1f);
   EXPECT_EQ(m.weights.edge_weights(2, 4), 0.002f * float((10 + 12) % 7));
   EXPECT_EQ(m.training.class_balance, 0.0);  // older files: the unweighted objective
+  EXPECT_FALSE(m.features.shape_evidence);     // older files: no shape evidence
   EXPECT_TRUE(m.training.class_weights.empty());
   std::ifstream in(path, std::ios::binary);
   const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

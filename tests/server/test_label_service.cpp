@@ -105,6 +105,38 @@ TEST(LabelService, SvmModelsLabelAsInProcess) {
   EXPECT_GT(answer.summary->points_labeled(), cloud.size() / 2);
 }
 
+// A model that takes shape evidence (the table-top objects fitted with boxes and cylinders) labels
+// through the service exactly as in process, and the evidence is what it weighs: the same weights
+// without it label otherwise.
+TEST(LabelService, ShapeEvidenceModelsLabelAsInProcess) {
+  LabelModel model = random_label_model("shapes", "1");
+  model.features.shape_evidence = true;
+  model.weights = crf::CrfModel::zeros(model.class_ids(), kFpfhSize + kShapeEvidenceDim);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> uniform(-4.0f, 4.0f);
+  for (Eigen::Index r = 0; r < model.weights.node_weights.rows(); ++r)
+    for (Eigen::Index c = 0; c < model.weights.node_weights.cols(); ++c)
+      model.weights.node_weights(r, c) = uniform(rng);
+  TestServer server({model});
+  const PointCloud cloud = table_with_box_cloud(0.01f);
+  const LabelAnswer answer =
+      label_stream(*server.stub, scan_requests(cloud, header_for("shapes"), 1000));
+  ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+  const std::vector<std::uint32_t> in_process = reference_labels(model, cloud);
+  EXPECT_EQ(answer.labels, in_process);
+  LabelModel blind = model;
+  blind.features.shape_evidence = false;
+  blind.weights.descriptor_dim = kFpfhSize;
+  const int knots = static_cast<int>(blind.weights.node_knots.size());
+  const int per_value = knots ? knots : 1;
+  Eigen::MatrixXf kept(model.weights.node_weights.rows(), kFpfhSize * per_value + 1);
+  kept << model.weights.node_weights.leftCols(kFpfhSize * per_value),
+      model.weights.node_weights.rightCols(1);
+  blind.weights.node_weights = kept;
+  blind.weights.edge_weights = Eigen::MatrixXf::Zero(kept.rows(), kFpfhSize + 1);
+  EXPECT_NE(reference_labels(blind, cloud), in_process) << "the evidence changes labels";
+}
+
 // The plane cascade is the service's default (LabelOptions.every_point turns it off): a model
 // that recorded its training scans' noise labels the planar points of a noisy table plane without
 // describing them, LabelSummary.cascaded_points counts them, and the labels are label_cloud's

@@ -1,4 +1,4 @@
-// The fitted ground truth (primlabel/research/mosd_truth.hpp): synthetic objects scanned by the
+// The fitted ground truth (primlabel/synth/fitted_truth.hpp): synthetic objects scanned by the
 // Kinect model are recovered as the shapes they are, the fitted labels agree with the synthetic
 // labels, and real mOSD scenes get a model per segment.
 
@@ -9,7 +9,7 @@
 
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
-#include "primlabel/research/mosd_truth.hpp"
+#include "primlabel/synth/fitted_truth.hpp"
 #include "primlabel/research/truth_check.hpp"
 #include "primlabel/synth/scanners.hpp"
 #include "primlabel/synth/scene.hpp"

@@ -29,7 +29,7 @@ struct Arguments {
   std::string dir, model, truth_dir;
   std::vector<std::string> scenes;
   bool object_truth = false, tabletop_only = false, json = false, quiet = false;
-  double truth_radius = research::ObjectTruthOptions{}.label_radius;
+  double truth_radius = synth::ObjectTruthOptions{}.label_radius;
   int threads = 0;
 };
 

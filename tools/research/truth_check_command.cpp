@@ -18,7 +18,7 @@ using namespace primlabel;
 
 struct Arguments {
   int scenes = 0;
-  double truth_radius = research::ObjectTruthOptions{}.label_radius;
+  double truth_radius = synth::ObjectTruthOptions{}.label_radius;
   bool json = false;
   int threads = 0;
 };

@@ -29,7 +29,7 @@ using namespace primlabel;
 struct Arguments {
   std::string dir;
   std::vector<std::string> scenes;
-  double truth_radius = research::ObjectTruthOptions{}.label_radius;
+  double truth_radius = synth::ObjectTruthOptions{}.label_radius;
   int threads = 0;
 };
 
@@ -50,9 +50,9 @@ int run_write_truth(const Arguments& args) {
     std::printf(
         "%s: %zu segments: %zu box, %zu upright cylinder, %zu lying cylinder, %zu "
         "unfitted; %llu of %llu object points labeled; wrote %s\n",
-        path.c_str(), t.objects.size(), t.count(research::FittedKind::kBox),
-        t.count(research::FittedKind::kUprightCylinder),
-        t.count(research::FittedKind::kLyingCylinder), t.count(research::FittedKind::kUnfitted),
+        path.c_str(), t.objects.size(), t.count(synth::FittedKind::kBox),
+        t.count(synth::FittedKind::kUprightCylinder),
+        t.count(synth::FittedKind::kLyingCylinder), t.count(synth::FittedKind::kUnfitted),
         static_cast<unsigned long long>(t.truth_points),
         static_cast<unsigned long long>(t.object_points), t.truth_file.c_str());
     json::Json scene = research::object_truth_json(t, true);

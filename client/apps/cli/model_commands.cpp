@@ -73,6 +73,9 @@ int run_info(Client& client, const std::string& model, const std::string& versio
                 scales.empty() ? "none" : scales.c_str(),
                 f.surface_variation_features() ? "yes" : "no");
   }
+  if (f.shape_evidence())
+    std::printf("shape      evidence: the class of each point on the box or cylinder fitted to "
+                "its table-top object, one more value a class\n");
   std::printf("graph      k %u, radius %g\n", m.graph().k(), m.graph().radius());
   // No validation points: no accuracy and no F1 to show, not 0 or nan.
   const bool validated = m.validation().points() > 0;

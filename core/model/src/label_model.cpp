@@ -109,6 +109,7 @@ v1::Model to_proto(const LabelModel& m) {
   f->set_radii_overridable(m.features.radii_overridable);
   for (float r : m.features.extra_feature_radii) f->add_extra_feature_radii(r);
   f->set_surface_variation_features(m.features.surface_variation_features);
+  f->set_shape_evidence(m.features.shape_evidence);
 
   v1::GraphParameters* g = out.mutable_graph();
   set_neighborhood(m.graph.neighborhood, &radius, &k, &max_nn);
@@ -220,6 +221,7 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
   m.features.extra_feature_radii.assign(f.extra_feature_radii().begin(),
                                         f.extra_feature_radii().end());
   m.features.surface_variation_features = f.surface_variation_features();
+  m.features.shape_evidence = f.shape_evidence();
   if (m.features.extra_feature_radii.size() > kMaxExtraFeatureRadii)
     fail(source, "more than " + std::to_string(kMaxExtraFeatureRadii) + " extra feature radii");
   for (float r : m.features.extra_feature_radii)

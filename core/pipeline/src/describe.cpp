@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "multi_scale_input.hpp"
+#include "primlabel/pipeline/shape_evidence.hpp"
 #include "plane_cascade.hpp"
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/normals.hpp"
@@ -159,6 +160,11 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   out.descriptors = multi_scale_input(cloud, std::move(out.descriptors), settings, *out.search,
                                       !options.use_cloud_normals, wanted, stage);
   out.seconds.descriptors = seconds_since(start);
+  if (settings.shape_evidence) {
+    const auto shapes_start = std::chrono::steady_clock::now();
+    out.descriptors = with_shape_evidence(cloud, std::move(out.descriptors), stage);
+    out.seconds.shapes = seconds_since(shapes_start);
+  }
   return out;
 }
 

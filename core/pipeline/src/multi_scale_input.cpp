@@ -113,7 +113,7 @@ Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
     for (float radius : settings.extra_feature_radii) variations.push_back(at(radius));
   }
 
-  const int dim = settings.model_input_dim();
+  const int dim = settings.scale_input_dim();
   Descriptors out = Descriptors::filled(n, dim, std::numeric_limits<float>::quiet_NaN());
   for (std::size_t i = 0; i < n; ++i) {
     if (!std::isfinite(blocks[0].row(i)[0])) continue;  // no descriptor: stays invalid

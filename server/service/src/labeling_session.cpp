@@ -122,7 +122,9 @@ std::optional<ServiceError> LabelingSession::outcome() {
   const double search = seconds.index + seconds.lists;
   const bool own_normals = plan_.options.use_cloud_normals;
   stages.normals = seconds.normals + (own_normals ? 0.0 : search);
-  stages.features = seconds.cascade + seconds.descriptors + (own_normals ? search : 0.0);
+  // Shape evidence is model input too: with the features.
+  stages.features =
+      seconds.cascade + seconds.descriptors + seconds.shapes + (own_normals ? search : 0.0);
   if (result_.primitives) stages.primitives = seconds.primitives;
   // The rest of the job: graph, inference and the fan-out (never below 0 by rounding).
   stages.inference =

@@ -33,6 +33,9 @@ enum class ModelKind { kCrf, kNodeOnly, kSvm };
 // Further descriptor radii a model may ask for (each costs one more FPFH pass per cloud).
 inline constexpr std::size_t kMaxExtraFeatureRadii = 4;
 enum class DescriptorKind { kFpfh, kPfh };
+// Shape evidence values a point (FeatureSettings::shape_evidence): one per taxonomy class but
+// unknown, in taxonomy id order (column c is class id c + 1).
+inline constexpr int kShapeEvidenceDim = 10;
 
 // How a cloud is described before labeling; the labels are only meaningful for the same settings.
 struct FeatureSettings {
@@ -51,14 +54,23 @@ struct FeatureSettings {
   // still get the descriptor at the feature radius; the CRF sees all of it (model_input_dim).
   std::vector<float> extra_feature_radii;
   bool surface_variation_features = false;
+  // Shape evidence (pipeline/shape_evidence.hpp): the table-top stage's objects are fitted with
+  // boxes and cylinders, and every point a fitted surface explains gets, as kShapeEvidenceDim
+  // more input values, the class the taxonomy's rule gives it on that surface (hidden faces
+  // included). The model learns how far to trust it; points of unfitted objects get zeros.
+  bool shape_evidence = false;
 
   int descriptor_dim() const { return descriptor == DescriptorKind::kFpfh ? kFpfhSize : kPfhSize; }
-  // Values per point the model weighs: the descriptor at every radius, then the variations.
-  int model_input_dim() const {
+  // Values per point from the descriptors: the descriptor at every radius, then the variations.
+  int scale_input_dim() const {
     const int scales = 1 + static_cast<int>(extra_feature_radii.size());
     return descriptor_dim() * scales + (surface_variation_features ? scales + 1 : 0);
   }
-  bool multi_scale() const { return model_input_dim() != descriptor_dim(); }
+  // Values per point the model weighs: the scale input, then the shape evidence.
+  int model_input_dim() const {
+    return scale_input_dim() + (shape_evidence ? kShapeEvidenceDim : 0);
+  }
+  bool multi_scale() const { return scale_input_dim() != descriptor_dim(); }
   // "fpfh", "fpfh_paper" or "pfh": the field name of these descriptors in written clouds.
   std::string descriptor_name() const {
     return descriptor == DescriptorKind::kPfh ? "pfh" : fpfh_field_name(fpfh_variant);

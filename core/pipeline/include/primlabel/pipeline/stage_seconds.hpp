@@ -16,6 +16,7 @@ struct StageSeconds {
   double normals = 0;      // normal estimation (0 with the cloud's own normals)
   double cascade = 0;      // the plane cascade's split (LabelingOptions::plane_cascade)
   double descriptors = 0;  // FPFH / PFH
+  double shapes = 0;       // shape evidence: the objects fitted with boxes and cylinders
   double graph = 0;        // the CRF's neighbourhood graph
   double inference = 0;    // CRF inference, or the SVM point by point
   double fanout = 0;       // carrying the described points' answers to every input point
@@ -29,7 +30,7 @@ struct LabelingStage {
   double StageSeconds::*seconds;
 };
 
-inline constexpr std::array<LabelingStage, 12> kLabelingStages = {{
+inline constexpr std::array<LabelingStage, 13> kLabelingStages = {{
     {"voxels", &StageSeconds::voxels},
     {"tabletop", &StageSeconds::tabletop},
     {"duplicates", &StageSeconds::duplicates},
@@ -38,6 +39,7 @@ inline constexpr std::array<LabelingStage, 12> kLabelingStages = {{
     {"normals", &StageSeconds::normals},
     {"cascade", &StageSeconds::cascade},
     {"descriptors", &StageSeconds::descriptors},
+    {"shapes", &StageSeconds::shapes},
     {"graph", &StageSeconds::graph},
     {"inference", &StageSeconds::inference},
     {"fanout", &StageSeconds::fanout},

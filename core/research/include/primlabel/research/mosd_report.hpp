@@ -10,16 +10,14 @@
 
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/pipeline/labeling.hpp"
-#include "primlabel/research/mosd_truth.hpp"
+#include "primlabel/synth/fitted_truth.hpp"
 #include "primlabel/research/truth_check.hpp"
 #include "primlabel/synth/generate.hpp"
 
 namespace primlabel::research {
 
-inline bool is_mosd_table_label(std::uint32_t label) { return label >= 1 && label <= 9; }
-inline bool is_mosd_object_label(std::uint32_t label) { return label >= 20; }
 
-// The fitted object truth of one scene (mosd_truth.hpp) and, with a model, its scores on it.
+// The fitted object truth of one scene (synth/fitted_truth.hpp) and, with a model, its scores on it.
 struct MosdObjectTruth {
   std::vector<FittedObject> objects;
   std::uint64_t object_points = 0;  // finite points of object segments

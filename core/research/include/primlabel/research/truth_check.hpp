@@ -1,5 +1,5 @@
 #pragma once
-// Scoring against the fitted ground truth (mosd_truth.hpp), and that truth's own error: the same
+// Scoring against the fitted ground truth (synth/fitted_truth.hpp), and that truth's own error: the same
 // fitting and labeling run on held-out synthetic Kinect table scenes, whose true labels are
 // known, compared with them per class.
 
@@ -10,9 +10,21 @@
 
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/geometry/json_text.hpp"
-#include "primlabel/research/mosd_truth.hpp"
+#include "primlabel/synth/fitted_truth.hpp"
 
 namespace primlabel::research {
+
+// The fitted truth lives beside the shapes it fits (primlabel/synth/fitted_truth.hpp).
+using synth::fit_object_truth;
+using synth::fitted_kind_name;
+using synth::FittedKind;
+using synth::FittedObject;
+using synth::is_mosd_object_label;
+using synth::is_mosd_table_label;
+using synth::mosd_segments;
+using synth::ObjectTruth;
+using synth::ObjectTruthOptions;
+using synth::synthetic_segments;
 
 // The taxonomy's classes without unknown (what the truth labels score).
 std::vector<std::uint32_t> scored_class_ids();

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "truth_fit.hpp"
+#include "shape_fit.hpp"
 
-namespace primlabel::research::truth {
+namespace primlabel::synth::fit {
 namespace {
 
 // Among candidate surface points, the nearest one whose surface the point's normal supports
@@ -122,4 +122,4 @@ double quantile(std::vector<double> values, double q) {
   return values[k];
 }
 
-}  // namespace primlabel::research::truth
+}  // namespace primlabel::synth::fit

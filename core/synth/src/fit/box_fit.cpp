@@ -6,9 +6,9 @@
 #include <cmath>
 
 #include "primlabel/tabletop/plane_fit.hpp"
-#include "truth_fit.hpp"
+#include "shape_fit.hpp"
 
-namespace primlabel::research::truth {
+namespace primlabel::synth::fit {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
@@ -149,4 +149,4 @@ std::optional<FittedObject> fit_box(const SegmentPoints& s, const FitSettings& s
   return box;
 }
 
-}  // namespace primlabel::research::truth
+}  // namespace primlabel::synth::fit

@@ -1,15 +1,15 @@
 #pragma once
-// The pieces of the fitted ground truth (mosd_truth.hpp), in the truth frame (z up, table z = 0).
+// The pieces of the fitted ground truth (synth/fitted_truth.hpp), in the truth frame (z up, table z = 0).
 
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
 #include <vector>
 
-#include "primlabel/research/mosd_truth.hpp"
+#include "primlabel/synth/fitted_truth.hpp"
 #include "primlabel/synth/shapes.hpp"
 
-namespace primlabel::research::truth {
+namespace primlabel::synth::fit {
 
 using Vec3d = Eigen::Vector3d;
 
@@ -73,4 +73,4 @@ struct RulePoint {
 std::vector<std::uint32_t> label_by_rule(const synth::Scene& scene,
                                          const std::vector<RulePoint>& points, double radius);
 
-}  // namespace primlabel::research::truth
+}  // namespace primlabel::synth::fit

@@ -3,9 +3,9 @@
 // truth and the synthetic truth cannot drift apart.
 
 #include "../synth/scan_common.hpp"
-#include "truth_fit.hpp"
+#include "shape_fit.hpp"
 
-namespace primlabel::research::truth {
+namespace primlabel::synth::fit {
 
 std::vector<std::uint32_t> label_by_rule(const synth::Scene& scene,
                                          const std::vector<RulePoint>& points, double radius) {
@@ -27,4 +27,4 @@ std::vector<std::uint32_t> label_by_rule(const synth::Scene& scene,
   return labels;
 }
 
-}  // namespace primlabel::research::truth
+}  // namespace primlabel::synth::fit

@@ -9,9 +9,9 @@
 #include <cmath>
 
 #include "primlabel/synth/random.hpp"
-#include "truth_fit.hpp"
+#include "shape_fit.hpp"
 
-namespace primlabel::research::truth {
+namespace primlabel::synth::fit {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
@@ -239,4 +239,4 @@ std::optional<FittedObject> fit_cylinder(const SegmentPoints& s, const FitSettin
   return out;
 }
 
-}  // namespace primlabel::research::truth
+}  // namespace primlabel::synth::fit

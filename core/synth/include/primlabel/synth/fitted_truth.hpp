@@ -29,7 +29,11 @@
 #include "primlabel/geometry/run_context.hpp"
 #include "primlabel/synth/generate.hpp"
 
-namespace primlabel::research {
+namespace primlabel::synth {
+
+// The mOSD `label` field: 1-9 the table's parts, 20 and above the objects' parts.
+inline bool is_mosd_table_label(std::uint32_t label) { return label >= 1 && label <= 9; }
+inline bool is_mosd_object_label(std::uint32_t label) { return label >= 20; }
 
 enum class FittedKind { kBox, kUprightCylinder, kLyingCylinder, kUnfitted };
 std::string_view fitted_kind_name(FittedKind kind);  // "box", "upright-cylinder", ...
@@ -85,4 +89,4 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
                              const ObjectTruthOptions& options = {},
                              const RunContext& context = {});
 
-}  // namespace primlabel::research
+}  // namespace primlabel::synth

@@ -1,20 +1,19 @@
 // The fitted ground truth of a scene: the table frame, a model per object segment, and the
-// synthetic rule on the fitted scene (mosd_truth.hpp).
+// synthetic rule on the fitted scene (synth/fitted_truth.hpp).
 
 #include <algorithm>
 #include <map>
 #include <stdexcept>
 
 #include "primlabel/geometry/normals.hpp"
-#include "primlabel/research/mosd_report.hpp"
-#include "primlabel/research/mosd_truth.hpp"
+#include "primlabel/synth/fitted_truth.hpp"
 #include "primlabel/tabletop/plane_fit.hpp"
-#include "truth_fit.hpp"
+#include "shape_fit.hpp"
 
-namespace primlabel::research {
+namespace primlabel::synth {
 namespace {
 
-using truth::Vec3d;
+using fit::Vec3d;
 
 // The table plane (MSAC + least squares on the table segment), its normal toward the sensor, as
 // the truth frame: z along the normal, z = 0 on the plane, x along the camera's x axis.
@@ -43,23 +42,23 @@ Eigen::Isometry3d fit_table_frame(const PointCloud& cloud, const std::vector<int
   return cloud_from_table.inverse();
 }
 
-FittedObject choose_model(int segment, const truth::SegmentPoints& points,
+FittedObject choose_model(int segment, const fit::SegmentPoints& points,
                           const ObjectTruthOptions& options) {
-  const truth::FitSettings settings{options.contact_tolerance,
+  const fit::FitSettings settings{options.contact_tolerance,
                                     options.seed + static_cast<std::uint64_t>(segment)};
   FittedObject chosen;
   chosen.segment = segment;
   chosen.points = points.p.size();
   if (points.p.size() < options.min_segment_points) return chosen;
-  const auto box = truth::fit_box(points, settings);
-  const auto cylinder = truth::fit_cylinder(points, settings);
-  truth::Evidence box_evidence, cylinder_evidence;
-  if (box) box_evidence = truth::evaluate(*box, points);
-  if (cylinder) cylinder_evidence = truth::evaluate(*cylinder, points);
+  const auto box = fit::fit_box(points, settings);
+  const auto cylinder = fit::fit_cylinder(points, settings);
+  fit::Evidence box_evidence, cylinder_evidence;
+  if (box) box_evidence = fit::evaluate(*box, points);
+  if (cylinder) cylinder_evidence = fit::evaluate(*cylinder, points);
   const bool take_box = box && (!cylinder || box_evidence.cost <= cylinder_evidence.cost);
   if (box || cylinder) {
     chosen = take_box ? *box : *cylinder;
-    const truth::Evidence& e = take_box ? box_evidence : cylinder_evidence;
+    const fit::Evidence& e = take_box ? box_evidence : cylinder_evidence;
     chosen.inliers = e.inliers;
     chosen.rms = e.rms;
   }
@@ -67,8 +66,8 @@ FittedObject choose_model(int segment, const truth::SegmentPoints& points,
   chosen.points = points.p.size();
   chosen.box_cost = box ? box_evidence.cost : NAN;
   chosen.cylinder_cost = cylinder ? cylinder_evidence.cost : NAN;
-  chosen.bound = truth::quantile(points.bound, 0.5);
-  const double z = truth::quantile(points.depth, 0.5);
+  chosen.bound = fit::quantile(points.bound, 0.5);
+  const double z = fit::quantile(points.depth, 0.5);
   chosen.max_rms = options.rms_base + options.rms_z2 * z * z;
   if (chosen.inlier_share() < options.min_inlier_share || chosen.rms > chosen.max_rms)
     chosen.kind = FittedKind::kUnfitted;
@@ -79,19 +78,19 @@ FittedObject choose_model(int segment, const truth::SegmentPoints& points,
 // solid (deeper than their bound, or facing into it) is part of a vessel's inside (the floor of
 // a pot), not an object of its own.
 void reject_nested(std::vector<FittedObject>& objects,
-                   const std::vector<truth::SegmentPoints>& points) {
+                   const std::vector<fit::SegmentPoints>& points) {
   std::vector<bool> nested(objects.size(), false);
   for (std::size_t a = 0; a < objects.size(); ++a) {
     if (objects[a].kind == FittedKind::kUnfitted) continue;
     for (std::size_t b = 0; b < objects.size() && !nested[a]; ++b) {
       if (a == b || objects[b].kind == FittedKind::kUnfitted) continue;
-      const auto shape = truth::make_shape(objects[b]);
+      const auto shape = fit::make_shape(objects[b]);
       const Eigen::Isometry3d local_from_table = objects[b].table_from_local.inverse();
       std::size_t inside = 0;
       for (std::size_t i = 0; i < points[a].p.size(); ++i) {
         const Vec3d local = local_from_table * points[a].p[i];
         if (shape->distance_outside(local) > 0) continue;
-        const truth::SurfacePoint sp = truth::closest_surface(objects[b], local);
+        const fit::SurfacePoint sp = fit::closest_surface(objects[b], local);
         const Vec3d normal = local_from_table.linear() * points[a].n[i];
         inside += sp.distance > points[a].bound[i] || normal.dot(sp.normal) < -0.5;
       }
@@ -176,9 +175,9 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
   std::map<int, std::vector<std::uint32_t>> members;
   for (std::uint32_t i = 0; i < cloud.size(); ++i)
     if (segments[i] > 0 && is_finite(cloud.xyz[i])) members[segments[i]].push_back(i);
-  std::vector<truth::SegmentPoints> points;
+  std::vector<fit::SegmentPoints> points;
   for (const auto& [segment, indices] : members) {
-    truth::SegmentPoints s;
+    fit::SegmentPoints s;
     s.viewpoint = t * origin;
     for (auto i : indices) {
       s.p.push_back(t * cloud.xyz[i].cast<double>());
@@ -197,7 +196,7 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
   slab.translate(Vec3d(0, 0, -0.04));
   scene.objects.emplace_back(std::make_shared<synth::BoxShape>(Vec3d(20, 20, 0.04)), slab, 0xC8A67A,
                              false);
-  std::vector<truth::RulePoint> rule_points;
+  std::vector<fit::RulePoint> rule_points;
   std::vector<std::uint32_t> rule_index;  // cloud index of each rule point
   for (std::uint32_t i = 0; i < cloud.size(); ++i) {
     if (segments[i] != 0 || !is_finite(cloud.xyz[i])) continue;
@@ -209,14 +208,14 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
   std::size_t k = 0;
   for (const auto& [segment, indices] : members) {
     const FittedObject& object = truth.objects[k];
-    const truth::SegmentPoints& s = points[k++];
+    const fit::SegmentPoints& s = points[k++];
     if (object.kind == FittedKind::kUnfitted) continue;
-    scene.objects.emplace_back(truth::make_shape(object), object.table_from_local, 0x808080,
+    scene.objects.emplace_back(fit::make_shape(object), object.table_from_local, 0x808080,
                                object.on_table);
     const int index = static_cast<int>(scene.objects.size()) - 1;
     const Eigen::Isometry3d local_from_table = object.table_from_local.inverse();
     for (std::size_t j = 0; j < indices.size(); ++j) {
-      const truth::SurfacePoint sp = truth::closest_surface(object, local_from_table * s.p[j],
+      const fit::SurfacePoint sp = fit::closest_surface(object, local_from_table * s.p[j],
                                                             local_from_table.linear() * s.n[j]);
       if (sp.distance >= s.bound[j]) continue;
       rule_points.push_back({index, sp.part, object.table_from_local * sp.point});
@@ -224,9 +223,9 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
     }
   }
   const std::vector<std::uint32_t> labels =
-      truth::label_by_rule(scene, rule_points, options.label_radius);
+      fit::label_by_rule(scene, rule_points, options.label_radius);
   for (std::size_t j = 0; j < labels.size(); ++j) truth.labels[rule_index[j]] = labels[j];
   return truth;
 }
 
-}  // namespace primlabel::research
+}  // namespace primlabel::synth
