@@ -1,7 +1,8 @@
 // primlabel::ros2node::LabelingComponent: the labeling bridge (client/ros_common) as an rclcpp
 // component, for a ROS 2 installation (client/ros2/README.md). The same parameters, topics,
-// fields and summary as primlabel-ros2; ROS 2's own parameters, names and QoS instead of the
-// node's DDS plumbing. Not built on Debian 12 (no rclcpp) and so not verified there.
+// fields, summary and QoS overrides as primlabel-ros2; ROS 2's own parameters (files, -p,
+// use_sim_time), names, logging, graph and QoS instead of the node's DDS plumbing. Not built on
+// Debian 12 (no rclcpp) and so not verified there.
 
 #include <exception>
 #include <memory>
@@ -69,14 +70,24 @@ class LabelingComponent : public rclcpp::Node {
         labeler_(parameters_) {
     // Reliable output matches default and sensor-data subscribers; best-effort input, keep last 1
     // matches either publisher and skips scans rather than falling behind (as primlabel-ros2).
+    // The same qos_overrides.<topic>.<publisher|subscription>.<policy> parameters as
+    // primlabel-ros2 change them (e.g. reliable input for a reliable publisher's large frames).
+    const rclcpp::QosOverridingOptions overridable(
+        {rclcpp::QosPolicyKind::Reliability, rclcpp::QosPolicyKind::History,
+         rclcpp::QosPolicyKind::Depth, rclcpp::QosPolicyKind::Durability});
+    rclcpp::PublisherOptions publisher_options;
+    publisher_options.qos_overriding_options = overridable;
+    rclcpp::SubscriptionOptions subscription_options;
+    subscription_options.qos_overriding_options = overridable;
     const rclcpp::QoS output_qos = rclcpp::QoS(rclcpp::KeepLast(1)).reliable();
-    cloud_publisher_ =
-        create_publisher<sensor_msgs::msg::PointCloud2>(parameters_.output_topic, output_qos);
-    summary_publisher_ =
-        create_publisher<std_msgs::msg::String>(parameters_.summary_topic, output_qos);
+    cloud_publisher_ = create_publisher<sensor_msgs::msg::PointCloud2>(
+        parameters_.output_topic, output_qos, publisher_options);
+    summary_publisher_ = create_publisher<std_msgs::msg::String>(parameters_.summary_topic,
+                                                                 output_qos, publisher_options);
     subscription_ = create_subscription<sensor_msgs::msg::PointCloud2>(
         parameters_.input_topic, rclcpp::SensorDataQoS().keep_last(1),
-        [this](sensor_msgs::msg::PointCloud2::ConstSharedPtr cloud) { on_cloud(*cloud); });
+        [this](sensor_msgs::msg::PointCloud2::ConstSharedPtr cloud) { on_cloud(*cloud); },
+        subscription_options);
     RCLCPP_INFO(get_logger(), "labeling %s -> %s (summary %s) through %s: %s",
                 subscription_->get_topic_name(), cloud_publisher_->get_topic_name(),
                 summary_publisher_->get_topic_name(), parameters_.server.c_str(),

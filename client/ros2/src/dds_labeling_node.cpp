@@ -6,6 +6,7 @@
 #include "pointcloud2_dds.hpp"
 #include "ros2_qos.hpp"
 #include "std_msgs/msg/String.h"
+#include "type_hash.hpp"
 
 namespace primlabel::ros2node {
 
@@ -22,8 +23,17 @@ dds_entity_t topic(dds_entity_t participant, const dds_topic_descriptor_t* type,
 DdsLabelingNode::DdsLabelingNode(const Ros2Settings& settings)
     : settings_(settings), labeler_(settings.parameters) {
   const roscommon::NodeParameters& p = settings.parameters;
+  const std::string domain = "DDS domain " + std::to_string(settings.domain_id);
+  if (!settings.dds_config.empty())
+    domain_ = DdsEntity(checked(dds_create_domain(settings.domain_id, settings.dds_config.c_str()),
+                                domain + " (configuration from the ROS 2 discovery variables and "
+                                         "CYCLONEDDS_URI)"));
+  // rmw_cyclonedds names the participant's security enclave in its USER_DATA.
+  const Qos participant_qos(dds_create_qos());
+  const std::string enclave = "enclave=/;";
+  dds_qset_userdata(participant_qos.get(), enclave.data(), enclave.size());
   participant_ =
-      DdsEntity(checked(dds_create_participant(settings.domain_id, nullptr, nullptr),
+      DdsEntity(checked(dds_create_participant(settings.domain_id, participant_qos.get(), nullptr),
                         "DDS participant on domain " + std::to_string(settings.domain_id)));
   const std::string input = dds_topic(settings, p.input_topic);
   const std::string output = dds_topic(settings, p.output_topic);
@@ -36,28 +46,48 @@ DdsLabelingNode::DdsLabelingNode(const Ros2Settings& settings)
   const dds_entity_t summary_topic =
       topic(participant_.get(), &std_msgs_msg_dds__String__desc, summary);
 
-  const Qos reader_qos = input_reader_qos();
-  const Qos writer_qos = output_writer_qos();
+  const Qos reader_qos = input_reader_qos(settings.input_qos);
+  const Qos cloud_qos = output_writer_qos(settings.output_qos);
+  const Qos summary_qos = output_writer_qos(settings.summary_qos);
+  if (!settings.humble_graph) {  // Iron and later: each endpoint names its type's hash
+    set_type_hash(reader_qos.get(), point_cloud2_type_hash());
+    set_type_hash(cloud_qos.get(), point_cloud2_type_hash());
+    set_type_hash(summary_qos.get(), string_type_hash());
+  }
   reader_ = DdsEntity(
       checked(dds_create_reader(participant_.get(), input_topic, reader_qos.get(), nullptr),
               "DDS reader on " + input));
   cloud_writer_ = DdsEntity(
-      checked(dds_create_writer(participant_.get(), output_topic, writer_qos.get(), nullptr),
+      checked(dds_create_writer(participant_.get(), output_topic, cloud_qos.get(), nullptr),
               "DDS writer on " + output));
   summary_writer_ = DdsEntity(
-      checked(dds_create_writer(participant_.get(), summary_topic, writer_qos.get(), nullptr),
+      checked(dds_create_writer(participant_.get(), summary_topic, summary_qos.get(), nullptr),
               "DDS writer on " + summary));
   waitset_ = DdsEntity(checked(dds_create_waitset(participant_.get()), "DDS waitset"));
   data_available_ = DdsEntity(
       checked(dds_create_readcondition(reader_.get(), DDS_ANY_STATE), "DDS read condition"));
   checked(dds_waitset_attach(waitset_.get(), data_available_.get(), 0), "DDS waitset attach");
+  discovery_info_ = std::make_unique<RosDiscoveryInfo>(participant_.get(), settings.humble_graph);
+  discovery_info_->announce(settings.node_namespace, settings.node_name, {reader_.get()},
+                            {cloud_writer_.get(), summary_writer_.get()});
 
   // The ROS 2 names, and the DDS topics they are (what a plain DDS tool subscribes to).
   log(Severity::kInfo, settings.node_name,
-      "labeling " + input.substr(2) + " -> " + output.substr(2) + " (summary " + summary.substr(2) +
-          "; DDS topics " + input + ", " + output + ", " + summary + ", domain " +
-          std::to_string(settings.domain_id) + ") through " + p.server + ": " +
-          roscommon::settings_text(p));
+      "labeling " + input.substr(2) + " (" + qos_text(reader_qos.get()) + ") -> " +
+          output.substr(2) + " (summary " + summary.substr(2) + "; DDS topics " + input + ", " +
+          output + ", " + summary + ", domain " + std::to_string(settings.domain_id) +
+          ") through " + p.server + ": " + roscommon::settings_text(p));
+  if (settings.use_sim_time)
+    log(Severity::kInfo, settings.node_name,
+        "use_sim_time true: the outputs carry their input's stamp, so the node reads no /clock");
+}
+
+DdsLabelingNode::~DdsLabelingNode() {
+  try {
+    if (discovery_info_) discovery_info_->withdraw();
+  } catch (const std::exception& e) {
+    log(Severity::kWarn, settings_.node_name, e.what());
+  }
 }
 
 void DdsLabelingNode::run(const std::atomic<bool>& stop, std::chrono::milliseconds poll) {

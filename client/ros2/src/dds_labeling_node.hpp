@@ -10,19 +10,26 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "dds_entity.hpp"
 #include "ros2_arguments.hpp"
 #include "ros_common/cloud_labeler.hpp"
+#include "ros_discovery_info.hpp"
 
 namespace primlabel::ros2node {
 
 class DdsLabelingNode {
  public:
-  // Joins the settings' DDS domain and creates the topics, the reader and the writers. Throws
+  // Joins the settings' DDS domain (configured as rmw_cyclonedds configures it), creates the
+  // topics, the reader and the writers, and announces the node on ros_discovery_info. Throws
   // std::runtime_error when DDS refuses (e.g. a bad CYCLONEDDS_URI).
   explicit DdsLabelingNode(const Ros2Settings& settings);
+  // Withdraws the node from ros_discovery_info.
+  ~DdsLabelingNode();
+  DdsLabelingNode(const DdsLabelingNode&) = delete;
+  DdsLabelingNode& operator=(const DdsLabelingNode&) = delete;
 
   // Labels clouds as they come until `stop` is set (checked at least every `poll`).
   void run(const std::atomic<bool>& stop, std::chrono::milliseconds poll);
@@ -36,10 +43,13 @@ class DdsLabelingNode {
 
   Ros2Settings settings_;
   roscommon::CloudLabeler labeler_;
-  // The participant owns the rest; members are destroyed in reverse, the participant last.
+  // The domain (when the node configures it) owns the participant, the participant the rest;
+  // members are destroyed in reverse, the domain last.
+  DdsEntity domain_;
   DdsEntity participant_;
   DdsEntity reader_, cloud_writer_, summary_writer_;
   DdsEntity waitset_, data_available_;
+  std::unique_ptr<RosDiscoveryInfo> discovery_info_;
   std::uint64_t labeled_ = 0, failed_ = 0;
   std::chrono::steady_clock::time_point last_domain_warning_{};
   bool warned_domain_ = false;

@@ -15,8 +15,9 @@
 namespace {
 
 constexpr const char* kUsage =
-    "usage: primlabel-ros2 [--ros-args] [-p name:=value ...] [-r __ns:=/ns] [-r __node:=name]\n"
-    "                      [-r topic:=remapped ...]\n"
+    "usage: primlabel-ros2 [--ros-args] [-p name:=value ...] [--params-file FILE ...]\n"
+    "                      [-r __ns:=/ns] [-r __node:=name] [-r topic:=remapped ...]\n"
+    "                      [--log-level debug|info|warn|error|fatal]\n"
     "Labels sensor_msgs/msg/PointCloud2 clouds through primlabel-server, speaking ROS 2's wire\n"
     "types over Cyclone DDS (no rclcpp): subscribes to input_topic (points), publishes\n"
     "output_topic (points_labeled, the input's fields plus uint32 label) and summary_topic\n"
@@ -24,8 +25,11 @@ constexpr const char* kUsage =
     "Parameters: server model model_version token token_file tls tls_ca tls_cert tls_key\n"
     "tls_server_name deadline retries voxel_size every_point viewpoint tabletop_only confidence\n"
     "probabilities objects primitives input_topic output_topic summary_topic domain_id\n"
-    "(default $ROS_DOMAIN_ID, else 0). Cyclone DDS reads $CYCLONEDDS_URI as for any ROS 2 node\n"
-    "(client/ros2/README.md).\n";
+    "(default $ROS_DOMAIN_ID, else 0) use_sim_time, and ROS 2's QoS overrides\n"
+    "qos_overrides./<topic>.subscription|publisher.reliability|history|depth|durability\n"
+    "(e.g. reliable input: -p qos_overrides./points.subscription.reliability:=reliable).\n"
+    "Discovery follows ROS_LOCALHOST_ONLY, ROS_AUTOMATIC_DISCOVERY_RANGE, ROS_STATIC_PEERS and\n"
+    "CYCLONEDDS_URI as rmw_cyclonedds does (client/ros2/README.md).\n";
 
 std::atomic<bool> stop_requested{false};
 
@@ -49,6 +53,7 @@ int main(int argc, char** argv) {
   try {
     const Ros2Settings settings = parse_arguments(std::vector<std::string>(argv + 1, argv + argc));
     node = settings.node_name;
+    set_log_level(settings.log_level);
     DdsLabelingNode labeling(settings);
     std::signal(SIGINT, request_stop);
     std::signal(SIGTERM, request_stop);
