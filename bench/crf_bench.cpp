@@ -6,6 +6,8 @@
 // machine compare cpu_ms at 1 thread (OMP_WAIT_POLICY=passive keeps spinning out of cpu_ms).
 //
 //   primlabel-bench crf --points 70225 --threads 1,2 --repeat 5
+//   primlabel-bench crf --model potts --coupling 1 --seed 1 --threads 2 --repeat 1
+//     (the second: what the test CrfInference.Speed70k printed before it moved here)
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -20,10 +22,10 @@
 #include <vector>
 
 #include "bench_commands.hpp"
+#include "crf_scenes.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
 #include "primlabel/geometry/json_text.hpp"
-#include "crf_scenes.hpp"
 
 namespace {
 
@@ -38,6 +40,8 @@ struct Arguments {
   std::vector<int> threads = {1, 2};
   int repeat = 5;
   std::string model = "prototype";  // prototype | potts | trained
+  float coupling = 0.25f;           // potts: the one coupling
+  std::uint32_t seed = 11;          // the scene's noise and jitter
   std::vector<std::string> methods = {"bp-sum", "bp-max", "mean-field", "node-only"};
 };
 
@@ -86,7 +90,7 @@ int run_crf_bench(const Arguments& args) {
   spec.num_classes = args.classes;
   spec.noise = args.noise;
   spec.neighbors = args.neighbors;
-  spec.seed = 11;
+  spec.seed = args.seed;
   const LabeledGraph scene = testing::make_grid_scene(spec);
   const std::size_t n = scene.graph.num_nodes();
 
@@ -108,7 +112,7 @@ int run_crf_bench(const Arguments& args) {
     train_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   } else if (args.model == "potts") {
     // What piecewise training makes (the default models): node weights plus one coupling.
-    model = testing::prototype_model(spec, 4.0f, 0.25f);
+    model = testing::prototype_model(spec, 4.0f, args.coupling);
   } else {
     // Nearest-prototype node weights, and edge weights with a bias plus random feature terms, so
     // psi differs from edge to edge as with a trained model.
@@ -197,13 +201,15 @@ int run_crf_bench(const Arguments& args) {
                        {"iterations", row.iterations},
                        {"converged", row.converged},
                        {"accuracy", json::rounded(row.accuracy, "%.4f")}});
-  const json::Json line = {{"bench", "crf"},
-                           {"points", n},
-                           {"edges", scene.graph.num_edges()},
-                           {"classes", spec.num_classes},
-                           {"dim", spec.dim},
-                           {"model", args.model},
-                           {"results", std::move(results)}};
+  json::Json line = {{"bench", "crf"},
+                     {"points", n},
+                     {"edges", scene.graph.num_edges()},
+                     {"classes", spec.num_classes},
+                     {"dim", spec.dim},
+                     {"model", args.model},
+                     {"seed", args.seed}};
+  if (args.model == "potts") line["coupling"] = json::rounded(args.coupling, "%.4g");
+  line["results"] = std::move(results);
   std::printf("%s\n", json::dump(line).c_str());
   return 0;
 }
@@ -226,6 +232,9 @@ BenchCommand add_crf_command(CLI::App& parent) {
                   "prototype (hand-made, feature-dependent couplings), potts (one coupling, as "
                   "piecewise training makes) or trained (pseudo-likelihood)")
       ->check(CLI::IsMember({"prototype", "potts", "trained"}));
+  cmd->add_option("--coupling", args->coupling, "potts: the one coupling between neighbours")
+      ->check(CLI::Range(0.0f, 100.0f));
+  cmd->add_option("--seed", args->seed, "the scene's noise and jitter");
   cmd->add_option("--methods", args->methods, "bp-sum,bp-max,mean-field,node-only")->delimiter(',');
   return {cmd, [args] { return run_crf_bench(*args); }};
 }

@@ -172,8 +172,9 @@ PfhRun run_pfh(const PointCloud& cloud, const NeighborSearch& search, const Feat
   const double n = static_cast<double>(cloud.size());
   const double full_pairs = full_sizes.mean_pfh_pairs * n;
   if (full_pairs <= max_pairs) {
-    run.seconds =
-        best_seconds(repeat, [&] { compute_pfh(cloud, options, context, &run.stats, &search); });
+    run.seconds = best_seconds(repeat, [&] {
+      compute_pfh(cloud, options, context, {.search = &search, .stats = &run.stats});
+    });
     run.pts_s = n / run.seconds;
     run.timed_points = cloud.size();
     run.pairs_per_s = full_pairs / run.seconds;
@@ -192,8 +193,9 @@ PfhRun run_pfh(const PointCloud& cloud, const NeighborSearch& search, const Feat
   }
   thinned.width = static_cast<std::uint32_t>(thinned.xyz.size());
   const NeighborSearch thinned_search(thinned.xyz);
-  run.seconds = best_seconds(
-      repeat, [&] { compute_pfh(thinned, options, context, &run.stats, &thinned_search); });
+  run.seconds = best_seconds(repeat, [&] {
+    compute_pfh(thinned, options, context, {.search = &thinned_search, .stats = &run.stats});
+  });
   const NeighborhoodSizes thinned_sizes = measure_neighborhoods(
       thinned, thinned_search, options.neighborhood, stride_sample(thinned.size(), thinned.size()));
   run.extrapolated = true;
@@ -427,7 +429,8 @@ int run_features_bench(const FeaturesBenchOptions& options) {
   double fpfh_seconds = std::numeric_limits<double>::quiet_NaN();
   if (run_fpfh) {
     fpfh_seconds = best_seconds(options.repeat, [&] {
-      fpfh = compute_fpfh(cloud, feature_options, RunContext{threads}, &fpfh_stats, &search);
+      fpfh = compute_fpfh(cloud, feature_options, RunContext{threads},
+                          {.search = &search, .stats = &fpfh_stats});
     });
     std::cerr << "  FPFH (" << describe(*feature_hood) << ", mean " << feature_sizes.mean_neighbors
               << " neighbours): " << rate(n, fpfh_seconds) << "; " << fpfh_stats.nan << " NaN, "

@@ -1,9 +1,10 @@
-# primlabel_library(NAME SOURCES src... [PUBLIC dep...] [PRIVATE dep...])
+# primlabel_library(NAME SOURCES src... [PUBLIC dep...] [PRIVATE dep...] [NO_HEADERS])
 #
 # One library of the project, in the folder that calls it: primlabel_NAME (alias primlabel::NAME),
 # static, public headers under include/ (include/primlabel/...), private sources and headers under
 # src/. Dependencies are declared here and nowhere else: a target sees the headers of what it links
-# and of nothing more, because every library has an include root of its own.
+# and of nothing more, because every library has an include root of its own. NO_HEADERS: a library
+# whose headers are all generated (the protobuf and IDL libraries) has no include/ of its own.
 #
 # The boundary check: every public header is also compiled alone, in a translation unit of its
 # own that sees only the library's public include root and its PUBLIC dependencies
@@ -11,21 +12,25 @@
 # that needs a library the target does not link publicly, or that depends on what was included
 # before it, fails the build. tests/architecture checks the link graph itself.
 function(primlabel_library name)
-  cmake_parse_arguments(PARSE_ARGV 1 ARG "" "" "SOURCES;PUBLIC;PRIVATE")
+  cmake_parse_arguments(PARSE_ARGV 1 ARG "NO_HEADERS" "" "SOURCES;PUBLIC;PRIVATE")
   set(target primlabel_${name})
   add_library(${target} STATIC ${ARG_SOURCES})
   add_library(primlabel::${name} ALIAS ${target})
-  target_include_directories(${target}
-    PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
-           $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>
-    PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  target_include_directories(${target} PUBLIC $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  if(NOT ARG_NO_HEADERS)
+    target_include_directories(${target}
+      PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+      PRIVATE ${CMAKE_CURRENT_SOURCE_DIR}/src)
+  endif()
   target_link_libraries(${target} PUBLIC ${ARG_PUBLIC} PRIVATE ${ARG_PRIVATE})
   # Parallelism is ours (fixed blocks, OpenMP): Eigen's own multithreaded products would choose
   # their blocking from the thread count, and results must not depend on it.
   target_compile_definitions(${target} PRIVATE EIGEN_DONT_PARALLELIZE)
   set_target_properties(${target} PROPERTIES EXPORT_NAME ${name} POSITION_INDEPENDENT_CODE ON)
   set_property(GLOBAL APPEND PROPERTY PRIMLABEL_LIBRARIES ${target})
-  primlabel_header_check(${target} ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  if(NOT ARG_NO_HEADERS)
+    primlabel_header_check(${target} ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  endif()
 endfunction()
 
 # Compiles each header under INCLUDE_ROOT alone (twice in one unit, so a missing include guard

@@ -101,8 +101,9 @@ int run(const Arguments& args) {
   const auto features_start = std::chrono::steady_clock::now();
   FeatureStats stats;
   const bool fpfh = args.descriptor == "fpfh";
-  Descriptors descriptors = fpfh ? compute_fpfh(cloud, options, context, &stats, &search)
-                                 : compute_pfh(cloud, options, context, &stats, &search);
+  const FeatureExtras extras{.search = &search, .stats = &stats};
+  Descriptors descriptors = fpfh ? compute_fpfh(cloud, options, context, extras)
+                                 : compute_pfh(cloud, options, context, extras);
   progress.done();
   const double feature_seconds = seconds_since(features_start);
   FloatField& field =

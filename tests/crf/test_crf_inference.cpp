@@ -1,23 +1,18 @@
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <utility>
 
 #include "brute_force.hpp"
-#include "primlabel/crf/inference.hpp"
 #include "crf_scenes.hpp"
+#include "primlabel/crf/inference.hpp"
 
 namespace primlabel::crf {
 namespace {
 
 using testing::SceneSpec;
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Loopy BP sum- and max-product, and mean-field (max_product is a BP option: one run is enough).
 constexpr std::pair<InferenceMethod, bool> kMethods[] = {{InferenceMethod::kLoopyBp, false},
@@ -52,27 +47,6 @@ InferenceResult infer_node_only(const CrfModel& model, const LabeledGraph& scene
   CrfModel node_only = model;
   node_only.edge_weights.setZero();
   return infer(node_only, scene.descriptors, scene.graph, {});
-}
-
-// Prints (does not assert) the speed on a 70k-point kNN-8 graph with K = 10, d = 33.
-TEST(CrfInference, Speed70k) {
-  const auto [scene, model] = noisy_scene(265, 265, 10);
-  const std::size_t n = scene.graph.num_nodes();
-  std::printf("graph: %zu nodes, %zu edges\n", n, scene.graph.num_edges());
-  for (const auto& [method, max_product] : kMethods) {
-    InferenceSettings options;
-    options.method = method;
-    options.max_product = max_product;
-    const auto start = std::chrono::steady_clock::now();
-    const InferenceResult result =
-        infer(model, scene.descriptors, scene.graph, options, {}, RunContext{2});
-    const double s = seconds_since(start);
-    std::printf("%-10s %-11s %6.1f ms  %9.0f points/s  %2d iterations%s  accuracy %.3f\n",
-                method == InferenceMethod::kLoopyBp ? "loopy-bp" : "mean-field",
-                max_product ? "max-product" : "sum-product", 1e3 * s, n / s, result.iterations,
-                result.converged ? " (converged)" : "", accuracy(result, scene));
-  }
-  std::printf("node-only accuracy %.3f\n", accuracy(infer_node_only(model, scene), scene));
 }
 
 // A random model with d = 3 and random descriptors: potentials with no special structure.

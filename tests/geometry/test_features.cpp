@@ -187,7 +187,7 @@ TEST(Fpfh, SubHistogramsSumTo100AndThePaperVariantAddsTheOwnSpfh) {
   FeatureOptions options;
   options.neighborhood = Neighborhood::Radius(0.02f);
   FeatureStats stats;
-  const auto pcl = compute_fpfh(cloud, options, {}, &stats);
+  const auto pcl = compute_fpfh(cloud, options, {}, {.stats = &stats});
   EXPECT_EQ(stats.computed, cloud.size());
   EXPECT_EQ(stats.nan, 0u);
   options.fpfh_variant = FpfhVariant::kWithOwnSpfh;
@@ -230,7 +230,7 @@ TEST(Features, InvalidPointsAndNormalsAreNaNAndLeftOutOfNeighbourhoods) {
   FeatureOptions options;
   options.neighborhood = Neighborhood::Radius(0.02f);
   FeatureStats stats;
-  const auto with_gaps = compute_fpfh(cloud, options, {}, &stats);
+  const auto with_gaps = compute_fpfh(cloud, options, {}, {.stats = &stats});
   EXPECT_EQ(stats.nan, 2u);
   EXPECT_EQ(stats.isolated, 1u);
   EXPECT_EQ(stats.computed, cloud.size() - 3);
@@ -248,7 +248,7 @@ TEST(Features, InvalidPointsAndNormalsAreNaNAndLeftOutOfNeighbourhoods) {
     for (int b = 0; b < kFpfhSize; ++b) ASSERT_NEAR(with_gaps.row(i)[b], removed.row(i)[b], 1e-4f);
   }
   FeatureStats pfh_stats;
-  const auto pfh = compute_pfh(cloud, options, {}, &pfh_stats);
+  const auto pfh = compute_pfh(cloud, options, {}, {.stats = &pfh_stats});
   EXPECT_EQ(pfh_stats.nan, 2u);
   EXPECT_EQ(pfh_stats.isolated, 1u);
   EXPECT_TRUE(std::isnan(pfh.row(broken_normal)[0]));
@@ -400,10 +400,12 @@ TEST(Fpfh, WantedPointsGetTheWholeComputationsBitsAndTheOthersNaN) {
     FeatureOptions options;
     options.neighborhood = hood;
     for (const NeighborLists* shared : {static_cast<const NeighborLists*>(nullptr), &lists}) {
-      const Descriptors all = compute_fpfh(cloud, options, RunContext{2}, nullptr, &search, shared);
+      const Descriptors all =
+          compute_fpfh(cloud, options, RunContext{2}, {.search = &search, .lists = shared});
       options.wanted = wanted;
       FeatureStats stats;
-      const Descriptors some = compute_fpfh(cloud, options, RunContext{2}, &stats, &search, shared);
+      const Descriptors some = compute_fpfh(cloud, options, RunContext{2},
+                                            {.search = &search, .lists = shared, .stats = &stats});
       options.wanted = {};
       std::size_t described = 0;
       for (std::size_t p = 0; p < cloud.size(); ++p) {

@@ -15,6 +15,7 @@
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
+#include "training_scenes.hpp"
 
 namespace primlabel {
 namespace {
@@ -30,20 +31,12 @@ struct Trained {
 Trained train_on_two_scenes() {
   const crf::GraphSettings graph;
   const FeatureSettings features;
-  std::vector<std::uint32_t> every_class;
-  for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
-  std::vector<SceneData> train;
-  for (int i = 0; i < 2; ++i)
-    train.push_back(pipeline::prepare_scene(
-        synth::synthetic_scene(synth::SceneSet::kTrain, i, synth::SensorKind::kLms400), "train",
-        features, graph, every_class, RunContext{2}));
-  const auto class_ids = pipeline::classes_present(train);
-  for (SceneData& s : train) pipeline::assign_labels(s, class_ids);
+  const auto scenes = testing::prepare_training_scenes(
+      testing::lms400_scenes(synth::SceneSet::kTrain, 2), {}, features, graph);
   pipeline::ModelTrainingOptions options;
   options.kind = ModelKind::kNodeOnly;
   options.iterations = 100;
-  return {pipeline::train_label_model(train, {}, class_ids, features, graph, options, RunContext{2})
-              .model,
+  return {testing::train_on(scenes, features, graph, options).model,
           synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kLms400)};
 }
 
@@ -161,23 +154,14 @@ TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRo
 TEST(PipelineLabeling, PiecewiseCrfTrainingKeepsTheCouplingThatValidatesBest) {
   const crf::GraphSettings graph;
   const FeatureSettings features;
-  std::vector<std::uint32_t> every_class;
-  for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
-  std::vector<SceneData> train, validation;
-  train.push_back(pipeline::prepare_scene(
-      synth::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400), "train",
-      features, graph, every_class, RunContext{2}));
-  validation.push_back(pipeline::prepare_scene(
-      synth::synthetic_scene(synth::SceneSet::kVal, 0, synth::SensorKind::kLms400), "val", features,
-      graph, every_class, RunContext{2}));
-  const auto class_ids = pipeline::classes_present(train);
-  pipeline::assign_labels(train[0], class_ids);
-  pipeline::assign_labels(validation[0], class_ids);
+  const auto scenes = testing::prepare_training_scenes(
+      testing::lms400_scenes(synth::SceneSet::kTrain, 1),
+      testing::lms400_scenes(synth::SceneSet::kVal, 1), features, graph);
+  const std::vector<SceneData>& validation = scenes.validation;
   pipeline::ModelTrainingOptions options;
   options.iterations = 60;
   ASSERT_EQ(options.objective, crf::TrainingObjective::kPiecewise);
-  const auto trained = pipeline::train_label_model(train, validation, class_ids, features, graph,
-                                                   options, RunContext{2});
+  const auto trained = testing::train_on(scenes, features, graph, options);
   const LabelModel& crf = trained.model;
   EXPECT_EQ(crf.kind, ModelKind::kCrf);
   EXPECT_EQ(crf.training.objective.rfind("piecewise", 0), 0u) << crf.training.objective;

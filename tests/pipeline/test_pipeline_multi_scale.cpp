@@ -13,6 +13,7 @@
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
+#include "training_scenes.hpp"
 
 namespace primlabel {
 namespace {
@@ -90,21 +91,12 @@ TEST(PipelineMultiScale, RowsHoldEveryScaleThenTheVariations) {
 TEST(PipelineMultiScale, TrainedModelLabelsGivesThePlainDescriptorAndRoundTrips) {
   const FeatureSettings features = multi_scale_settings();
   const crf::GraphSettings graph;
-  std::vector<std::uint32_t> every_class;
-  for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
-  std::vector<pipeline::SceneData> train;
-  for (int i = 0; i < 2; ++i)
-    train.push_back(pipeline::prepare_scene(
-        synth::synthetic_scene(synth::SceneSet::kTrain, i, synth::SensorKind::kLms400), "train",
-        features, graph, every_class, RunContext{2}));
-  const auto class_ids = pipeline::classes_present(train);
-  for (pipeline::SceneData& s : train) pipeline::assign_labels(s, class_ids);
+  const auto scenes = testing::prepare_training_scenes(
+      testing::lms400_scenes(synth::SceneSet::kTrain, 2), {}, features, graph);
   pipeline::ModelTrainingOptions options;
   options.kind = ModelKind::kNodeOnly;
   options.iterations = 40;
-  LabelModel model =
-      pipeline::train_label_model(train, {}, class_ids, features, graph, options, RunContext{2})
-          .model;
+  LabelModel model = testing::train_on(scenes, features, graph, options).model;
   ASSERT_EQ(model.weights.descriptor_dim, features.model_input_dim());
   // A CRF: the node weights and a coupling between neighbours, so the graph runs too.
   model.kind = ModelKind::kCrf;

@@ -11,6 +11,7 @@
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
+#include "training_scenes.hpp"
 
 namespace primlabel {
 namespace {
@@ -25,24 +26,15 @@ const Trained& trained() {
   static const Trained once = [] {
     const crf::GraphSettings graph;
     const FeatureSettings features;
-    std::vector<std::uint32_t> every_class;
-    for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
-    std::vector<pipeline::SceneData> train;
-    PointCloud scan =
-        synth::synthetic_scene(synth::SceneSet::kTrain, 0, synth::SensorKind::kLms400);
+    std::vector<PointCloud> scans = testing::lms400_scenes(synth::SceneSet::kTrain, 1);
     // What primlabel-train records of its scans: the noise bound of the cascade.
-    const CloudSignature acquired = measure_signature(scan.xyz, scan.viewpoint.origin);
-    train.push_back(pipeline::prepare_scene(std::move(scan), "train", features, graph, every_class,
-                                            RunContext{2}));
-    train.back().acquired = acquired;
-    const auto class_ids = pipeline::classes_present(train);
-    pipeline::assign_labels(train.front(), class_ids);
+    const CloudSignature acquired = measure_signature(scans[0].xyz, scans[0].viewpoint.origin);
+    auto scenes = testing::prepare_training_scenes(std::move(scans), {}, features, graph);
+    scenes.train.front().acquired = acquired;
     pipeline::ModelTrainingOptions options;
     options.kind = ModelKind::kNodeOnly;
     options.iterations = 60;
-    LabelModel model =
-        pipeline::train_label_model(train, {}, class_ids, features, graph, options, RunContext{2})
-            .model;
+    LabelModel model = testing::train_on(scenes, features, graph, options).model;
     model.kind = ModelKind::kCrf;
     crf::CrfModel& w = model.weights;
     w.edge_weights = Eigen::MatrixXf::Zero(w.num_classes(), w.edge_feature_dim());

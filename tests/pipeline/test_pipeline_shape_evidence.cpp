@@ -19,6 +19,7 @@
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
 #include "random_label_model.hpp"
+#include "training_scenes.hpp"
 
 namespace primlabel {
 namespace {
@@ -61,8 +62,9 @@ TEST(PipelineShapeEvidence, AgreesWithTheTrueLabelsOfSyntheticKinectFrames) {
   const double covered = double(total.with_evidence) / double(total.points);
   const double agreeing = double(total.agreeing) / double(total.with_evidence);
   const double corners = double(total.corners_found) / double(total.corners);
-  std::printf("shape evidence on %zu labeled voxels: covers %.3f, agrees %.3f, corners %.3f of %zu\n",
-              total.points, covered, agreeing, corners, total.corners);
+  std::printf(
+      "shape evidence on %zu labeled voxels: covers %.3f, agrees %.3f, corners %.3f of %zu\n",
+      total.points, covered, agreeing, corners, total.corners);
   EXPECT_GT(covered, 0.80) << "the table and most objects are fitted";
   EXPECT_GT(agreeing, 0.90) << "the fitted shapes are the true shapes, nearly";
   EXPECT_GT(corners, 0.50) << "hidden faces make corners a per-point model cannot see";
@@ -104,26 +106,20 @@ TEST(PipelineShapeEvidence, ModelTrainedWithItLabelsAndRoundTrips) {
   features.shape_evidence = true;
   ASSERT_EQ(features.model_input_dim(), kFpfhSize + kShapeEvidenceDim);
   const crf::GraphSettings graph;
-  std::vector<std::uint32_t> every_class;
-  for (PrimitiveClass c : all_classes()) every_class.push_back(class_id(c));
-  std::vector<pipeline::SceneData> train;
-  for (int i = 0; i < 2; ++i)
-    train.push_back(pipeline::prepare_scene(kinect_voxels(synth::SceneSet::kTrain, i), "train",
-                                            features, graph, every_class, RunContext{2}));
-  ASSERT_EQ(train[0].graph.descriptors.dim, features.model_input_dim());
-  const auto class_ids = pipeline::classes_present(train);
-  for (pipeline::SceneData& s : train) pipeline::assign_labels(s, class_ids);
+  std::vector<PointCloud> clouds;
+  for (int i = 0; i < 2; ++i) clouds.push_back(kinect_voxels(synth::SceneSet::kTrain, i));
+  const auto scenes = testing::prepare_training_scenes(std::move(clouds), {}, features, graph);
+  ASSERT_EQ(scenes.train[0].graph.descriptors.dim, features.model_input_dim());
   pipeline::ModelTrainingOptions options;
   options.kind = ModelKind::kNodeOnly;
   options.iterations = 60;
-  LabelModel model =
-      pipeline::train_label_model(train, {}, class_ids, features, graph, options, RunContext{2})
-          .model;
+  LabelModel model = testing::train_on(scenes, features, graph, options).model;
   model.features.voxel_size = 0.007f;
   ASSERT_EQ(model.weights.descriptor_dim, features.model_input_dim());
   ASSERT_TRUE(model.features.shape_evidence);
 
-  const PointCloud frame = synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kKinect);
+  const PointCloud frame =
+      synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kKinect);
   PointCloud one = frame, two = frame;
   pipeline::LabelingOptions labeling;
   labeling.want_descriptors = true;

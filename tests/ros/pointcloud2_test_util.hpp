@@ -10,8 +10,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "byte_order.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/ros_common/byte_order.hpp"
 
 namespace primlabel::rostest {
 
@@ -31,7 +31,7 @@ inline MessageLayout layout_of(bool float64, bool big_endian, std::uint32_t row_
   return layout;
 }
 
-inline bool swapped(const PointCloud2& m) { return rosnode::needs_swap(m.is_bigendian); }
+inline bool swapped(const PointCloud2& m) { return roscommon::needs_swap(m.is_bigendian); }
 
 template <class T>
 void put(std::uint8_t* at, T value, bool swap) {

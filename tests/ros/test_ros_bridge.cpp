@@ -8,11 +8,10 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 
-#include "labeled_pointcloud2.hpp"
-#include "node_parameters.hpp"
 #include "pointcloud2_test_util.hpp"
-#include "pointcloud2_xyz.hpp"
-#include "summary_json.hpp"
+#include "primlabel/ros/pointcloud2_message.hpp"
+#include "primlabel/ros_common/node_parameters.hpp"
+#include "primlabel/ros_common/summary_json.hpp"
 
 namespace primlabel::rostest {
 namespace {
@@ -146,7 +145,7 @@ TEST(LabeledPointCloud2, KeepsTheInputLayoutAndAppendsLabelConfidenceAndProbabil
        {MessageLayout{}, layout_of(false, true, 0), layout_of(true, false, 7)}) {
     const PointCloud2 in = to_pointcloud2(organised_cloud(), layout);
     const client::LabelResult r = result_for(6);
-    const PointCloud2 out = labeled_pointcloud2(in, r, rosnode::LabeledFields{true, true});
+    const PointCloud2 out = labeled_pointcloud2(in, r, roscommon::LabeledFields{true, true});
     expect_layout_kept(in, out);
     const PointField& label = field_named(out, "label");
     EXPECT_EQ(label.datatype, PointField::UINT32);
@@ -193,7 +192,7 @@ TEST(LabeledPointCloud2, RefusesAResultOfAnotherSize) {
   EXPECT_THROW(labeled_pointcloud2(in, result_for(5), {}), std::invalid_argument);
   client::LabelResult no_probabilities = result_for(6);
   no_probabilities.probabilities.clear();
-  EXPECT_THROW(labeled_pointcloud2(in, no_probabilities, rosnode::LabeledFields{true, false}),
+  EXPECT_THROW(labeled_pointcloud2(in, no_probabilities, roscommon::LabeledFields{true, false}),
                std::invalid_argument);
 }
 
@@ -204,7 +203,7 @@ TEST(LabeledPointCloud2, AppendsObjectAndSegmentIdsAfterTheLabel) {
   client::LabelResult r = result_for(6);
   r.object_ids = {0, 0, 1, 2, 0xFFFFFFFFu, 1};
   r.segments = {3, 0xFFFFFFFFu, 1, 1, 0, 2};
-  rosnode::LabeledFields fields;
+  roscommon::LabeledFields fields;
   fields.object = fields.segment = fields.confidence = true;
   for (const PointField& f : in.fields)  // an input field of a name the node writes is replaced
     ASSERT_NE(f.name, "object");
@@ -230,9 +229,9 @@ TEST(LabeledPointCloud2, AppendsObjectAndSegmentIdsAfterTheLabel) {
     }
   }
   client::LabelResult no_ids = result_for(6);
-  EXPECT_THROW(labeled_pointcloud2(in, no_ids, rosnode::LabeledFields{false, false, true, false}),
+  EXPECT_THROW(labeled_pointcloud2(in, no_ids, roscommon::LabeledFields{false, false, true, false}),
                std::invalid_argument);
-  EXPECT_THROW(labeled_pointcloud2(in, no_ids, rosnode::LabeledFields{false, false, false, true}),
+  EXPECT_THROW(labeled_pointcloud2(in, no_ids, roscommon::LabeledFields{false, false, false, true}),
                std::invalid_argument);
 }
 
@@ -251,16 +250,16 @@ TEST(LabeledPointCloud2, TheHeaderIsTheEchoedFrameAndStampElseTheInputs) {
 }
 
 TEST(LabeledPointCloud2, ProbabilityFieldNames) {
-  EXPECT_EQ(rosnode::probability_field_name("plane", 1), "prob_plane");
-  EXPECT_EQ(rosnode::probability_field_name("edge/corner 2", 4), "prob_edge_corner_2");
-  EXPECT_EQ(rosnode::probability_field_name("", 9), "prob_9");
+  EXPECT_EQ(roscommon::probability_field_name("plane", 1), "prob_plane");
+  EXPECT_EQ(roscommon::probability_field_name("edge/corner 2", 4), "prob_edge_corner_2");
+  EXPECT_EQ(roscommon::probability_field_name("", 9), "prob_9");
 }
 
 TEST(SummaryJson, CarriesTheProtoFieldNamesFrameAndStamp) {
   v1::LabelSummary summary = result_for(1).summary;
   summary.set_model("tabletop-kinect");
   summary.add_class_counts()->set_name("plane");
-  const auto json = nlohmann::json::parse(rosnode::summary_json(summary));
+  const auto json = nlohmann::json::parse(roscommon::summary_json(summary));
   EXPECT_EQ(json.at("frame_id"), "camera_depth_optical_frame");
   EXPECT_EQ(json.at("stamp_ns"), "1700000000123456789");  // 64-bit integers as strings
   EXPECT_EQ(json.at("model"), "tabletop-kinect");
@@ -269,28 +268,28 @@ TEST(SummaryJson, CarriesTheProtoFieldNamesFrameAndStamp) {
 }
 
 TEST(NodeParameters, ObjectsAndPrimitivesGoIntoTheLabelOptions) {
-  rosnode::NodeParameters parameters;
-  EXPECT_FALSE(rosnode::label_options(parameters).objects);
-  EXPECT_FALSE(rosnode::label_options(parameters).primitives);
+  roscommon::NodeParameters parameters;
+  EXPECT_FALSE(roscommon::label_options(parameters).objects);
+  EXPECT_FALSE(roscommon::label_options(parameters).primitives);
   parameters.tabletop_only = parameters.objects = parameters.primitives = true;
-  const auto options = rosnode::label_options(parameters);
+  const auto options = roscommon::label_options(parameters);
   EXPECT_TRUE(options.tabletop_only);
   EXPECT_TRUE(options.objects);
   EXPECT_TRUE(options.primitives);
 }
 
 TEST(NodeParameters, EveryPointGoesIntoTheLabelOptions) {
-  rosnode::NodeParameters parameters;
-  EXPECT_FALSE(rosnode::label_options(parameters).every_point);  // the service's cascade
+  roscommon::NodeParameters parameters;
+  EXPECT_FALSE(roscommon::label_options(parameters).every_point);  // the service's cascade
   parameters.every_point = true;
-  EXPECT_TRUE(rosnode::label_options(parameters).every_point);
+  EXPECT_TRUE(roscommon::label_options(parameters).every_point);
 }
 
 // The start-up line names every labeling setting with its value, so a ~tabletop_only the
 // parameter server kept from an earlier run is seen at once.
 TEST(NodeParameters, TheStartUpLineNamesEverySetting) {
-  rosnode::NodeParameters parameters;
-  std::string text = rosnode::settings_text(parameters);
+  roscommon::NodeParameters parameters;
+  std::string text = roscommon::settings_text(parameters);
   for (const char* part :
        {"tabletop_only false", "every_point false", "voxel_size the model's",
         "viewpoint the frame's origin", "objects false", "primitives false", "confidence false",
@@ -300,17 +299,17 @@ TEST(NodeParameters, TheStartUpLineNamesEverySetting) {
   parameters.tabletop_only = true;
   parameters.voxel_size = 0.007;
   parameters.viewpoint = std::array<double, 3>{0.0, 0.0, 1.5};
-  text = rosnode::settings_text(parameters);
+  text = roscommon::settings_text(parameters);
   for (const char* part :
        {"model tabletop-kinect", "tabletop_only true", "voxel_size 0.007 m", "viewpoint 0,0,1.5"})
     EXPECT_NE(text.find(part), std::string::npos) << part << " in: " << text;
 }
 
 TEST(NodeParameters, TheViewpointGoesIntoTheLabelOptionsOnlyWhenSet) {
-  rosnode::NodeParameters parameters;
-  EXPECT_FALSE(rosnode::label_options(parameters).viewpoint.has_value());  // the frame's origin
+  roscommon::NodeParameters parameters;
+  EXPECT_FALSE(roscommon::label_options(parameters).viewpoint.has_value());  // the frame's origin
   parameters.viewpoint = std::array<double, 3>{0.5, -1.25, 2.0};
-  const auto options = rosnode::label_options(parameters);
+  const auto options = roscommon::label_options(parameters);
   ASSERT_TRUE(options.viewpoint.has_value());
   EXPECT_EQ(*options.viewpoint, Vec3f(0.5f, -1.25f, 2.0f));
 }

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "type_hash.hpp"
+#include "primlabel/ros2/type_hash.hpp"
 
 namespace primlabel::ros2node {
 namespace {

@@ -2,7 +2,7 @@
 // objects and the chunks' object ids are exactly those of label_cloud in process, streamed and
 // unary; refused without tabletop_only; nothing without the option.
 
-#include "primlabel/service/label_job.hpp"
+#include "primlabel/service/answer_size.hpp"
 #include "server_test_util.hpp"
 #include "tabletop_objects_scene.hpp"
 

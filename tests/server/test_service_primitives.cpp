@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "primitives/primitive_samples.hpp"
-#include "primlabel/service/label_job.hpp"
+#include "primlabel/service/answer_size.hpp"
 #include "server_test_util.hpp"
 
 namespace primlabel::servertest {

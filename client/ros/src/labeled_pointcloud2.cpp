@@ -1,6 +1,4 @@
-#include "labeled_pointcloud2.hpp"
-
-#include "pointcloud2_message.hpp"
+#include "primlabel/ros/pointcloud2_message.hpp"
 
 namespace primlabel::rosnode {
 
@@ -14,7 +12,7 @@ std_msgs::Header echoed_header(const std_msgs::Header& input, const v1::LabelSum
 
 sensor_msgs::PointCloud2 labeled_pointcloud2(const sensor_msgs::PointCloud2& input,
                                              const client::LabelResult& result,
-                                             const LabeledFields& fields) {
+                                             const roscommon::LabeledFields& fields) {
   return to_message(roscommon::labeled_pointcloud2(view_of(input), result, fields),
                     echoed_header(input.header, result.summary));
 }

@@ -1,14 +1,14 @@
-#include "labeling_node.hpp"
+#include "primlabel/ros/labeling_node.hpp"
 
 #include <std_msgs/String.h>
 
 #include <exception>
 
-#include "pointcloud2_message.hpp"
+#include "primlabel/ros/pointcloud2_message.hpp"
 
 namespace primlabel::rosnode {
 
-LabelingNode::LabelingNode(ros::NodeHandle& node, const NodeParameters& parameters)
+LabelingNode::LabelingNode(ros::NodeHandle& node, const roscommon::NodeParameters& parameters)
     : parameters_(parameters), labeler_(parameters) {
   cloud_publisher_ = node.advertise<sensor_msgs::PointCloud2>(parameters.output_topic, 1);
   summary_publisher_ = node.advertise<std_msgs::String>(parameters.summary_topic, 1);
@@ -18,7 +18,7 @@ LabelingNode::LabelingNode(ros::NodeHandle& node, const NodeParameters& paramete
   ROS_INFO("primlabel-ros: labeling %s -> %s (summary %s) through %s: %s",
            subscriber_.getTopic().c_str(), cloud_publisher_.getTopic().c_str(),
            summary_publisher_.getTopic().c_str(), parameters.server.c_str(),
-           settings_text(parameters).c_str());
+           roscommon::settings_text(parameters).c_str());
 }
 
 void LabelingNode::on_cloud(const sensor_msgs::PointCloud2ConstPtr& cloud) {

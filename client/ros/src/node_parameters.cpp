@@ -1,4 +1,4 @@
-#include "node_parameters.hpp"
+#include "primlabel/ros/node_parameters.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -27,8 +27,8 @@ void read(const ros::NodeHandle& node, const std::string& key, T& value) {
 
 }  // namespace
 
-NodeParameters read_parameters(const ros::NodeHandle& node) {
-  NodeParameters p;
+roscommon::NodeParameters read_parameters(const ros::NodeHandle& node) {
+  roscommon::NodeParameters p;
   read(node, "server", p.server);
   read(node, "token", p.token);
   read(node, "token_file", p.token_file);
@@ -61,7 +61,7 @@ NodeParameters read_parameters(const ros::NodeHandle& node) {
   read(node, "output_topic", p.output_topic);
   read(node, "summary_topic", p.summary_topic);
 
-  check_parameters(p, "~");
+  roscommon::check_parameters(p, "~");
   return p;
 }
 

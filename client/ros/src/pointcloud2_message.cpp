@@ -1,4 +1,4 @@
-#include "pointcloud2_message.hpp"
+#include "primlabel/ros/pointcloud2_message.hpp"
 
 #include <utility>
 

@@ -1,10 +1,8 @@
-#include "pointcloud2_xyz.hpp"
-
-#include "pointcloud2_message.hpp"
+#include "primlabel/ros/pointcloud2_message.hpp"
 
 namespace primlabel::rosnode {
 
-XyzLayout xyz_layout(const sensor_msgs::PointCloud2& cloud) {
+roscommon::XyzLayout xyz_layout(const sensor_msgs::PointCloud2& cloud) {
   return roscommon::xyz_layout(view_of(cloud), cloud.data.size());
 }
 

@@ -7,8 +7,9 @@
 #include <cstring>
 #include <exception>
 
-#include "labeling_node.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/ros/labeling_node.hpp"
+#include "primlabel/ros/node_parameters.hpp"
 
 namespace {
 
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "primlabel_ros");
   ros::NodeHandle node;
   try {
-    const primlabel::rosnode::NodeParameters parameters =
+    const primlabel::roscommon::NodeParameters parameters =
         primlabel::rosnode::read_parameters(ros::NodeHandle("~"));
     primlabel::rosnode::LabelingNode labeling(node, parameters);
     ros::spin();

@@ -13,7 +13,7 @@
 #include <std_msgs/msg/string.hpp>
 #include <utility>
 
-#include "ros_common/cloud_labeler.hpp"
+#include "primlabel/ros_common/cloud_labeler.hpp"
 
 namespace primlabel::ros2node {
 

@@ -1,12 +1,12 @@
-#include "dds_labeling_node.hpp"
+#include "primlabel/ros2/dds_labeling_node.hpp"
 
 #include <exception>
 
-#include "node_log.hpp"
-#include "pointcloud2_dds.hpp"
-#include "ros2_qos.hpp"
+#include "primlabel/ros2/node_log.hpp"
+#include "primlabel/ros2/pointcloud2_dds.hpp"
+#include "primlabel/ros2/ros2_qos.hpp"
+#include "primlabel/ros2/type_hash.hpp"
 #include "std_msgs/msg/String.h"
-#include "type_hash.hpp"
 
 namespace primlabel::ros2node {
 

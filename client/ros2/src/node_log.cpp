@@ -1,4 +1,4 @@
-#include "node_log.hpp"
+#include "primlabel/ros2/node_log.hpp"
 
 #include <algorithm>
 #include <atomic>

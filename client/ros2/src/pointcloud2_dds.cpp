@@ -1,4 +1,4 @@
-#include "pointcloud2_dds.hpp"
+#include "primlabel/ros2/pointcloud2_dds.hpp"
 
 namespace primlabel::ros2node {
 

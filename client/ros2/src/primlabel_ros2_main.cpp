@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "dds_labeling_node.hpp"
-#include "node_log.hpp"
 #include "primlabel/build_version.hpp"
+#include "primlabel/ros2/dds_labeling_node.hpp"
+#include "primlabel/ros2/node_log.hpp"
 
 namespace {
 

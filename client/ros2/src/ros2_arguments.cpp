@@ -1,4 +1,4 @@
-#include "ros2_arguments.hpp"
+#include "primlabel/ros2/ros2_arguments.hpp"
 
 #include <array>
 #include <cmath>
@@ -7,9 +7,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "ros2_discovery.hpp"
-#include "ros2_names.hpp"
-#include "ros2_params_file.hpp"
+#include "primlabel/ros2/ros2_discovery.hpp"
+#include "primlabel/ros2/ros2_names.hpp"
+#include "primlabel/ros2/ros2_params_file.hpp"
 
 namespace primlabel::ros2node {
 

@@ -1,4 +1,4 @@
-#include "ros2_discovery.hpp"
+#include "primlabel/ros2/ros2_discovery.hpp"
 
 #include <cctype>
 #include <cstdlib>

@@ -1,4 +1,4 @@
-#include "ros2_names.hpp"
+#include "primlabel/ros2/ros2_names.hpp"
 
 #include <cctype>
 #include <stdexcept>

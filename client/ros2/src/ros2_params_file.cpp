@@ -1,4 +1,4 @@
-#include "ros2_params_file.hpp"
+#include "primlabel/ros2/ros2_params_file.hpp"
 
 #include <filesystem>
 #include <fstream>

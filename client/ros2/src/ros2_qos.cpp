@@ -1,4 +1,4 @@
-#include "ros2_qos.hpp"
+#include "primlabel/ros2/ros2_qos.hpp"
 
 namespace primlabel::ros2node {
 

@@ -1,12 +1,12 @@
-#include "ros_discovery_info.hpp"
+#include "primlabel/ros2/ros_discovery_info.hpp"
 
 #include <algorithm>
 #include <cstring>
 
+#include "primlabel/ros2/ros2_qos.hpp"
+#include "primlabel/ros2/type_hash.hpp"
 #include "rmw_dds_common/msg/ParticipantEntitiesInfo.h"
 #include "rmw_dds_common/msg/ParticipantEntitiesInfoHumble.h"
-#include "ros2_qos.hpp"
-#include "type_hash.hpp"
 
 namespace primlabel::ros2node {
 

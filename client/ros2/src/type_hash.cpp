@@ -1,4 +1,4 @@
-#include "type_hash.hpp"
+#include "primlabel/ros2/type_hash.hpp"
 
 #include <openssl/evp.h>
 

@@ -1,7 +1,7 @@
-#include "ros_common/cloud_labeler.hpp"
+#include "primlabel/ros_common/cloud_labeler.hpp"
 
-#include "ros_common/pointcloud2_xyz.hpp"
-#include "ros_common/summary_json.hpp"
+#include "primlabel/ros_common/pointcloud2_xyz.hpp"
+#include "primlabel/ros_common/summary_json.hpp"
 
 namespace primlabel::roscommon {
 

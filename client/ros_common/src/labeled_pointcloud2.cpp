@@ -1,4 +1,4 @@
-#include "ros_common/labeled_pointcloud2.hpp"
+#include "primlabel/ros_common/labeled_pointcloud2.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "common/class_fields.hpp"
-#include "ros_common/byte_order.hpp"
-#include "ros_common/pointcloud2_xyz.hpp"
+#include "primlabel/ros_common/byte_order.hpp"
+#include "primlabel/ros_common/pointcloud2_xyz.hpp"
 
 namespace primlabel::roscommon {
 

@@ -1,4 +1,4 @@
-#include "ros_common/node_parameters.hpp"
+#include "primlabel/ros_common/node_parameters.hpp"
 
 #include <chrono>
 #include <cmath>

@@ -1,11 +1,11 @@
-#include "ros_common/pointcloud2_xyz.hpp"
+#include "primlabel/ros_common/pointcloud2_xyz.hpp"
 
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 
-#include "ros_common/byte_order.hpp"
+#include "primlabel/ros_common/byte_order.hpp"
 
 namespace primlabel::roscommon {
 

@@ -1,4 +1,4 @@
-#include "ros_common/summary_json.hpp"
+#include "primlabel/ros_common/summary_json.hpp"
 
 #include <google/protobuf/util/json_util.h>
 

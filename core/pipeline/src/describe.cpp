@@ -151,11 +151,12 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
     // Every point described against the sample's points (same indices as the cloud).
     const std::vector<Vec3f> sample = voxel_sample(cloud.xyz, settings.feature_sample_size, stage);
     const NeighborSearch sample_search(sample, context.stop);
-    out.descriptors = compute_fpfh(cloud, feature_options, stage, nullptr, &sample_search, nullptr);
+    out.descriptors = compute_fpfh(cloud, feature_options, stage, {.search = &sample_search});
   } else {
-    out.descriptors = fpfh ? compute_fpfh(cloud, feature_options, stage, nullptr, out.search.get(),
-                                          out.lists.get())
-                           : compute_pfh(cloud, feature_options, stage, nullptr, out.search.get());
+    out.descriptors =
+        fpfh ? compute_fpfh(cloud, feature_options, stage,
+                            {.search = out.search.get(), .lists = out.lists.get()})
+             : compute_pfh(cloud, feature_options, stage, {.search = out.search.get()});
   }
   out.descriptors = multi_scale_input(cloud, std::move(out.descriptors), settings, *out.search,
                                       !options.use_cloud_normals, wanted, stage);

@@ -81,7 +81,7 @@ Descriptors multi_scale_input(const PointCloud& cloud, Descriptors descriptors,
     options.neighborhood = capped(Neighborhood::Radius(radius));
     options.fpfh_variant = settings.fpfh_variant;
     options.wanted = wanted;
-    blocks.push_back(compute_fpfh(cloud, options, context, nullptr, &search, &lists));
+    blocks.push_back(compute_fpfh(cloud, options, context, {.search = &search, .lists = &lists}));
   }
   // Variations at the normal radius (estimate_normals' curvature when it ran at that radius),
   // the feature radius and the further radii, in that order.

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <thread>
 
+#include "config_file.hpp"
 #include "primlabel/build_version.hpp"
 
 namespace primlabel::server {
@@ -25,81 +26,18 @@ std::string read_token_file(const std::string& path) {
   return token;
 }
 
-std::string trim(const std::string& text) {
-  const auto first = text.find_first_not_of(" \t\r");
-  if (first == std::string::npos) return {};
-  const auto last = text.find_last_not_of(" \t\r");
-  return text.substr(first, last - first + 1);
-}
-
-bool given_on_command_line(const std::vector<std::string>& args, const std::string& flag) {
-  for (const std::string& arg : args)
-    if (arg == flag || arg.rfind(flag + "=", 0) == 0) return true;
-  return false;
-}
-
-// The command line with the config file's settings put in front of it, leaving out every
-// setting that a flag or an environment variable gives: flags > environment > file.
-std::vector<std::string> with_config_file(CLI::App& app, int argc, const char* const* argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
-  std::string path;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--config" && i + 1 < args.size()) path = args[i + 1];
-    if (args[i].rfind("--config=", 0) == 0) path = args[i].substr(9);
-  }
-  if (const char* env = std::getenv("PRIMLABEL_CONFIG"); path.empty() && env) path = env;
-  std::vector<std::string> out{argv[0]};
-  if (!path.empty()) {
-    std::ifstream in(path);
-    if (!in) throw ConfigError{"cannot read the config file '" + path + "'", kExitUsage};
-    std::string line;
-    for (int number = 1; std::getline(in, line); ++number) {
-      line = trim(line);
-      if (line.empty() || line[0] == '#' || line[0] == ';') continue;
-      const auto eq = line.find('=');
-      const std::string where = path + ":" + std::to_string(number);
-      if (eq == std::string::npos)
-        throw ConfigError{where + ": expected `key = value`", kExitUsage};
-      std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
-      if (key.rfind("--", 0) == 0) key = key.substr(2);
-      if (value.size() >= 2 && (value.front() == '"' || value.front() == '\'') &&
-          value.back() == value.front())
-        value = value.substr(1, value.size() - 2);
-      const std::string flag = "--" + key;
-      const CLI::Option* option = app.get_option_no_throw(flag);
-      if (!option || key == "config" || key == "help")
-        throw ConfigError{where + ": unknown setting '" + key + "'", kExitUsage};
-      const std::string env = option->get_envname();
-      if (given_on_command_line(args, flag) || (!env.empty() && std::getenv(env.c_str()))) continue;
-      out.push_back(flag + "=" + value);
-    }
-  }
-  out.insert(out.end(), args.begin(), args.end());
-  return out;
-}
-
 int hardware_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 
-}  // namespace
-
-int effective_workers(const ServerConfig& config) {
-  return config.workers > 0 ? config.workers : std::max(1, hardware_threads() / 2);
-}
-
-int effective_threads_per_job(const ServerConfig& config) {
-  if (config.threads_per_job > 0) return config.threads_per_job;
-  return std::max(1, hardware_threads() / effective_workers(config));
-}
-
-ServerConfig parse_server_config(int argc, const char* const* argv) {
-  ServerConfig config;
-  CLI::App app{"primlabel-server: the gRPC point labeling service."};
-  // Every option with a default shows it in --help ("[0.025]").
-  app.option_defaults()->always_capture_default();
-  app.set_version_flag("--version", primlabel::version_line("primlabel-server"));
-  app.name("primlabel-server");
+// What a flag gives before it is checked and put into the ServerConfig.
+struct RawSettings {
   std::string config_file;  // read before parsing, see with_config_file
-  app.add_option("--config", config_file,
+  std::vector<std::string> pins;
+  std::string token_file;
+};
+
+// Where the models are, where the server listens, which model and version a request gets.
+void add_service_options(CLI::App& app, ServerConfig& config, RawSettings& raw) {
+  app.add_option("--config", raw.config_file,
                  "config file of `key = value` lines, keys named like the flags; "
                  "flags and environment variables win over it")
       ->envname("PRIMLABEL_CONFIG");
@@ -118,8 +56,7 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
                  "model for requests that name none and whose cloud no model's domain decides "
                  "(default: the repository's default_model file, else the only model)")
       ->envname("PRIMLABEL_DEFAULT_MODEL");
-  std::vector<std::string> pins;
-  app.add_option("--pin", pins, "MODEL=VERSION: serve this version by default, not the latest")
+  app.add_option("--pin", raw.pins, "MODEL=VERSION: serve this version by default, not the latest")
       ->envname("PRIMLABEL_PIN");
   app.add_option("--reload-seconds", config.reload_seconds,
                  "poll the model repository this often (0: only on ReloadModels)")
@@ -132,6 +69,10 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
       ->envname("PRIMLABEL_UNLOAD_AFTER_MISSING_POLLS")
       ->check(CLI::Range(1u, 1000000u))
       ->capture_default_str();
+}
+
+// How much the server takes on: jobs, threads, request and message sizes, the drain.
+void add_capacity_options(CLI::App& app, ServerConfig& config) {
   app.add_option("--workers", config.workers,
                  "concurrent labeling jobs (0: half the cores, at least 1)")
       ->envname("PRIMLABEL_WORKERS")
@@ -168,7 +109,10 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
       ->envname("PRIMLABEL_DRAIN_SECONDS")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  // Streams against slow or hostile clients.
+}
+
+// Streams against slow or hostile clients.
+void add_stream_limit_options(CLI::App& app, ServerConfig& config) {
   app.add_option("--max-receiving-streams", config.max_receiving_streams,
                  "Label streams receiving points at once (apart from --workers + --queue)")
       ->envname("PRIMLABEL_MAX_RECEIVING_STREAMS")
@@ -199,6 +143,10 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
       ->envname("PRIMLABEL_MAX_REQUEST_SECONDS")
       ->check(CLI::Range(0.01, 1e7))
       ->capture_default_str();
+}
+
+// TLS, the bearer token and who may administer models.
+void add_security_options(CLI::App& app, ServerConfig& config, RawSettings& raw) {
   app.add_option("--tls-cert", config.tls_cert, "server certificate chain (PEM): enables TLS")
       ->envname("PRIMLABEL_TLS_CERT")
       ->check(CLI::ExistingFile);
@@ -209,8 +157,7 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
                  "CA bundle (PEM): require and verify client certificates (mutual TLS)")
       ->envname("PRIMLABEL_TLS_CLIENT_CA")
       ->check(CLI::ExistingFile);
-  std::string token_file;
-  app.add_option("--token-file", token_file,
+  app.add_option("--token-file", raw.token_file,
                  "file holding the bearer token required on admin RPCs "
                  "(or the token itself in PRIMLABEL_TOKEN)")
       ->envname("PRIMLABEL_TOKEN_FILE");
@@ -221,11 +168,11 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
                "allow admin RPCs (load, unload, reload models) without a token; without a token "
                "and without this flag they are refused")
       ->envname("PRIMLABEL_INSECURE_ADMIN");
-  app.add_option("--log-level", config.log_level, "debug, info, warn or error")
-      ->envname("PRIMLABEL_LOG_LEVEL")
-      ->check(CLI::IsMember({"debug", "info", "warn", "error"}))
-      ->capture_default_str();
+}
 
+// Parses the command line below the config file; --help and --version, and every bad flag, come
+// back as a ConfigError carrying the text CLI11 would print.
+void parse_command_line(CLI::App& app, int argc, const char* const* argv) {
   try {
     const std::vector<std::string> args = with_config_file(app, argc, argv);
     std::vector<const char*> pointers;
@@ -237,25 +184,65 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
     throw ConfigError{e.get_exit_code() == 0 ? out.str() : err.str(),
                       e.get_exit_code() == 0 ? kExitOk : kExitUsage};
   }
+}
 
+// MODEL=VERSION pins into config.pins.
+void apply_pins(const std::vector<std::string>& pins, ServerConfig& config) {
   for (const std::string& pin : pins) {
     const auto eq = pin.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == pin.size())
       throw ConfigError{"--pin expects MODEL=VERSION, got '" + pin + "'", kExitUsage};
     config.pins[pin.substr(0, eq)] = pin.substr(eq + 1);
   }
+}
+
+// TLS files that go together, and the token from its file or the environment.
+void check_security(const RawSettings& raw, ServerConfig& config) {
   if (config.tls_cert.empty() != config.tls_key.empty())
     throw ConfigError{"--tls-cert and --tls-key go together", kExitUsage};
   if (!config.tls_client_ca.empty() && config.tls_cert.empty())
     throw ConfigError{"--tls-client-ca needs --tls-cert and --tls-key", kExitUsage};
-  if (!token_file.empty()) {
-    config.token = read_token_file(token_file);
+  if (!raw.token_file.empty()) {
+    config.token = read_token_file(raw.token_file);
   } else if (const char* token = std::getenv("PRIMLABEL_TOKEN"); token && *token) {
     config.token = token;
   }
   if (config.token_for_all && config.token.empty())
     throw ConfigError{"--token-for-all needs a token (--token-file or PRIMLABEL_TOKEN)",
                       kExitUsage};
+}
+
+}  // namespace
+
+int effective_workers(const ServerConfig& config) {
+  return config.workers > 0 ? config.workers : std::max(1, hardware_threads() / 2);
+}
+
+int effective_threads_per_job(const ServerConfig& config) {
+  if (config.threads_per_job > 0) return config.threads_per_job;
+  return std::max(1, hardware_threads() / effective_workers(config));
+}
+
+ServerConfig parse_server_config(int argc, const char* const* argv) {
+  ServerConfig config;
+  CLI::App app{"primlabel-server: the gRPC point labeling service."};
+  // Every option with a default shows it in --help ("[0.025]").
+  app.option_defaults()->always_capture_default();
+  app.set_version_flag("--version", primlabel::version_line("primlabel-server"));
+  app.name("primlabel-server");
+  RawSettings raw;
+  add_service_options(app, config, raw);
+  add_capacity_options(app, config);
+  add_stream_limit_options(app, config);
+  add_security_options(app, config, raw);
+  app.add_option("--log-level", config.log_level, "debug, info, warn or error")
+      ->envname("PRIMLABEL_LOG_LEVEL")
+      ->check(CLI::IsMember({"debug", "info", "warn", "error"}))
+      ->capture_default_str();
+
+  parse_command_line(app, argc, argv);
+  apply_pins(raw.pins, config);
+  check_security(raw, config);
   return config;
 }
 

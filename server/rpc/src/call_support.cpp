@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "primlabel/service/label_job.hpp"
+#include "primlabel/service/job_plan.hpp"
 
 namespace primlabel::server {
 

@@ -7,6 +7,7 @@
 
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/ops/stage_times.hpp"
+#include "primlabel/service/answer_size.hpp"
 #include "primlabel/service/object_messages.hpp"
 #include "primlabel/service/primitive_messages.hpp"
 #include "primlabel/wire/packing.hpp"
@@ -18,12 +19,10 @@ LabelResponder::LabelResponder(const pipeline::LabelingResult& result,
     : result_(result),
       points_(result.labels.size()),
       classes_(std::uint64_t(result.probabilities.cols())) {
-  bytes_per_point_ =
-      wire::kLabelBytesPerPoint +
-      sizeof(float) * std::uint64_t(result.descriptors.dim) * (result.descriptors.empty() ? 0 : 1) +
-      sizeof(float) * classes_ + (result.primitives ? sizeof(std::uint32_t) : 0) +
-      (result.objects ? sizeof(std::uint32_t) : 0);
-  const std::uint64_t fitting = std::max<std::uint64_t>(1, max_bytes / bytes_per_point_);
+  const std::uint64_t bytes_per_point = array_bytes_per_point(
+      {result.descriptors.empty() ? 0 : std::uint64_t(result.descriptors.dim), classes_,
+       bool(result.primitives), bool(result.objects)});
+  const std::uint64_t fitting = std::max<std::uint64_t>(1, max_bytes / bytes_per_point);
   chunk_points_ =
       requested_points > 0 ? std::min<std::uint64_t>(requested_points, fitting) : fitting;
 }
@@ -90,7 +89,7 @@ v1::ModelChoice choice_message(pipeline::ChoiceReason reason) {
 
 }  // namespace
 
-void fill_summary(const RequestRecord& record, const LabelPlan& plan,
+void fill_summary(const RequestRecord& record, const JobPlan& plan,
                   const pipeline::LabelingResult& result, v1::LabelSummary& summary) {
   const ModelEntry& entry = *plan.entry;
   summary.set_model_choice(choice_message(plan.choice));

@@ -49,7 +49,7 @@ std::optional<ServiceError> LabelingSession::start(const v1::ScanHeader& header,
   record_.model = header.model();
   const ScanLimits limits = limits_of(*env_.config);
   if (auto invalid = check_header(header, limits)) return invalid;
-  if (auto refused = plan_labeling(header, *env_.registry, plan_)) return refused;
+  if (auto refused = plan_job(header, *env_.registry, plan_)) return refused;
   if (plan_.entry) note_model();
   if (streamed) {
     receiving_ = env_.receiving->try_take();

@@ -11,9 +11,11 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <memory>
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "feature_neighborhood.hpp"
 #include "pair_bins_batch.hpp"
@@ -288,122 +290,100 @@ std::vector<std::uint8_t> needed_for(std::span<const std::uint8_t> wanted,
   return needed;
 }
 
-}  // namespace
+// One compute_fpfh call: where each point's neighbours come from, and the SPFH rows of pass 1
+// that pass 2 weighs. Pass 1 takes one of two paths (spfh_from_pair_counts, spfh_per_point);
+// both give the same bits.
+class FpfhRun {
+ public:
+  FpfhRun(const PointCloud& cloud, const FeatureOptions& options, const RunContext& context,
+          const FeatureExtras& extras)
+      : cloud_(cloud),
+        options_(options),
+        context_(context),
+        stop_(context.stop),
+        usable_(checked_usable_points(cloud, options)),
+        index_(detail::ensure_search(cloud, extras.search, owned_search_, stop_)),
+        lists_(extras.lists),
+        n_(cloud.size()),
+        blocks_(static_cast<std::ptrdiff_t>((n_ + kBlock - 1) / kBlock)),
+        threads_(detail::resolve_threads(context.threads)),
+        use_lists_(lists_ && options.neighborhood.radius > 0.0f &&
+                   options.neighborhood.radius <= lists_->neighborhood().radius),
+        all_usable_(std::all_of(usable_.begin(), usable_.end(), [](char u) { return u != 0; })),
+        usable_or_all_(all_usable_ ? nullptr : usable_.data()),
+        cache_(n_, use_lists_ ? 0 : options.neighbor_cache_bytes),
+        progress_(context.progress, 2 * n_),
+        subset_(!options.wanted.empty()) {
+    detail::assign_checked(spfh_, n_ * kFpfhSize, 0.0f, stop_, "FPFH");
+    detail::assign_checked(spfh_sums_, n_ * 3, 0.0, stop_, "FPFH");
+    detail::assign_checked(neighbor_count_, n_, std::uint32_t(0), stop_, "FPFH");
+    if (subset_ && options.wanted.size() != n_)
+      throw std::invalid_argument("FPFH: " + std::to_string(options.wanted.size()) +
+                                  " wanted flags for " + std::to_string(n_) + " points");
+    // Only some points wanted: pass 1 on them and their neighbours alone. A needed point that
+    // then misses a pair its list expects (its lower neighbour was not needed) takes the
+    // per-point path like any other, so the rows are the same bits.
+    if (subset_)
+      needed_ = needed_for(
+          options.wanted,
+          [this](std::size_t p, NeighborList& scratch) { return neighbors_of(p, scratch); },
+          usable_, blocks_, context.with_threads(threads_));
+    throw_if_stopped(stop_, "FPFH");
+  }
 
-Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
-                         const RunContext& context, FeatureStats* stats,
-                         const NeighborSearch* search, const NeighborLists* lists) {
-  const std::stop_token& stop = context.stop;
-  if (!options.neighborhood.valid())
-    throw std::invalid_argument("FPFH: invalid neighbourhood " + options.neighborhood.describe());
-  const std::vector<char> usable = detail::usable_points(cloud, "FPFH");
-  std::unique_ptr<NeighborSearch> owned;
-  const NeighborSearch& index = detail::ensure_search(cloud, search, owned, stop);
+  // Radius neighbourhoods are symmetric (q is within r of p exactly when p is within r of q: the
+  // same float distance), so pass 1 may compute each pair once, while the counts fit in memory.
+  bool pairs_symmetric() const {
+    const Neighborhood& hood = options_.neighborhood;
+    return hood.radius > 0.0f && hood.k == 0 &&
+           n_ * kPairCountBytes * std::size_t(threads_) <= kPairCountBudget;
+  }
 
-  const std::size_t n = cloud.size();
-  const std::ptrdiff_t blocks = static_cast<std::ptrdiff_t>((n + kBlock - 1) / kBlock);
-  const int threads = detail::resolve_threads(context.threads);
-  // Radius neighbourhoods need no order: every sum below is order-independent up to rounding,
-  // and tree order is itself deterministic.
-  const bool sorted = false;
-  const bool use_lists = lists && options.neighborhood.radius > 0.0f &&
-                         options.neighborhood.radius <= lists->neighborhood().radius;
-  // Point p's neighbours (with or without a normal), from the shared lists (no copy where they
-  // answer as they are) or a search into `scratch`.
-  const auto neighbors_of = [&](std::size_t p, NeighborList& scratch) {
-    if (use_lists) return lists->view(p, options.neighborhood, scratch);
-    index.find(cloud.xyz[p], options.neighborhood, scratch, sorted);
-    return std::span<const std::uint32_t>(scratch.indices);
-  };
-  // Points without a normal are skipped where a list is read; null when every point has one.
-  const bool all_usable = std::all_of(usable.begin(), usable.end(), [](char u) { return u != 0; });
-  const char* usable_or_all = all_usable ? nullptr : usable.data();
-
-  std::vector<float> spfh;
-  std::vector<double> spfh_sums;              // per sub-histogram, for the normalisation
-  std::vector<std::uint32_t> neighbor_count;  // per point: its list's points that take part
-  detail::assign_checked(spfh, n * kFpfhSize, 0.0f, stop, "FPFH");
-  detail::assign_checked(spfh_sums, n * 3, 0.0, stop, "FPFH");
-  detail::assign_checked(neighbor_count, n, std::uint32_t(0), stop, "FPFH");
-  // Shared lists are read again in pass 2 at no cost; searched ones are kept for it.
-  NeighborCache cache(n, use_lists ? 0 : options.neighbor_cache_bytes);
-  detail::ProgressCounter progress(context.progress, 2 * n);
-  // What pass 2 needs of p's list: the list itself (when searched) and how many take part.
-  const auto keep_for_pass_2 = [&](std::size_t p, std::span<const std::uint32_t> list) {
-    cache.store(p, list);
-    const std::size_t taking_part =
-        all_usable ? list.size()
-                   : std::size_t(std::count_if(list.begin(), list.end(),
-                                               [&](std::uint32_t q) { return usable[q] != 0; }));
-    neighbor_count[p] = static_cast<std::uint32_t>(
-        std::min<std::size_t>(taking_part, std::numeric_limits<std::uint32_t>::max()));
-  };
-  const auto finish_row = [&](std::size_t p) {
-    const float* row = &spfh[p * kFpfhSize];
-    for (int b = 0; b < kFpfhSize; ++b) spfh_sums[3 * p + b / kBins] += row[b];
-  };
-
-  // Pass 1, SPFH. Radius neighbourhoods are symmetric (q is within r of p exactly when p is
-  // within r of q: the same float distance), so each pair is computed once. A list cut by the
-  // cap is not the whole ball: its point's row, and the rows of points that then miss a pair,
-  // take the per-point path, as do k-nearest neighbourhoods and counts beyond the memory bound.
-  const Neighborhood& hood = options.neighborhood;
-  // Only some points wanted: pass 1 on them and their neighbours alone. A needed point that then
-  // misses a pair its list expects (its lower neighbour was not needed) takes the per-point path
-  // like any other, so the rows are the same bits.
-  const bool subset = !options.wanted.empty();
-  if (subset && options.wanted.size() != n)
-    throw std::invalid_argument("FPFH: " + std::to_string(options.wanted.size()) +
-                                " wanted flags for " + std::to_string(n) + " points");
-  const std::vector<std::uint8_t> needed =
-      subset
-          ? needed_for(options.wanted, neighbors_of, usable, blocks, context.with_threads(threads))
-          : std::vector<std::uint8_t>{};
-  throw_if_stopped(stop, "FPFH");
-  const bool symmetric = hood.radius > 0.0f && hood.k == 0 &&
-                         n * kPairCountBytes * std::size_t(threads) <= kPairCountBudget;
-  if (symmetric) {
-    std::vector<PairCounts> per_thread(static_cast<std::size_t>(threads));
-    std::vector<std::uint64_t> expected(n, 0);
-    std::vector<std::uint8_t> cut(n, 0);
+  // Pass 1, each pair once. A list cut by the cap is not the whole ball: its point's row, and the
+  // rows of points that then miss a pair, take the per-point path.
+  void spfh_from_pair_counts() {
+    std::vector<PairCounts> per_thread(static_cast<std::size_t>(threads_));
+    std::vector<std::uint64_t> expected(n_, 0);
+    std::vector<std::uint8_t> cut(n_, 0);
     std::atomic<std::size_t> next_thread{0};
     struct CountScratch {
       SpfhScratch pairs;
       PairCounts* counts;
     };
+    const Neighborhood& hood = options_.neighborhood;
     detail::for_each_block(
-        blocks, context.with_threads(threads),
+        blocks_, context_.with_threads(threads_),
         [&] {
           PairCounts* mine = &per_thread[next_thread++];
-          mine->init(n);
+          mine->init(n_);
           return CountScratch{SpfhScratch(), mine};
         },
         [&](CountScratch& scratch, std::ptrdiff_t block) {
-          const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+          const auto [first, last] = block_range(block);
           for (std::size_t p = first; p < last; ++p) {
-            if (stop.stop_requested()) return;
-            if (!usable[p] || (subset && !needed[p])) continue;
+            if (stop_.stop_requested()) return;
+            if (!takes_part_in_pass_1(p)) continue;
             const std::span<const std::uint32_t> list = neighbors_of(p, scratch.pairs.list);
             keep_for_pass_2(p, list);
             cut[p] = hood.max_neighbors > 0 && list.size() >= std::size_t(hood.max_neighbors);
             expected[p] =
-                count_upper_pairs(cloud, p, list, usable_or_all, scratch.pairs, *scratch.counts);
+                count_upper_pairs(cloud_, p, list, usable_or_all_, scratch.pairs, *scratch.counts);
           }
-          progress.add((last - first) / 2);
+          progress_.add((last - first) / 2);
         });
-    throw_if_stopped(stop, "FPFH");
+    throw_if_stopped(stop_, "FPFH");
     const std::size_t used = next_thread.load();
     // Rows from the summed counts. A point whose list was cut, that did not receive exactly the
     // pairs its own list expects (a lower neighbour's cut list, or a search that is not
     // symmetric after all), or whose counts could overflow, gets its row by the per-point path:
     // the result is the same either way.
     detail::for_each_block(
-        blocks, context.with_threads(threads), [] { return SpfhScratch(); },
+        blocks_, context_.with_threads(threads_), [] { return SpfhScratch(); },
         [&](SpfhScratch& scratch, std::ptrdiff_t block) {
-          const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+          const auto [first, last] = block_range(block);
           for (std::size_t p = first; p < last; ++p) {
-            if (stop.stop_requested()) return;
-            if (!usable[p] || (subset && !needed[p]) || neighbor_count[p] < 2) continue;
+            if (stop_.stop_requested()) return;
+            if (!takes_part_in_pass_1(p) || neighbor_count_[p] < 2) continue;
             std::uint64_t received = 0;
             std::uint32_t counts[kFpfhSize] = {};
             for (std::size_t t = 0; t < used; ++t) {
@@ -411,73 +391,155 @@ Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
               const std::uint16_t* row = per_thread[t].counts.data() + p * kFpfhSize;
               for (int b = 0; b < kFpfhSize; ++b) counts[b] += row[b];
             }
-            float* row = &spfh[p * kFpfhSize];
-            if (cut[p] || received != expected[p] || neighbor_count[p] > kMaxCountedNeighbors) {
+            float* row = &spfh_[p * kFpfhSize];
+            if (cut[p] || received != expected[p] || neighbor_count_[p] > kMaxCountedNeighbors) {
               std::span<const std::uint32_t> list;
-              if (!cache.load(p, list)) list = neighbors_of(p, scratch.list);
-              compute_spfh(cloud, p, list, usable_or_all, neighbor_count[p], scratch, row);
+              if (!cache_.load(p, list)) list = neighbors_of(p, scratch.list);
+              compute_spfh(cloud_, p, list, usable_or_all_, neighbor_count_[p], scratch, row);
             } else {
-              const float* sum_of = scratch.sums.for_neighbors(neighbor_count[p]);
+              const float* sum_of = scratch.sums.for_neighbors(neighbor_count_[p]);
               for (int b = 0; b < kFpfhSize; ++b) row[b] = sum_of[counts[b]];
             }
             finish_row(p);
           }
-          progress.add(last - first - (last - first) / 2);
+          progress_.add(last - first - (last - first) / 2);
         });
-  } else {
+    throw_if_stopped(stop_, "FPFH");
+  }
+
+  // Pass 1, every pair of every point: k-nearest neighbourhoods and counts beyond the memory bound.
+  void spfh_per_point() {
     detail::for_each_block(
-        blocks, context.with_threads(threads), [] { return SpfhScratch(); },
+        blocks_, context_.with_threads(threads_), [] { return SpfhScratch(); },
         [&](SpfhScratch& scratch, std::ptrdiff_t block) {
-          const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
+          const auto [first, last] = block_range(block);
           for (std::size_t p = first; p < last; ++p) {
             // Per point: a stop is honoured within one (capped) neighbourhood's time.
-            if (stop.stop_requested()) return;
-            if (!usable[p] || (subset && !needed[p])) continue;
+            if (stop_.stop_requested()) return;
+            if (!takes_part_in_pass_1(p)) continue;
             const std::span<const std::uint32_t> list = neighbors_of(p, scratch.list);
             keep_for_pass_2(p, list);
-            if (neighbor_count[p] < 2) continue;
-            compute_spfh(cloud, p, list, usable_or_all, neighbor_count[p], scratch,
-                         &spfh[p * kFpfhSize]);
+            if (neighbor_count_[p] < 2) continue;
+            compute_spfh(cloud_, p, list, usable_or_all_, neighbor_count_[p], scratch,
+                         &spfh_[p * kFpfhSize]);
             finish_row(p);
           }
-          progress.add(last - first);
+          progress_.add(last - first);
         });
+    throw_if_stopped(stop_, "FPFH");
   }
-  throw_if_stopped(stop, "FPFH");
 
-  std::vector<float> fpfh;
-  detail::assign_checked(fpfh, n * kFpfhSize, 0.0f, stop, "FPFH");
-  std::atomic<std::size_t> computed{0}, isolated{0};
-  detail::for_each_block(
-      blocks, context.with_threads(threads), [] { return NeighborList(); },
-      [&](NeighborList& scratch, std::ptrdiff_t block) {
-        std::size_t block_computed = 0, block_isolated = 0;
-        const std::size_t first = std::size_t(block) * kBlock, last = std::min(n, first + kBlock);
-        for (std::size_t p = first; p < last; ++p) {
-          if (stop.stop_requested()) return;
-          float* out = &fpfh[p * kFpfhSize];
-          if (!usable[p] || (subset && !options.wanted[p])) {
-            std::fill(out, out + kFpfhSize, std::numeric_limits<float>::quiet_NaN());
-            continue;
+  // Pass 2: each wanted point's neighbours' SPFH rows, weighed by inverse squared distance.
+  Descriptors weigh_neighbors(FeatureStats* stats) {
+    std::vector<float> fpfh;
+    detail::assign_checked(fpfh, n_ * kFpfhSize, 0.0f, stop_, "FPFH");
+    std::atomic<std::size_t> computed{0}, isolated{0};
+    detail::for_each_block(
+        blocks_, context_.with_threads(threads_), [] { return NeighborList(); },
+        [&](NeighborList& scratch, std::ptrdiff_t block) {
+          std::size_t block_computed = 0, block_isolated = 0;
+          const auto [first, last] = block_range(block);
+          for (std::size_t p = first; p < last; ++p) {
+            if (stop_.stop_requested()) return;
+            float* out = &fpfh[p * kFpfhSize];
+            if (!usable_[p] || (subset_ && !options_.wanted[p])) {
+              std::fill(out, out + kFpfhSize, std::numeric_limits<float>::quiet_NaN());
+              continue;
+            }
+            if (neighbor_count_[p] < 2) {
+              ++block_isolated;  // stays all zero, as in PCL
+              continue;
+            }
+            std::span<const std::uint32_t> list;
+            if (!cache_.load(p, list)) list = neighbors_of(p, scratch);
+            weight_spfh(cloud_, p, spfh_, spfh_sums_, list, usable_or_all_, out);
+            if (options_.fpfh_variant == FpfhVariant::kWithOwnSpfh)
+              for (int b = 0; b < kFpfhSize; ++b) out[b] += spfh_[p * kFpfhSize + b];
+            ++block_computed;
           }
-          if (neighbor_count[p] < 2) {
-            ++block_isolated;  // stays all zero, as in PCL
-            continue;
-          }
-          std::span<const std::uint32_t> list;
-          if (!cache.load(p, list)) list = neighbors_of(p, scratch);
-          weight_spfh(cloud, p, spfh, spfh_sums, list, usable_or_all, out);
-          if (options.fpfh_variant == FpfhVariant::kWithOwnSpfh)
-            for (int b = 0; b < kFpfhSize; ++b) out[b] += spfh[p * kFpfhSize + b];
-          ++block_computed;
-        }
-        computed += block_computed, isolated += block_isolated;
-        progress.add(last - first);
-      });
-  throw_if_stopped(stop, "FPFH");
-  progress.finish();
-  if (stats) *stats = FeatureStats{computed.load(), isolated.load(), n - computed - isolated};
-  return Descriptors(kFpfhSize, std::move(fpfh));
+          computed += block_computed, isolated += block_isolated;
+          progress_.add(last - first);
+        });
+    throw_if_stopped(stop_, "FPFH");
+    progress_.finish();
+    if (stats) *stats = FeatureStats{computed.load(), isolated.load(), n_ - computed - isolated};
+    return Descriptors(kFpfhSize, std::move(fpfh));
+  }
+
+ private:
+  static std::vector<char> checked_usable_points(const PointCloud& cloud,
+                                                 const FeatureOptions& options) {
+    if (!options.neighborhood.valid())
+      throw std::invalid_argument("FPFH: invalid neighbourhood " + options.neighborhood.describe());
+    return detail::usable_points(cloud, "FPFH");
+  }
+
+  std::pair<std::size_t, std::size_t> block_range(std::ptrdiff_t block) const {
+    const std::size_t first = std::size_t(block) * kBlock;
+    return {first, std::min(n_, first + kBlock)};
+  }
+
+  bool takes_part_in_pass_1(std::size_t p) const { return usable_[p] && (!subset_ || needed_[p]); }
+
+  // Point p's neighbours (with or without a normal), from the shared lists (no copy where they
+  // answer as they are) or a search into `scratch`. Radius neighbourhoods need no order: every
+  // sum is order-independent up to rounding, and tree order is itself deterministic.
+  std::span<const std::uint32_t> neighbors_of(std::size_t p, NeighborList& scratch) const {
+    if (use_lists_) return lists_->view(p, options_.neighborhood, scratch);
+    index_.find(cloud_.xyz[p], options_.neighborhood, scratch, /*sorted=*/false);
+    return std::span<const std::uint32_t>(scratch.indices);
+  }
+
+  // What pass 2 needs of p's list: the list itself (when searched; shared lists are read again
+  // at no cost) and how many take part.
+  void keep_for_pass_2(std::size_t p, std::span<const std::uint32_t> list) {
+    cache_.store(p, list);
+    const std::size_t taking_part =
+        all_usable_ ? list.size()
+                    : std::size_t(std::count_if(list.begin(), list.end(),
+                                                [&](std::uint32_t q) { return usable_[q] != 0; }));
+    neighbor_count_[p] = static_cast<std::uint32_t>(
+        std::min<std::size_t>(taking_part, std::numeric_limits<std::uint32_t>::max()));
+  }
+
+  void finish_row(std::size_t p) {
+    const float* row = &spfh_[p * kFpfhSize];
+    for (int b = 0; b < kFpfhSize; ++b) spfh_sums_[3 * p + b / kBins] += row[b];
+  }
+
+  const PointCloud& cloud_;
+  const FeatureOptions& options_;
+  const RunContext& context_;
+  const std::stop_token& stop_;
+  const std::vector<char> usable_;
+  std::unique_ptr<NeighborSearch> owned_search_;
+  const NeighborSearch& index_;
+  const NeighborLists* lists_;
+  const std::size_t n_;
+  const std::ptrdiff_t blocks_;
+  const int threads_;
+  const bool use_lists_;
+  const bool all_usable_;
+  const char* usable_or_all_;  // points without a normal skipped; null when every point has one
+  NeighborCache cache_;
+  detail::ProgressCounter progress_;
+  const bool subset_;
+  std::vector<std::uint8_t> needed_;  // subset: the points pass 1 describes
+  std::vector<float> spfh_;
+  std::vector<double> spfh_sums_;              // per sub-histogram, for the normalisation
+  std::vector<std::uint32_t> neighbor_count_;  // per point: its list's points that take part
+};
+
+}  // namespace
+
+Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
+                         const RunContext& context, const FeatureExtras& extras) {
+  FpfhRun run(cloud, options, context, extras);
+  if (run.pairs_symmetric())
+    run.spfh_from_pair_counts();
+  else
+    run.spfh_per_point();
+  return run.weigh_neighbors(extras.stats);
 }
 
 }  // namespace primlabel

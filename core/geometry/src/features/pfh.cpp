@@ -48,14 +48,14 @@ void compute_point_pfh(const PointCloud& cloud, const NeighborList& neighbors, P
 }  // namespace
 
 Descriptors compute_pfh(const PointCloud& cloud, const FeatureOptions& options,
-                        const RunContext& context, FeatureStats* stats,
-                        const NeighborSearch* search) {
+                        const RunContext& context, const FeatureExtras& extras) {
+  FeatureStats* stats = extras.stats;
   const std::stop_token& stop = context.stop;
   if (!options.neighborhood.valid())
     throw std::invalid_argument("PFH: invalid neighbourhood " + options.neighborhood.describe());
   const std::vector<char> usable = detail::usable_points(cloud, "PFH");
   std::unique_ptr<NeighborSearch> owned;
-  const NeighborSearch& index = detail::ensure_search(cloud, search, owned, stop);
+  const NeighborSearch& index = detail::ensure_search(cloud, extras.search, owned, stop);
 
   const std::size_t n = cloud.size();
   std::vector<float> pfh;

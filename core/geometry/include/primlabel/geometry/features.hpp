@@ -57,20 +57,24 @@ struct FeatureStats {
   std::size_t nan = 0;       // invalid points or normals: NaN descriptor
 };
 
+// What a descriptor computation may be lent and where it reports; each part optional.
+struct FeatureExtras {
+  const NeighborSearch* search = nullptr;  // an index on cloud.xyz; built when null
+  // FPFH: shared neighbour lists on cloud.xyz (see estimate_normals), used when the
+  // neighbourhood is a radius within theirs.
+  const NeighborLists* lists = nullptr;
+  FeatureStats* stats = nullptr;  // filled when set
+};
+
 // cloud.size() x 33. Requires cloud.normals. Once context.stop is requested the remaining blocks
 // of points are skipped and the function throws Cancelled; context.progress counts points (twice:
 // both passes).
-// `lists`: shared neighbour lists on cloud.xyz (see estimate_normals), used when the
-// neighbourhood is a radius within theirs.
 Descriptors compute_fpfh(const PointCloud& cloud, const FeatureOptions& options,
-                         const RunContext& context = {}, FeatureStats* stats = nullptr,
-                         const NeighborSearch* search = nullptr,
-                         const NeighborLists* lists = nullptr);
+                         const RunContext& context = {}, const FeatureExtras& extras = {});
 
-// cloud.size() x 125. Requires cloud.normals. context as for compute_fpfh.
+// cloud.size() x 125. Requires cloud.normals. context as for compute_fpfh; extras.lists unused.
 Descriptors compute_pfh(const PointCloud& cloud, const FeatureOptions& options,
-                        const RunContext& context = {}, FeatureStats* stats = nullptr,
-                        const NeighborSearch* search = nullptr);
+                        const RunContext& context = {}, const FeatureExtras& extras = {});
 
 // The four pair features of (p1, n1) and (p2, n2) as pcl::computePairFeatures defines them.
 // `valid` is false (and the features all zero, which is what PCL bins) for coincident points or a

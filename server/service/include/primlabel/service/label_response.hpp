@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "primlabel/pipeline/labeling.hpp"
-#include "primlabel/service/label_job.hpp"
+#include "primlabel/service/job_plan.hpp"
 #include "primlabel/service/model_registry.hpp"
 #include "primlabel/service/request_record.hpp"
 #include "primlabel/v1/labeling.pb.h"
@@ -18,7 +18,6 @@ class LabelResponder {
   LabelResponder(const pipeline::LabelingResult& result, std::uint32_t requested_points,
                  std::uint64_t max_bytes);
 
-  std::uint64_t bytes_per_point() const { return bytes_per_point_; }
   std::uint64_t chunk_points() const { return chunk_points_; }
   std::uint64_t chunk_count() const;
   // Chunk `index` (points [index * chunk_points, ...)).
@@ -30,12 +29,11 @@ class LabelResponder {
   const pipeline::LabelingResult& result_;
   std::uint64_t points_;
   std::uint64_t classes_;
-  std::uint64_t bytes_per_point_;
   std::uint64_t chunk_points_;
 };
 
 // `plan.entry` is the model that labeled the cloud.
-void fill_summary(const RequestRecord& record, const LabelPlan& plan,
+void fill_summary(const RequestRecord& record, const JobPlan& plan,
                   const pipeline::LabelingResult& result, v1::LabelSummary& summary);
 
 }  // namespace primlabel::server

@@ -14,7 +14,8 @@
 #include <memory>
 #include <optional>
 
-#include "primlabel/service/label_job.hpp"
+#include "primlabel/service/answer_size.hpp"
+#include "primlabel/service/job_plan.hpp"
 #include "primlabel/service/request_record.hpp"
 #include "primlabel/service/scan_assembler.hpp"
 #include "primlabel/service/service_environment.hpp"
@@ -48,7 +49,7 @@ class LabelingSession {
   std::chrono::steady_clock::time_point job_ended() const { return job_end_; }
 
   const v1::ScanHeader& header() const { return header_; }
-  const LabelPlan& plan() const { return plan_; }
+  const JobPlan& plan() const { return plan_; }
   std::uint64_t points() const { return assembler_ ? assembler_->points() : 0; }
   // The answer's per-point arrays in bytes, from the point count and the options.
   std::uint64_t answer_bytes() const {
@@ -65,7 +66,7 @@ class LabelingSession {
   IdleMemoryTrimmer* const trimmer_;
   RequestRecord& record_;
   v1::ScanHeader header_;
-  LabelPlan plan_;
+  JobPlan plan_;
   std::optional<ScanAssembler> assembler_;
   std::optional<SlotBudget::Slot> receiving_;
   std::optional<Admission::Ticket> ticket_;  // given back by the worker when the job ends

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "ros_common/pointcloud2.hpp"
+#include "primlabel/ros_common/pointcloud2.hpp"
 #include "sensor_msgs/msg/PointCloud2.h"
 #include "std_msgs/msg/Header.h"
 

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "primlabel/client/client.hpp"
-#include "ros_common/pointcloud2.hpp"
+#include "primlabel/ros_common/pointcloud2.hpp"
 
 namespace primlabel::roscommon {
 

@@ -7,9 +7,9 @@
 #include <string>
 
 #include "primlabel/client/client.hpp"
-#include "ros_common/labeled_pointcloud2.hpp"
-#include "ros_common/node_parameters.hpp"
-#include "ros_common/pointcloud2.hpp"
+#include "primlabel/ros_common/labeled_pointcloud2.hpp"
+#include "primlabel/ros_common/node_parameters.hpp"
+#include "primlabel/ros_common/pointcloud2.hpp"
 
 namespace primlabel::roscommon {
 

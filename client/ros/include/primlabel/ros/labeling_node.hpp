@@ -11,15 +11,15 @@
 
 #include <cstdint>
 
-#include "node_parameters.hpp"
-#include "ros_common/cloud_labeler.hpp"
+#include "primlabel/ros_common/cloud_labeler.hpp"
+#include "primlabel/ros_common/node_parameters.hpp"
 
 namespace primlabel::rosnode {
 
 class LabelingNode {
  public:
   // Subscribes and advertises on `node` (topic names resolve in its namespace).
-  LabelingNode(ros::NodeHandle& node, const NodeParameters& parameters);
+  LabelingNode(ros::NodeHandle& node, const roscommon::NodeParameters& parameters);
 
   void on_cloud(const sensor_msgs::PointCloud2ConstPtr& cloud);
 
@@ -27,7 +27,7 @@ class LabelingNode {
   std::uint64_t failed() const { return failed_; }
 
  private:
-  NodeParameters parameters_;
+  roscommon::NodeParameters parameters_;
   roscommon::CloudLabeler labeler_;
   ros::Publisher cloud_publisher_;
   ros::Publisher summary_publisher_;

@@ -13,10 +13,10 @@
 #include <memory>
 #include <string>
 
-#include "dds_entity.hpp"
-#include "ros2_arguments.hpp"
-#include "ros_common/cloud_labeler.hpp"
-#include "ros_discovery_info.hpp"
+#include "primlabel/ros2/dds_entity.hpp"
+#include "primlabel/ros2/ros2_arguments.hpp"
+#include "primlabel/ros2/ros_discovery_info.hpp"
+#include "primlabel/ros_common/cloud_labeler.hpp"
 
 namespace primlabel::ros2node {
 

@@ -1,8 +1,9 @@
 #pragma once
-// One labeling request between "points received" and "labels ready": which model and options
-// it gets (checked against what the model allows), and the labeling itself, which turns every
-// way it can fail (stopped, bad options, out of memory, any other exception) into a
-// ServiceError. No transport here.
+// A labeling job's plan, between "header received" and "labels ready": which model and options
+// the request gets (checked against what the model allows; not core's pipeline::LabelingPlan,
+// which is how label_cloud works through one cloud), and running it, which turns every way it
+// can fail (stopped, bad options, out of memory, any other exception) into a ServiceError. The
+// answer's size: answer_size.hpp. No transport here.
 
 #include <cstdint>
 #include <memory>
@@ -18,7 +19,7 @@
 
 namespace primlabel::server {
 
-struct LabelPlan {
+struct JobPlan {
   // The model, held for the whole request: reloads cannot touch it. Empty until the job when
   // the request names no model and the header leaves the choice to the cloud's signature.
   std::shared_ptr<const ModelEntry> entry;
@@ -41,35 +42,17 @@ struct LabelPlan {
 
 // Resolves the model (or as much of the choice as the header allows) and checks the options
 // (NOT_FOUND, INVALID_ARGUMENT, FAILED_PRECONDITION).
-std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelRegistry& registry,
-                                          LabelPlan& plan);
+std::optional<ServiceError> plan_job(const v1::ScanHeader& header, ModelRegistry& registry,
+                                     JobPlan& plan);
 
 // Finishes a choice the header left open, from the cloud's signature (a neighbour index over
 // it); NOT_FOUND when no model fits and the server has no default. Runs inside the job.
-std::optional<ServiceError> finish_model_choice(LabelPlan& plan, const PointCloud& cloud,
+std::optional<ServiceError> finish_model_choice(JobPlan& plan, const PointCloud& cloud,
                                                 const RunContext& context);
-
-// Bytes per point of the answer the plan asks for (labels, descriptors, probabilities, segment
-// ids, object ids and the objects' messages), known before labeling.
-std::uint64_t answer_bytes_per_point(const LabelPlan& plan);
-
-// A bound on one encoded v1::Primitive (a plane, the largest: 16 doubles and 4 scalars with their
-// tags, about 300 bytes); test_server_service checks real messages against it.
-inline constexpr std::uint64_t kMaxPrimitiveMessageBytes = 400;
-// A bound on one encoded v1::TabletopObject without its primitive ids (an id, a count, three
-// Vec3d and a double with their tags: about 110 bytes).
-inline constexpr std::uint64_t kMaxObjectMessageBytes = 160;
-// An estimate of the encoded v1::TabletopTable: the plane and up to 1024 hull vertices at 31 bytes
-// each (the hull of the table's grid cells has far fewer).
-inline constexpr std::uint64_t kMaxTableMessageBytes = 64 + 1024 * 31;
-// Bytes the summary may carry on top of its fixed part, whatever the cloud size: the primitives
-// (at most PrimitiveOptions::segments.max_segments of them) and the table with the objects'
-// primitive ids (the objects themselves are counted per point in answer_bytes_per_point).
-std::uint64_t answer_summary_bytes(const LabelPlan& plan);
 
 // Finishes the model choice if it is open, then runs label_cloud; never throws. CANCELLED when
 // context.stop was requested.
-std::optional<ServiceError> run_label_job(LabelPlan& plan, PointCloud& cloud,
+std::optional<ServiceError> run_label_job(JobPlan& plan, PointCloud& cloud,
                                           const RunContext& context,
                                           pipeline::LabelingResult& result);
 

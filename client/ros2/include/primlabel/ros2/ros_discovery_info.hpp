@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "dds_entity.hpp"
+#include "primlabel/ros2/dds_entity.hpp"
 
 namespace primlabel::ros2node {
 

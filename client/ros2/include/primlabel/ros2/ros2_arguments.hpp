@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "node_log.hpp"
-#include "ros2_qos.hpp"
-#include "ros_common/node_parameters.hpp"
+#include "primlabel/ros2/node_log.hpp"
+#include "primlabel/ros2/ros2_qos.hpp"
+#include "primlabel/ros_common/node_parameters.hpp"
 
 namespace primlabel::ros2node {
 

@@ -1,4 +1,4 @@
-#include "primlabel/service/label_job.hpp"
+#include "primlabel/service/job_plan.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -8,11 +8,10 @@
 #include "primlabel/geometry/cloud_signature.hpp"
 #include "primlabel/service/label_options.hpp"
 #include "primlabel/service/registry_error.hpp"
-#include "primlabel/tabletop/tabletop.hpp"
 
 namespace primlabel::server {
 
-std::vector<const ModelEntry*> LabelPlan::possible_models() const {
+std::vector<const ModelEntry*> JobPlan::possible_models() const {
   if (entry) return {entry.get()};
   std::vector<const ModelEntry*> models;
   for (const auto& candidate : candidates)
@@ -24,7 +23,7 @@ std::vector<const ModelEntry*> LabelPlan::possible_models() const {
 namespace {
 
 // Takes the chooser's decision into the plan: the entry it names, or NOT_FOUND.
-std::optional<ServiceError> apply_choice(LabelPlan& plan) {
+std::optional<ServiceError> apply_choice(JobPlan& plan) {
   const pipeline::ModelChoice& choice = plan.chooser->choice();
   if (choice.model.empty())
     return ServiceError{ErrorCode::kNotFound, "the request names no model and " + choice.why};
@@ -41,7 +40,7 @@ std::optional<ServiceError> apply_choice(LabelPlan& plan) {
 
 // Every served model as a candidate of the choice, in the registry's (name) order.
 std::optional<ServiceError> start_choice(const pipeline::CloudShape& shape,
-                                         const ModelRegistry& registry, LabelPlan& plan) {
+                                         const ModelRegistry& registry, JobPlan& plan) {
   std::vector<pipeline::ModelCandidate> candidates;
   for (const ServedModel& served : registry.list()) {
     plan.candidates.push_back(served.served);
@@ -58,8 +57,8 @@ std::optional<ServiceError> start_choice(const pipeline::CloudShape& shape,
 
 }  // namespace
 
-std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelRegistry& registry,
-                                          LabelPlan& plan) {
+std::optional<ServiceError> plan_job(const v1::ScanHeader& header, ModelRegistry& registry,
+                                     JobPlan& plan) {
   const pipeline::CloudShape shape{header.layout().width(), header.layout().height()};
   plan.options = labeling_options(header);
   if (auto refused = refuse_options(plan.options)) return refused;
@@ -88,7 +87,7 @@ std::optional<ServiceError> plan_labeling(const v1::ScanHeader& header, ModelReg
   return std::nullopt;
 }
 
-std::optional<ServiceError> finish_model_choice(LabelPlan& plan, const PointCloud& cloud,
+std::optional<ServiceError> finish_model_choice(JobPlan& plan, const PointCloud& cloud,
                                                 const RunContext& context) {
   if (plan.entry) return std::nullopt;
   const auto start = std::chrono::steady_clock::now();
@@ -98,41 +97,7 @@ std::optional<ServiceError> finish_model_choice(LabelPlan& plan, const PointClou
   return apply_choice(plan);
 }
 
-std::uint64_t answer_bytes_per_point(const LabelPlan& plan) {
-  // Until the choice is made, the largest answer any candidate would give.
-  std::uint64_t model_bytes = 0;
-  for (const ModelEntry* entry : plan.possible_models()) {
-    const LabelModel& model = *entry->model;
-    std::uint64_t bytes = 0;
-    if (plan.options.want_descriptors)
-      bytes += sizeof(float) * std::uint64_t(model.features.descriptor_dim());
-    if (plan.options.want_probabilities) bytes += sizeof(float) * model.class_ids().size();
-    model_bytes = std::max(model_bytes, bytes);
-  }
-  std::uint64_t bytes = sizeof(std::uint32_t) + model_bytes;
-  if (plan.options.want_primitives) bytes += sizeof(std::uint32_t);  // LabelChunk.segments
-  if (plan.options.want_objects) {
-    bytes += sizeof(std::uint32_t);  // LabelChunk.objects
-    // Every object holds at least min_size points of the cloud (clusters smaller are dropped
-    // and the refinements only split off parts at least as large).
-    const std::uint64_t min_points =
-        std::max<std::size_t>(1, tabletop::TabletopOptions{}.clusters.min_size);
-    bytes += (kMaxObjectMessageBytes + min_points - 1) / min_points;
-  }
-  return bytes;
-}
-
-std::uint64_t answer_summary_bytes(const LabelPlan& plan) {
-  std::uint64_t bytes = 0;
-  const std::uint64_t segments = plan.options.primitives.segments.max_segments;
-  if (plan.options.want_primitives) bytes += segments * kMaxPrimitiveMessageBytes;
-  // The table, and each segment's id listed by at most one object (5 bytes a varint).
-  if (plan.options.want_objects)
-    bytes += kMaxTableMessageBytes + (plan.options.want_primitives ? 5 * segments : 0);
-  return bytes;
-}
-
-std::optional<ServiceError> run_label_job(LabelPlan& plan, PointCloud& cloud,
+std::optional<ServiceError> run_label_job(JobPlan& plan, PointCloud& cloud,
                                           const RunContext& context,
                                           pipeline::LabelingResult& result) {
   try {

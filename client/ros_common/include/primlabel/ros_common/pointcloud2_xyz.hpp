@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include "primlabel/geometry/point_cloud.hpp"
-#include "ros_common/pointcloud2.hpp"
+#include "primlabel/ros_common/pointcloud2.hpp"
 
 namespace primlabel::roscommon {
 
