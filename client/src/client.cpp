@@ -4,7 +4,10 @@
 #include <grpcpp/support/byte_buffer.h>
 
 #include <algorithm>
+#include <cmath>
 #include <future>
+#include <stdexcept>
+#include <string>
 #include <list>
 #include <thread>
 
@@ -22,6 +25,13 @@ namespace {
 
 using Clock = std::chrono::system_clock;
 
+// The one option the server cannot check: it only ever sees scaled points.
+void require_valid_units(const LabelOptions& o) {
+  if (!(o.metres_per_unit > 0.0f) || !std::isfinite(o.metres_per_unit))
+    throw std::invalid_argument("metres_per_unit must be finite and > 0, got " +
+                                std::to_string(o.metres_per_unit));
+}
+
 v1::LabelRequest header_request(const PointCloud& cloud, const LabelOptions& o) {
   v1::LabelRequest request;
   v1::ScanHeader& header = *request.mutable_header();
@@ -30,7 +40,7 @@ v1::LabelRequest header_request(const PointCloud& cloud, const LabelOptions& o) 
   header.set_scan_id(o.scan_id);
   header.set_frame_id(o.frame_id);
   header.set_stamp_ns(o.stamp_ns);
-  const Vec3f viewpoint = o.viewpoint.value_or(cloud.viewpoint.origin);
+  const Vec3f viewpoint = o.viewpoint.value_or(cloud.viewpoint.origin) * o.metres_per_unit;
   header.mutable_viewpoint()->set_x(viewpoint.x());
   header.mutable_viewpoint()->set_y(viewpoint.y());
   header.mutable_viewpoint()->set_z(viewpoint.z());
@@ -57,7 +67,14 @@ v1::LabelRequest header_request(const PointCloud& cloud, const LabelOptions& o) 
 
 void fill_chunk(const PointCloud& cloud, const LabelOptions& o, std::size_t first,
                 std::size_t count, v1::PointChunk& chunk) {
-  chunk.set_xyz(wire::pack_vec3(cloud.xyz, first, count));
+  if (o.metres_per_unit == 1.0f) {
+    chunk.set_xyz(wire::pack_vec3(cloud.xyz, first, count));
+  } else {
+    std::vector<Vec3f> scaled(cloud.xyz.begin() + std::ptrdiff_t(first),
+                              cloud.xyz.begin() + std::ptrdiff_t(first + count));
+    for (Vec3f& p : scaled) p *= o.metres_per_unit;
+    chunk.set_xyz(wire::pack_vec3(scaled, 0, count));
+  }
   if (o.send_normals && cloud.has_normals())
     chunk.set_normals(wire::pack_vec3(cloud.normals, first, count));
 }
@@ -197,6 +214,7 @@ struct Client::Impl {
   LabelResult label_stream(const PointCloud& cloud, const LabelOptions& o,
                            const std::function<void(std::size_t, std::size_t)>& on_progress,
                            CallControl* control) {
+    require_valid_units(o);
     const std::size_t chunk_points = std::max<std::size_t>(1, o.chunk_points);
     LabelResult result;
     result.attempts = with_retries(timeout_of(o), control, [&](grpc::ClientContext& context) {
@@ -242,6 +260,7 @@ struct Client::Impl {
   }
 
   LabelResult label_unary(const PointCloud& cloud, const LabelOptions& o, CallControl* control) {
+    require_valid_units(o);
     v1::LabelCloudRequest request;
     *request.mutable_header() = header_request(cloud, o).header();
     fill_chunk(cloud, o, 0, cloud.size(), *request.mutable_points());

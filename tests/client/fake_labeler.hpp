@@ -43,6 +43,8 @@ class FakeLabeler final : public v1::Labeler::Service {
   std::vector<std::string> scan_ids;      // in arrival order
   std::vector<v1::PointLayout> layouts;   // of each scan, in arrival order (guarded by mutex)
   std::vector<v1::LabelOptions> options;  // likewise
+  std::vector<Vec3f> viewpoints;          // likewise
+  std::vector<Vec3f> first_points;        // each scan's first point as received (NaN: none)
 
   // When set, every Label / LabelCloud call is counted here as the real server does:
   // primlabel_requests_total{method, model, status}.
@@ -264,6 +266,9 @@ class FakeLabeler final : public v1::Labeler::Service {
       scan_ids.push_back(header.scan_id());
       layouts.push_back(header.layout());
       options.push_back(header.options());
+      viewpoints.emplace_back(header.viewpoint().x(), header.viewpoint().y(),
+                              header.viewpoint().z());
+      first_points.push_back(points.empty() ? Vec3f::Constant(std::nanf("")) : points.front());
     }
     // As the real server says how it chose: named, or (the fake's only model) the default.
     summary.set_model_choice(header.model().empty() ? v1::MODEL_CHOICE_DEFAULT

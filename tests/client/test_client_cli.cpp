@@ -401,6 +401,54 @@ TEST(ClientCli, MissingOrBrokenInputExitsOne) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
 }
 
+// A cloud of NaNs (a depth frame with the lens covered) or no points at all: nothing was
+// labeled, so not exit 0 and "unknown 100%", but exit 1 and why; the other inputs go on.
+TEST(ClientCli, ACloudWithNoFinitePointExitsOneSayingSo) {
+  FakeServer server;
+  test::TempDir dir;
+  PointCloud blind;
+  blind.resize_unorganized(50);
+  for (Vec3f& p : blind.xyz) p = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  write_cloud(dir.file("blind.pcd"), blind);
+  write_scan(dir.file("scan.pcd"));
+  const auto r = test::run_command(cli() + " --server " + server.address() + " label " +
+                                   dir.file("blind.pcd") + " " + dir.file("scan.pcd") + " -o " +
+                                   dir.file("out"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("blind.pcd: no point has finite coordinates (50 points)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("out/scan_labeled.pcd")));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("out/blind_labeled.pcd")));
+}
+
+// --units scales what is sent (points and viewpoint) to metres; the file written back keeps the
+// input's own coordinates. A unit it does not know is a usage error.
+TEST(ClientCli, UnitsScaleThePointsSentAndTheOutputKeepsTheInputs) {
+  FakeServer server;
+  test::TempDir dir;
+  PointCloud scan;
+  scan.resize_unorganized(100);
+  for (std::size_t i = 0; i < 100; ++i) scan.xyz[i] = Vec3f(float(i), 500.0f, 1200.0f);
+  scan.viewpoint.origin = Vec3f(0.0f, 0.0f, 100.0f);
+  write_cloud(dir.file("mm.pcd"), scan);
+  const std::string base = cli() + " --server " + server.address() + " label " +
+                           dir.file("mm.pcd") + " -o " + dir.file("out.pcd");
+  for (const auto& [flag, scale] : {std::pair{"mm", 0.001f}, std::pair{"CM", 0.01f},
+                                    std::pair{"m", 1.0f}}) {
+    SCOPED_TRACE(flag);
+    const auto r = test::run_command(base + " --units " + flag);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    std::lock_guard lock(server.service.mutex);
+    EXPECT_TRUE(server.service.first_points.back().isApprox(scan.xyz[0] * scale));
+    EXPECT_TRUE(server.service.viewpoints.back().isApprox(scan.viewpoint.origin * scale));
+    EXPECT_EQ(read_cloud(dir.file("out.pcd")).xyz[99], scan.xyz[99]);
+  }
+  const auto bad = test::run_command(base + " --units inch");
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--units"), std::string::npos) << bad.output;
+}
+
 TEST(ClientCli, UnreachableServerExitsThree) {
   test::TempDir dir;
   write_scan(dir.file("scan.pcd"));

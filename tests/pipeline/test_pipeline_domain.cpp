@@ -68,6 +68,33 @@ TEST(DomainWarning, NoiseOnlyWhenMoreThanTwiceTheNoisiestTrainingScenes) {
   EXPECT_EQ(both, pipeline::spacing_warning(trained, 0.01f) + "; " + noisy);
 }
 
+// A depth camera's frame at 1 m (spacing 1.5 mm) written in other units.
+PointCloud frame_in_units(float scale) {
+  PointCloud cloud = test::plane_grid(0.0f, 0.0f, 0.2f, 0.0015f);
+  for (Vec3f& p : cloud.xyz) p *= scale;
+  cloud.viewpoint.origin = Vec3f(0.0f, 0.0f, 1.0f) * scale;
+  return cloud;
+}
+
+TEST(UnitsHint, NamesMillimetresAndCentimetresOnlyWhenScalingFitsTheModel) {
+  TrainingSummary kinect;
+  kinect.acquired_spacing_min = 0.00135f, kinect.acquired_spacing_max = 0.00203f;
+  const std::string mm = pipeline::units_hint(kinect, frame_in_units(1000.0f));
+  EXPECT_NE(mm.find("looks like millimetres"), std::string::npos) << mm;
+  EXPECT_NE(mm.find("--units mm"), std::string::npos) << mm;
+  const std::string cm = pipeline::units_hint(kinect, frame_in_units(100.0f));
+  EXPECT_NE(cm.find("looks like centimetres"), std::string::npos) << cm;
+  EXPECT_NE(cm.find("scale it by 0.01"), std::string::npos) << cm;
+  EXPECT_EQ(pipeline::units_hint(kinect, frame_in_units(1.0f)), "");
+  // A sparse scan in metres whose spacing alone would fit at 0.001: 1.5 m apart, 50 m away. Its
+  // range in millimetres (5 cm) is no table top's: no hint.
+  PointCloud far_scan = test::plane_grid(0.0f, 0.0f, 30.0f, 1.5f);
+  far_scan.viewpoint.origin = Vec3f(0.0f, 0.0f, 50.0f);
+  EXPECT_EQ(pipeline::units_hint(kinect, far_scan), "");
+  // Nothing recorded, nothing to say.
+  EXPECT_EQ(pipeline::units_hint(TrainingSummary{}, frame_in_units(1000.0f)), "");
+}
+
 TEST(SurfaceVariation, IsTheMedianOfTheFiniteValues) {
   EXPECT_FLOAT_EQ(median_surface_variation({0.1f, std::nanf(""), 0.3f, 0.2f}), 0.2f);
   EXPECT_TRUE(std::isnan(median_surface_variation({})));

@@ -305,6 +305,26 @@ TEST(NodeParameters, TheStartUpLineNamesEverySetting) {
     EXPECT_NE(text.find(part), std::string::npos) << part << " in: " << text;
 }
 
+// A driver publishing millimetres: units scales what the service gets; anything but m, cm and
+// mm is refused at start-up, naming the parameter.
+TEST(NodeParameters, UnitsScaleTheRequestAndOnlyMCmMmAreAccepted) {
+  roscommon::NodeParameters parameters;
+  EXPECT_EQ(roscommon::label_options(parameters).metres_per_unit, 1.0f);
+  EXPECT_NE(roscommon::settings_text(parameters).find("units m"), std::string::npos);
+  parameters.units = "mm";
+  roscommon::check_parameters(parameters, "~");
+  EXPECT_EQ(roscommon::label_options(parameters).metres_per_unit, 0.001f);
+  parameters.units = "cm";
+  EXPECT_EQ(roscommon::label_options(parameters).metres_per_unit, 0.01f);
+  parameters.units = "inch";
+  try {
+    roscommon::check_parameters(parameters, "~");
+    ADD_FAILURE() << "units inch accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("~units"), std::string::npos) << e.what();
+  }
+}
+
 TEST(NodeParameters, TheViewpointGoesIntoTheLabelOptionsOnlyWhenSet) {
   roscommon::NodeParameters parameters;
   EXPECT_FALSE(roscommon::label_options(parameters).viewpoint.has_value());  // the frame's origin

@@ -49,6 +49,8 @@ TEST(Ros2Arguments, ParametersRemapsNamespaceAndDomain) {
                                           "-p",
                                           "retries:=2",
                                           "-p",
+                                          "units:=mm",
+                                          "-p",
                                           "domain_id:=7",
                                           "-r",
                                           "__ns:=/robot",
@@ -65,6 +67,7 @@ TEST(Ros2Arguments, ParametersRemapsNamespaceAndDomain) {
   EXPECT_DOUBLE_EQ((*s.parameters.viewpoint)[1], -1.0);
   EXPECT_DOUBLE_EQ((*s.parameters.viewpoint)[2], 1.5);
   EXPECT_EQ(s.parameters.retries, 2);
+  EXPECT_EQ(s.parameters.units, "mm");
   EXPECT_EQ(s.domain_id, 7u);
   EXPECT_EQ(s.node_name, "labeler");
   EXPECT_EQ(dds_topic(s, s.parameters.input_topic), "rt/camera/depth/points");
@@ -89,6 +92,7 @@ TEST(Ros2Arguments, RefusesWhatIsWrong) {
                                              {"-p", "viewpoint:=[1, 2]"},
                                              {"-p", "domain_id:=233"},
                                              {"-p", "retries:=0"},
+                                             {"-p", "units:=feet"},
                                              {"-p", "objects:=true"},  // without tabletop_only
                                              {"-p", "server:=host:99999"},
                                              {"-r", "__ns:=robot"},

@@ -1,5 +1,5 @@
-// Hostile geometry against a real server on 127.0.0.1: far points (1e18 up to FLT_MAX) mixed with
-// a normal scan, 100k coincident points, 20k points packed into a 1 mm cube. Each request ends
+// Hostile geometry against a real server on 127.0.0.1: far points (1e6 up to FLT_MAX) mixed with
+// a normal scan, with and without voxels, 100k coincident points, 20k points packed into a 1 mm cube. Each request ends
 // with a clear status in bounded time and memory, and the server goes on serving the next
 // legitimate client with the same labels as before.
 
@@ -91,6 +91,56 @@ TEST_F(HostileGeometry, FarPointsMixedWithAScanGetAnAnswerAndTheScanKeepsItsLabe
            std::chrono::seconds(60));
   EXPECT_TRUE(lonely.status.ok()) << lonely.status.error_message();
   expect_still_serving();
+}
+
+// The same far points against a model that downsamples (as the default LMS400 and Kinect
+// models do): once "voxel leaf 0.003 is too small for the cloud's extent", INTERNAL. Now the far
+// points are answered unknown and counted, and so are a leaf of 1e-30 and a 1e6 m cube.
+TEST(HostileGeometryOnVoxels, FarPointsAnyLeafAndAHugeCubeAreAnsweredAndCounted) {
+  LabelModel model = random_label_model("voxels", "1", 7, 0.5f);
+  model.features.voxel_size = 0.003f;
+  TestServer server({model});
+  const PointCloud table = table_with_box_cloud(0.01f);
+  const auto send = [&](const PointCloud& cloud, float voxel_size = 0.0f) {
+    v1::ScanHeader header = header_for();
+    header.mutable_options()->set_voxel_size(voxel_size);
+    return label_stream(*server.stub, scan_requests(cloud, header), std::chrono::seconds(60));
+  };
+  const LabelAnswer plain = send(table);
+  ASSERT_TRUE(plain.status.ok()) << plain.status.error_message();
+  ASSERT_TRUE(plain.summary);
+  EXPECT_EQ(plain.summary->points_isolated(), 0u);
+  EXPECT_GT(plain.summary->points_labeled(), table.size() * 9 / 10);
+
+  for (const float far : {1e6f, 1e18f, FLT_MAX}) {
+    SCOPED_TRACE(far);
+    std::vector<Vec3f> points = table.xyz;
+    points.push_back({far, 0.0f, 0.0f});
+    points.push_back({0.1f, -far, far});
+    const LabelAnswer answer = send(cloud_of(std::move(points)));
+    ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
+    ASSERT_EQ(answer.labels.size(), table.size() + 2);
+    EXPECT_EQ(answer.labels[table.size()], 0u);
+    EXPECT_EQ(answer.labels[table.size() + 1], 0u);
+    ASSERT_TRUE(answer.summary);
+    EXPECT_EQ(answer.summary->points_isolated(), 2u);
+    EXPECT_GT(answer.summary->points_labeled(), table.size() * 9 / 10);
+  }
+
+  const LabelAnswer tiny_leaf = send(table, 1e-30f);
+  ASSERT_TRUE(tiny_leaf.status.ok()) << tiny_leaf.status.error_message();
+  EXPECT_GT(tiny_leaf.summary->points_labeled(), table.size() * 9 / 10);
+
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> cube(-5e5f, 5e5f);
+  std::vector<Vec3f> spread(100000);
+  for (Vec3f& p : spread) p = Vec3f(cube(rng), cube(rng), cube(rng));
+  const LabelAnswer huge = send(cloud_of(spread));
+  ASSERT_TRUE(huge.status.ok()) << huge.status.error_message();
+  EXPECT_EQ(huge.summary->points_isolated(), spread.size());
+  EXPECT_EQ(huge.summary->points_labeled(), 0u);
+
+  EXPECT_EQ(health_status(server.channel, "primlabel.v1.Labeler"), "SERVING");
 }
 
 TEST_F(HostileGeometry, OneHundredThousandCoincidentPointsAreBoundedInTimeAndMemory) {

@@ -58,6 +58,55 @@ TEST(TabletopVoxelGrid, CentroidPerVoxelAndMembership) {
   EXPECT_TRUE(voxel_downsample(points, {}, 0.1f).centroids.empty());
 }
 
+// Far outliers are real (a laser's stray return, a depth camera's garbage pixel): the grid takes
+// any extent. A far point is a voxel of its own and the scan's voxels stay as they were.
+TEST(TabletopVoxelGrid, AFarPointIsAVoxelOfItsOwnAndTheScanKeepsItsVoxels) {
+  std::mt19937 rng(11);
+  std::vector<Vec3f> points;
+  add_blob(points, Vec3f(0.15f, 0.15f, 0.15f), 0.15f, 3000, rng);
+  points.push_back(Vec3f::Zero());  // the scan's lowest corner stays the origin of the cells
+  const std::size_t scan = points.size();
+  const VoxelGrid near = voxel_downsample(points, all_indices(scan), 0.003f);
+  for (const float far : {1e4f, 1e6f, 1e18f, std::numeric_limits<float>::max()}) {
+    SCOPED_TRACE(far);
+    std::vector<Vec3f> with_far = points;
+    with_far.push_back({far, 0.1f, 0.1f});
+    with_far.push_back({0.1f, -far, far});
+    with_far.push_back({-far, -far, -far});  // below the scan: must not take its precision
+    const VoxelGrid grid = voxel_downsample(with_far, all_indices(with_far.size()), 0.003f);
+    ASSERT_EQ(grid.centroids.size(), near.centroids.size() + 3);
+    std::vector<Vec3f> scan_centroids;
+    for (const Vec3f& c : grid.centroids)
+      if (c.norm() < 1.0f) scan_centroids.push_back(c);
+    EXPECT_EQ(scan_centroids, near.centroids);
+    for (std::size_t i = scan; i < with_far.size(); ++i)
+      EXPECT_EQ(grid.member_offsets[grid.voxel_of_point[i] + 1] -
+                    grid.member_offsets[grid.voxel_of_point[i]],
+                1u);
+    EXPECT_EQ(grid.centroids[grid.voxel_of_point[scan]], with_far[scan]);
+  }
+}
+
+TEST(TabletopVoxelGrid, ATinyLeafOrAHugeCubeNeedsNoMoreThanOneVoxelAPoint) {
+  std::mt19937 rng(12);
+  std::vector<Vec3f> points;
+  add_blob(points, Vec3f::Zero(), 5e5f, 100000, rng);  // 100k points in a 1e6 m cube
+  points.push_back(points[7]);                          // an exact copy shares its voxel
+  std::vector<std::uint32_t> shuffled = all_indices(points.size());
+  std::shuffle(shuffled.begin(), shuffled.end(), rng);
+  for (const float leaf : {1e-30f, 0.003f}) {
+    SCOPED_TRACE(leaf);
+    const VoxelGrid grid = voxel_downsample(points, all_indices(points.size()), leaf);
+    EXPECT_EQ(grid.members.size(), points.size());
+    EXPECT_EQ(grid.centroids.size(), points.size() - 1);  // random floats: no two share a cell
+    EXPECT_EQ(grid.voxel_of_point[7], grid.voxel_of_point[points.size() - 1]);
+    // The order of the input does not matter, on the wide path as on the packed one.
+    const VoxelGrid again = voxel_downsample(points, shuffled, leaf);
+    EXPECT_EQ(again.centroids, grid.centroids);
+    EXPECT_EQ(again.voxel_of_point, grid.voxel_of_point);
+  }
+}
+
 // The voxel filter and the plane fit take their stop token from the RunContext.
 TEST(TabletopVoxelGrid, AStoppedRunContextCancelsTheFilterAndTheFit) {
   std::vector<Vec3f> points;

@@ -125,6 +125,12 @@ int run_label(Client& client, LabelCommand command) {
       if (exit_code == kExitOk) exit_code = kExitFile;
       continue;
     }
+    if (std::none_of(cloud.xyz.begin(), cloud.xyz.end(), [](const Vec3f& p) { return is_finite(p); })) {
+      std::fprintf(stderr, "primlabel: %s: no point has finite coordinates (%zu points): nothing "
+                   "to label\n", input.c_str(), cloud.size());
+      if (exit_code == kExitOk) exit_code = kExitFile;
+      continue;
+    }
     LabelOptions options = command.options;
     if (options.scan_id.empty()) options.scan_id = fs::path(input).stem().string();
     const auto start = std::chrono::steady_clock::now();
@@ -171,6 +177,12 @@ int run_label(Client& client, LabelCommand command) {
     if (!result.summary.domain_warning().empty())
       std::fprintf(stderr, "primlabel: warning: %s: %s\n", input.c_str(),
                    result.summary.domain_warning().c_str());
+    if (result.summary.points_isolated() > 0 && !command.quiet)
+      std::fprintf(stderr,
+                   "primlabel: %s: %llu points have no neighbour within the model's radii "
+                   "(far outliers or lonely returns): labeled unknown\n",
+                   input.c_str(),
+                   static_cast<unsigned long long>(result.summary.points_isolated()));
     if (had_labels && !command.quiet)
       std::fprintf(stderr,
                    "primlabel: %s: its own label field is kept as '%s'; 'label' now holds "

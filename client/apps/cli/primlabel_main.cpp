@@ -14,6 +14,7 @@
 
 #include "commands.hpp"
 #include "common/client_flags.hpp"
+#include "common/units_flag.hpp"
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/subcommands.hpp"
 #include "status_exit_codes.hpp"
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
   label->add_flag("--png", label_args.png, "Also write a PNG picture beside each output");
   label->add_flag("--descriptors", label_args.descriptors, "Add the FPFH descriptors (fpfh)");
   label->add_flag("--probabilities", label_args.probabilities,
-                  "Add the per-class probabilities (probability, columns as `info` lists)");
+                  "Add the per-class probabilities (one field per class, prob_<class>, e.g. prob_plane)");
   label->add_option("--primitives", label_args.primitives,
                     "Also fit primitive instances and write them as JSON (as primlabel-eval "
                     "--primitives): a file (one input) or directory (several, "
@@ -70,6 +71,7 @@ int main(int argc, char** argv) {
   label->add_flag("--tabletop", label_args.options.tabletop_only,
                   "Label only the table and the objects on it");
   label->add_option("--voxel-size", label_args.options.voxel_size, "Downsample first (m)");
+  add_units_flag(*label, label_args.options.metres_per_unit);
   label->add_flag("--every-point", label_args.options.every_point,
                   "Describe and infer every point: no plane cascade, the model's exact labels "
                   "everywhere (slower)");

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "common/client_flags.hpp"
+#include "common/units_flag.hpp"
 #include "directory_watch.hpp"
 #include "framing.hpp"
 #include "primlabel/build_version.hpp"
@@ -241,6 +242,7 @@ int main(int argc, char** argv) {
   app.add_flag("--descriptors", options.label.descriptors, "Keep the FPFH descriptors");
   app.add_flag("--probabilities", options.label.probabilities, "Keep the class probabilities");
   app.add_flag("--tabletop", options.label.tabletop_only, "Label only the table top");
+  add_units_flag(app, options.label.metres_per_unit);
   app.add_flag("--every-point", options.label.every_point,
                "Describe and infer every point: no plane cascade (slower)");
   app.add_flag("-q,--quiet", quiet, "Only errors and the summary on stderr");

@@ -43,7 +43,13 @@ std::string options_fingerprint(const LabelOptions& o) {
   line += ";every_point=" + std::to_string(int(o.every_point));
   char voxel[32];
   std::snprintf(voxel, sizeof voxel, ";voxel=%.9g", double(o.voxel_size));
-  return line + voxel;
+  line += voxel;
+  if (o.metres_per_unit != 1.0f) {  // only then: fingerprints of scans in metres stay as they were
+    char units[32];
+    std::snprintf(units, sizeof units, ";units=%.9g", double(o.metres_per_unit));
+    line += units;
+  }
+  return line;
 }
 
 std::string output_name(const std::string& content_id, const LabelOptions& options,

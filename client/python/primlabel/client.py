@@ -45,6 +45,7 @@ _NON_FINITE = {
     "drop": labeling_pb2.NON_FINITE_DROP,  # NaN/Inf points are labeled 0 and counted
     "reject": labeling_pb2.NON_FINITE_REJECT,  # they fail the call with INVALID_ARGUMENT
 }
+_METRES_PER_UNIT = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 
 
 @dataclass(frozen=True)
@@ -393,8 +394,9 @@ class Client:
         tabletop_only) for the table and its objects as instances (Result.table,
         Result.objects, per point Result.object_ids); every_point, True to describe and infer
         every point: no plane cascade (summary.cascaded_points stays 0), the model's exact labels
-        everywhere, slower; chunk_points,
-        response_chunk_points; deadline (seconds).
+        everywhere, slower; units, "m" (default), "cm" or "mm": the unit of xyz and viewpoint,
+        scaled to metres on the way out (primitives and objects come back in metres);
+        chunk_points, response_chunk_points; deadline (seconds).
         """
         call, timeout = self._prepare(xyz, normals, model, voxel_size, probabilities, descriptors,
                                       tabletop_only, scan_id, **options)
@@ -475,6 +477,7 @@ class Client:
         chunk_points: int = DEFAULT_CHUNK_POINTS,
         response_chunk_points: int = 0,
         deadline: float | None = None,
+        units: str = "m",
     ) -> tuple[_Call, float]:
         """The checked request of one labeling call, and its deadline in seconds."""
         frame = (0, 0)  # width, height of an organised frame: it lets the server pick the model
@@ -489,6 +492,11 @@ class Client:
             frame = (np.shape(xyz)[1], np.shape(xyz)[0])
             xyz = np.reshape(xyz, (-1, 3))
         points = as_points(xyz, "xyz")
+        if units not in _METRES_PER_UNIT:
+            raise InvalidInput(f"units must be 'm', 'cm' or 'mm', got {units!r}")
+        scale = _METRES_PER_UNIT[units]
+        if scale != 1.0:  # the server works in metres; the caller's array is left as it was
+            points = (points * np.float32(scale)).astype(np.float32)
         sent_normals = None if normals is None else as_points(normals, "normals", len(points))
         if non_finite not in _NON_FINITE:
             raise InvalidInput(f"non_finite must be 'drop' or 'reject', got {non_finite!r}")
@@ -499,6 +507,7 @@ class Client:
         origin = np.zeros(3) if viewpoint is None else np.asarray(viewpoint, dtype=np.float64)
         if origin.shape != (3,):
             raise InvalidInput(f"viewpoint must be (x, y, z), got shape {origin.shape}")
+        origin = origin * scale
 
         header = labeling_pb2.ScanHeader(
             model=model or "",

@@ -235,6 +235,19 @@ def test_token_is_required_and_checked(token_server, cloud):
         assert [m.name for m in c.models()] == ["tiny"]
 
 
+def test_a_cloud_in_millimetres_is_labeled_as_in_metres_with_units(client, cloud, cli_labels):
+    millimetres = cloud.xyz.astype(np.float64) * 1000.0
+    viewpoint = np.asarray(cloud.viewpoint[:3], dtype=np.float64) * 1000.0
+    result = client.label(millimetres, viewpoint=viewpoint, units="mm")
+    # float32 round trips through x1000 and x0.001 move a few points by an ulp, no more.
+    assert np.mean(result.labels == cli_labels.label) > 0.99
+    # Unscaled, the same numbers are a sparse cloud a kilometre wide: nothing is labeled like it.
+    raw = client.label(millimetres, viewpoint=viewpoint)
+    assert np.mean(raw.labels == cli_labels.label) < 0.5
+    with pytest.raises(primlabel.InvalidInput):
+        client.label(millimetres, units="inch")
+
+
 def test_bad_arrays_are_refused_before_any_call(client):
     for xyz in (np.zeros((5, 2)), np.zeros(3), np.array([["a", "b", "c"]]), np.zeros((2, 3), complex)):
         with pytest.raises(ValueError):

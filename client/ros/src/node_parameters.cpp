@@ -43,6 +43,7 @@ roscommon::NodeParameters read_parameters(const ros::NodeHandle& node) {
   read(node, "model_version", p.model_version);
   read(node, "voxel_size", p.voxel_size);
   read(node, "every_point", p.every_point);
+  read(node, "units", p.units);
   if (node.hasParam("viewpoint")) {
     std::vector<double> xyz;
     if (!node.getParam("viewpoint", xyz) || xyz.size() != 3 || !std::isfinite(xyz[0]) ||

@@ -23,7 +23,7 @@ constexpr const char* kUsage =
     "output_topic (points_labeled, the input's fields plus uint32 label) and summary_topic\n"
     "(points_labeled_summary, std_msgs/msg/String JSON).\n"
     "Parameters: server model model_version token token_file tls tls_ca tls_cert tls_key\n"
-    "tls_server_name deadline retries voxel_size every_point viewpoint tabletop_only confidence\n"
+    "tls_server_name deadline retries voxel_size units every_point viewpoint tabletop_only confidence\n"
     "probabilities objects primitives input_topic output_topic summary_topic domain_id\n"
     "(default $ROS_DOMAIN_ID, else 0) use_sim_time, and ROS 2's QoS overrides\n"
     "qos_overrides./<topic>.subscription|publisher.reliability|history|depth|durability\n"

@@ -103,10 +103,12 @@ void set_parameter(Ros2Settings& s, QosParameters& qos, const std::string& name,
   std::string* const strings[] = {&p.server,          &p.token,        &p.token_file,
                                   &p.tls_ca,          &p.tls_cert,     &p.tls_key,
                                   &p.tls_server_name, &p.model,        &p.model_version,
-                                  &p.input_topic,     &p.output_topic, &p.summary_topic};
+                                  &p.input_topic,     &p.output_topic, &p.summary_topic,
+                                  &p.units};
   const char* const string_names[] = {
       "server",          "token", "token_file",    "tls_ca",      "tls_cert",     "tls_key",
-      "tls_server_name", "model", "model_version", "input_topic", "output_topic", "summary_topic"};
+      "tls_server_name", "model", "model_version", "input_topic", "output_topic", "summary_topic",
+      "units"};
   for (std::size_t k = 0; k < std::size(strings); ++k)
     if (name == string_names[k]) {
       *strings[k] = text;

@@ -29,6 +29,8 @@ void check_parameters(NodeParameters& p, const std::string& prefix) {
   }
   if (!std::isfinite(p.voxel_size) || p.voxel_size < 0)
     throw std::invalid_argument(prefix + "voxel_size must be a finite number >= 0 (metres)");
+  if (p.units != "m" && p.units != "cm" && p.units != "mm")
+    throw std::invalid_argument(prefix + "units must be m, cm or mm, got '" + p.units + "'");
   if (!std::isfinite(p.deadline) || p.deadline <= 0)
     throw std::invalid_argument(prefix + "deadline must be a finite number of seconds > 0");
   if (p.objects && !p.tabletop_only)
@@ -67,6 +69,7 @@ client::LabelOptions label_options(const NodeParameters& p) {
   options.model_version = p.model_version;
   options.voxel_size = static_cast<float>(p.voxel_size);
   options.every_point = p.every_point;
+  options.metres_per_unit = p.units == "mm" ? 0.001f : p.units == "cm" ? 0.01f : 1.0f;
   if (p.viewpoint)
     options.viewpoint =
         Vec3f(static_cast<float>((*p.viewpoint)[0]), static_cast<float>((*p.viewpoint)[1]),
@@ -89,7 +92,7 @@ std::string settings_text(const NodeParameters& p) {
     out << p.voxel_size << " m";
   else
     out << "the model's";
-  out << ", viewpoint ";
+  out << ", units " << p.units << ", viewpoint ";
   if (p.viewpoint)
     out << (*p.viewpoint)[0] << "," << (*p.viewpoint)[1] << "," << (*p.viewpoint)[2];
   else

@@ -1,7 +1,11 @@
 #include "primlabel/pipeline/domain.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
+
+#include "primlabel/geometry/cloud_signature.hpp"
 
 namespace primlabel::pipeline {
 
@@ -14,8 +18,9 @@ std::string spacing_warning(const TrainingSummary& training, float point_spacing
   char text[240];
   std::snprintf(
       text, sizeof text,
-      "point spacing %.2f mm is %s than the %.2f-%.2f mm this model was trained for "
-      "(more than %gx): labels are unreliable; use a model for this sensor or a voxel size",
+      "point spacing %.2f mm as described (after any voxel filter) is %s than the %.2f-%.2f mm "
+      "of this model's training scenes described alike (more than %gx): labels are unreliable; "
+      "use a model for this sensor or a voxel size",
       point_spacing * 1e3, point_spacing > high ? "sparser" : "denser", low * 1e3, high * 1e3,
       double(kSpacingTolerance));
   return text;
@@ -41,6 +46,41 @@ std::string domain_warning(const TrainingSummary& training, float point_spacing,
   const std::string noise = noise_warning(training, surface_variation);
   if (spacing.empty()) return noise;
   return noise.empty() ? spacing : spacing + "; " + noise;
+}
+
+std::string units_hint(const TrainingSummary& training, const PointCloud& cloud,
+                       const RunContext& context) {
+  if (!(training.acquired_spacing_min > 0.0f) || cloud.empty()) return {};
+  const CloudSignature signature =
+      measure_signature(cloud.xyz, cloud.viewpoint.origin, context, kUnitsSamples);
+  // The median range from the sensor, over the same kind of strided sample.
+  std::vector<float> ranges;
+  const std::size_t stride = std::max<std::size_t>(1, cloud.size() / kUnitsSamples);
+  for (std::size_t i = 0; i < cloud.size(); i += stride)
+    if (is_finite(cloud.xyz[i])) ranges.push_back((cloud.xyz[i] - cloud.viewpoint.origin).norm());
+  if (ranges.empty() || !(signature.point_spacing > 0.0f)) return {};
+  std::nth_element(ranges.begin(), ranges.begin() + std::ptrdiff_t(ranges.size() / 2), ranges.end());
+  const float range = ranges[ranges.size() / 2];
+  struct Unit {
+    float scale;
+    const char *name, *flag;
+  };
+  for (const Unit& unit : {Unit{0.001f, "millimetres", "mm"}, Unit{0.01f, "centimetres", "cm"}}) {
+    const float spacing = signature.point_spacing * unit.scale;
+    const float metres = range * unit.scale;
+    if (spacing < training.acquired_spacing_min / kSpacingTolerance ||
+        spacing > training.acquired_spacing_max * kSpacingTolerance ||
+        metres < kTableTopRangeMin || metres > kTableTopRangeMax)
+      continue;
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "the cloud looks like %s (acquired spacing %.3g, median range %.4g in its "
+                  "units): scale it by %g or pass --units %s",
+                  unit.name, double(signature.point_spacing), double(range), double(unit.scale),
+                  unit.flag);
+    return text;
+  }
+  return {};
 }
 
 }  // namespace primlabel::pipeline

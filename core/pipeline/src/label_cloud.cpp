@@ -140,6 +140,17 @@ LabelingResult label_described(const LabelModel& model, const FeatureSettings& f
   return result;
 }
 
+std::size_t isolated_points(const PointCloud& cloud, const LabelingPlan& plan,
+                            const std::vector<std::uint32_t>& labels) {
+  const std::uint32_t unknown = class_id(PrimitiveClass::kUnknown);
+  std::size_t isolated = 0;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (labels[i] == unknown && is_finite(cloud.xyz[i]) &&
+        (plan.in_place || plan.slot_of[i] != kNoSlot))
+      ++isolated;
+  return isolated;
+}
+
 // The objects' counts and shapes from the input points' coordinates and ids, and the primitives
 // lying in each.
 void describe_objects_of_input(const PointCloud& cloud, LabelingResult& result) {
@@ -170,6 +181,10 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
   result.seconds.duplicates = plan.seconds.duplicates;
   result.domain_warning =
       domain_warning(model.training, result.point_spacing, result.surface_variation);
+  if (result.point_spacing > model.training.point_spacing_max * kSpacingTolerance) {
+    const std::string units = units_hint(model.training, cloud, context);
+    if (!units.empty()) result.domain_warning = units + "; " + result.domain_warning;
+  }
 
   // Back once: every input point gets its slot's answer; primitives and objects are the input's.
   if (!plan.in_place) fan_out(plan, described, options, cloud, result);
@@ -179,6 +194,7 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
     result.objects = std::move(plan.objects);
     describe_objects_of_input(cloud, result);
   }
+  result.isolated_points = isolated_points(cloud, plan, result.labels);
   return result;
 }
 

@@ -6,7 +6,6 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <stdexcept>
 
 #include "primlabel/geometry/cancellation.hpp"
@@ -72,21 +71,16 @@ std::vector<float> surface_variations(const std::vector<Vec3f>& xyz, float radiu
                                       const NeighborSearch& search, const NeighborLists* lists,
                                       const RunContext& context) {
   const Neighborhood hood = capped(Neighborhood::Radius(radius));
-  std::optional<tabletop::VoxelGrid> grid;
-  try {
-    grid = tabletop::voxel_downsample(xyz, tabletop::finite_indices(xyz), radius / kVoxelsPerRadius,
-                                      context);
-  } catch (const std::invalid_argument&) {
-    // An extent too large for the voxel grid (a far outlier): every point measured itself.
-  }
-  if (!grid || 2 * grid->centroids.size() > xyz.size())
+  const tabletop::VoxelGrid grid = tabletop::voxel_downsample(
+      xyz, tabletop::finite_indices(xyz), radius / kVoxelsPerRadius, context);
+  if (2 * grid.centroids.size() > xyz.size())
     return variations_of(xyz, hood, search, lists, context);
-  const NeighborSearch centroid_search(grid->centroids, context.stop);
+  const NeighborSearch centroid_search(grid.centroids, context.stop);
   const std::vector<float> per_voxel =
-      variations_of(grid->centroids, hood, centroid_search, nullptr, context);
+      variations_of(grid.centroids, hood, centroid_search, nullptr, context);
   std::vector<float> out(xyz.size(), std::numeric_limits<float>::quiet_NaN());
   for (std::size_t i = 0; i < xyz.size(); ++i)
-    if (grid->voxel_of_point[i] != tabletop::kNoVoxel) out[i] = per_voxel[grid->voxel_of_point[i]];
+    if (grid.voxel_of_point[i] != tabletop::kNoVoxel) out[i] = per_voxel[grid.voxel_of_point[i]];
   return out;
 }
 

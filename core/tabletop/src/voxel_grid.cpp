@@ -65,6 +65,69 @@ void radix_sort_checked(std::vector<std::pair<std::uint64_t, std::uint32_t>>& v,
   }
 }
 
+using KeyedPoints = std::vector<std::pair<std::uint64_t, std::uint32_t>>;
+
+// Cells fit 21 bits an axis (every real scan at any sensible leaf): one 64-bit key per point,
+// radix-sorted when the indices ascend.
+KeyedPoints packed_cell_keys(const std::vector<Vec3f>& points,
+                             const std::vector<std::uint32_t>& indices, const Vec3f& lo,
+                             const Vec3f& hi, double inv, const std::stop_token& stop) {
+  std::uint64_t cells[3];
+  for (int axis = 0; axis < 3; ++axis)
+    cells[axis] =
+        static_cast<std::uint64_t>(std::floor((double(hi[axis]) - double(lo[axis])) * inv)) + 1;
+  KeyedPoints keyed;
+  keyed.reserve(indices.size());
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    if (k % kCheckEvery == 0) throw_if_stopped(stop, kWhat);
+    const std::uint32_t i = indices[k];
+    const Vec3f& p = points[i];
+    const auto cell = [&](int axis) {
+      return std::min(cells[axis] - 1,
+                      static_cast<std::uint64_t>(std::floor((double(p[axis]) - lo[axis]) * inv)));
+    };
+    keyed.emplace_back((cell(2) * cells[1] + cell(1)) * cells[0] + cell(0), i);
+  }
+  const std::uint64_t largest_key = cells[0] * cells[1] * cells[2] - 1;
+  if (std::is_sorted(indices.begin(), indices.end()))
+    radix_sort_checked(keyed, std::bit_width(largest_key), stop);
+  else
+    sort_checked(keyed, stop);
+  return keyed;
+}
+
+// Any extent (a far outlier, a leaf of 1e-30): the cell coordinates stay doubles, exact integers
+// or beyond 2^53 still ordered and apart for distinct float points, and each point's key is its
+// cell's rank in (z, y, x) order. The cells start at 0, not at the lowest corner: a far point
+// below the scan would otherwise take the scan's precision (1e38 + 0.1 == 1e38).
+KeyedPoints ranked_cell_keys(const std::vector<Vec3f>& points,
+                             const std::vector<std::uint32_t>& indices, double inv,
+                             const std::stop_token& stop) {
+  struct Cell {
+    double z, y, x;
+    std::uint32_t index;
+    auto operator<=>(const Cell&) const = default;
+  };
+  std::vector<Cell> cells;
+  cells.reserve(indices.size());
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    if (k % kCheckEvery == 0) throw_if_stopped(stop, kWhat);
+    const Vec3f& p = points[indices[k]];
+    const auto cell = [&](int axis) { return std::floor(double(p[axis]) * inv); };
+    cells.push_back({cell(2), cell(1), cell(0), indices[k]});
+  }
+  sort_checked(cells, stop);
+  KeyedPoints keyed;
+  keyed.reserve(cells.size());
+  std::uint64_t rank = 0;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const Cell& c = cells[k];
+    if (k > 0 && (c.z != cells[k - 1].z || c.y != cells[k - 1].y || c.x != cells[k - 1].x)) ++rank;
+    keyed.emplace_back(rank, c.index);
+  }
+  return keyed;
+}
+
 }  // namespace
 
 VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
@@ -86,37 +149,14 @@ VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
     hi = hi.cwiseMax(points[indices[k]]);
   }
   const double inv = 1.0 / leaf;
-  constexpr double kMaxCells = double(1 << 21);
   // The extent in double: in float it overflows to infinity for points near +-FLT_MAX.
   const double extent = (hi.cast<double>() - lo.cast<double>()).maxCoeff();
-  if (!(extent * inv < kMaxCells - 1))
-    throw std::invalid_argument("voxel leaf " + std::to_string(leaf) +
-                                " is too small for the cloud's extent (" + std::to_string(extent) +
-                                " m: a point far from the others?)");
-
   // Sorting (key, index) pairs makes the voxel order and member order independent of the input.
-  // The key orders cells by (z, y, x) and uses only the bits the extent needs.
-  std::uint64_t cells[3];
-  for (int axis = 0; axis < 3; ++axis)
-    cells[axis] =
-        static_cast<std::uint64_t>(std::floor((double(hi[axis]) - double(lo[axis])) * inv)) + 1;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
-  keyed.reserve(indices.size());
-  for (std::size_t k = 0; k < indices.size(); ++k) {
-    if (k % kCheckEvery == 0) throw_if_stopped(stop, kWhat);
-    const std::uint32_t i = indices[k];
-    const Vec3f& p = points[i];
-    const auto cell = [&](int axis) {
-      return std::min(cells[axis] - 1,
-                      static_cast<std::uint64_t>(std::floor((double(p[axis]) - lo[axis]) * inv)));
-    };
-    keyed.emplace_back((cell(2) * cells[1] + cell(1)) * cells[0] + cell(0), i);
-  }
-  const std::uint64_t largest_key = cells[0] * cells[1] * cells[2] - 1;
-  if (std::is_sorted(indices.begin(), indices.end()))
-    radix_sort_checked(keyed, std::bit_width(largest_key), stop);
-  else
-    sort_checked(keyed, stop);
+  // Both keys order cells by (z, y, x); the packed ones count from the cloud's lowest corner.
+  constexpr double kPackedCells = double(1 << 21);
+  const KeyedPoints keyed = extent * inv < kPackedCells - 1
+                                ? packed_cell_keys(points, indices, lo, hi, inv, stop)
+                                : ranked_cell_keys(points, indices, inv, stop);
 
   grid.members.reserve(keyed.size());
   for (std::size_t begin = 0; begin < keyed.size();) {

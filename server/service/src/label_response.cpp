@@ -137,6 +137,7 @@ void fill_summary(const RequestRecord& record, const JobPlan& plan,
   summary.set_descriptor_dim(static_cast<std::uint32_t>(result.descriptors.dim));
   if (entry.model) summary.set_descriptor_name(entry.model->features.descriptor_name());
   summary.set_cascaded_points(result.cascaded_points);
+  summary.set_points_isolated(result.isolated_points);
   if (std::isfinite(result.point_spacing)) summary.set_point_spacing(result.point_spacing);
   summary.set_domain_warning(result.domain_warning);
   *summary.mutable_classes() = entry.metadata.classes();

@@ -24,6 +24,10 @@ struct NodeParameters {
   std::string model;          // empty = the server's default model
   std::string model_version;  // empty = the latest loaded
   double voxel_size = 0.0;    // > 0: downsample first (m); 0 = the model's setting
+  // The unit of the clouds' coordinates: "m" (REP 103, the default), "cm" or "mm" (some depth
+  // drivers); points and viewpoint are scaled to metres for the service, the published cloud
+  // keeps the input's coordinates.
+  std::string units = "m";
   // Describe and infer every point: no plane cascade (the summary's cascaded_points stays 0),
   // the model's exact labels everywhere, slower.
   bool every_point = false;
@@ -47,7 +51,7 @@ struct NodeParameters {
 
 // Checks `parameters` once read and writes the server address with its port. Throws
 // std::invalid_argument naming the parameter (as `prefix` + name: "~voxel_size" for ROS 1's
-// private parameters): a negative or non-finite voxel size, a deadline <= 0, retries < 1, an
+// private parameters): a negative or non-finite voxel size, units other than m, cm and mm, a deadline <= 0, retries < 1, an
 // empty topic, a malformed server address, objects without tabletop_only.
 void check_parameters(NodeParameters& parameters, const std::string& prefix);
 

@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/geometry/run_context.hpp"
 #include "primlabel/model/label_model.hpp"
 
 namespace primlabel::pipeline {
@@ -28,5 +30,17 @@ std::string noise_warning(const TrainingSummary& training, float surface_variati
 // Both, joined by "; " when both apply.
 std::string domain_warning(const TrainingSummary& training, float point_spacing,
                            float surface_variation);
+
+// A cloud written in millimetres or centimetres looks metres-sized to the model: its points seem
+// a thousand times apart, nothing lies within the radii, and every point comes back unknown.
+// When the cloud's acquired spacing, scaled by 0.001 (or 0.01), fits the model's training scans
+// and its median range from the viewpoint then lies within [kTableTopRangeMin, kTableTopRangeMax]
+// m, one line saying so and how to fix it ("... pass --units mm"); empty otherwise, and when the
+// model did not record its acquired spacing. Measures the cloud's signature: call it only for a
+// cloud already found sparser than the model's domain.
+inline constexpr float kTableTopRangeMin = 0.1f, kTableTopRangeMax = 10.0f;
+inline constexpr std::size_t kUnitsSamples = 1024;
+std::string units_hint(const TrainingSummary& training, const PointCloud& cloud,
+                       const RunContext& context = {});
 
 }  // namespace primlabel::pipeline

@@ -127,6 +127,10 @@ struct LabelingResult {
   std::size_t labeled_points = 0;    // input points that got a descriptor (through their voxel)
   std::size_t described_points = 0;  // points described: voxels when downsampling
   std::size_t cascaded_points = 0;   // of those, labeled plane by the plane cascade
+  // Input points with finite coordinates left unknown because nothing lies within the model's
+  // radii of them (a far outlier, a lonely return): they could not be described. Points the
+  // table-top stage leaves out are not counted.
+  std::size_t isolated_points = 0;
   StageSeconds seconds;              // where the time went, stage by stage
   float point_spacing = 0;           // median point spacing of the described cloud (m)
   float surface_variation = 0;       // median surface variation of its computed normals

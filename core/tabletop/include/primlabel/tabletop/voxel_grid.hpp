@@ -26,11 +26,10 @@ struct VoxelGrid {
 
 // Centroid per voxel of edge `leaf` over points[indices] (which must be finite). Voxels are
 // ordered by their integer coordinates (z, then y, then x), so the output does not depend on the
-// order of `indices`. Throws std::invalid_argument when leaf <= 0 or the extent overflows the
-// 21-bit voxel coordinates.
-// Throws std::invalid_argument when the extent needs more than 2^21 voxels per axis (e.g. one far
-// point), and Cancelled when context.stop is requested (checked every 64k points and between the
-// sort's runs and merges).
+// order of `indices`. Cells count from the cloud's lowest corner while the extent fits 2^21 of
+// them an axis; beyond (a far outlier, a tiny leaf) from the origin, so a far point is a voxel of
+// its own and cannot coarsen the scan's. Throws std::invalid_argument when leaf is not positive and finite, and Cancelled when
+// context.stop is requested (checked every 64k points and between the sort's runs and merges).
 VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
                            const std::vector<std::uint32_t>& indices, float leaf,
                            const RunContext& context = {});
