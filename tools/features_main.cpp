@@ -44,6 +44,7 @@ int print_signature(const Arguments& args) {
   out["point_spacing_m"] = json::rounded(s.point_spacing, "%.6f");
   out["roughness_m"] = json::rounded(s.roughness, "%.6f");
   out["noise_growth"] = json::rounded(s.noise_growth, "%.3f");
+  out["depth_ties"] = json::rounded(s.depth_ties, "%.3f");
   std::printf("%s\n", json::dump(out).c_str());
   return cli::kExitOk;
 }

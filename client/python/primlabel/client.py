@@ -395,7 +395,9 @@ class Client:
         Result.objects, per point Result.object_ids); every_point, True to describe and infer
         every point: no plane cascade (summary.cascaded_points stays 0), the model's exact labels
         everywhere, slower; units, "m" (default), "cm" or "mm": the unit of xyz and viewpoint,
-        scaled to metres on the way out (primitives and objects come back in metres);
+        scaled to metres on the way out (primitives and objects come back in metres); shape,
+        (height, width) of an organised frame whose container does not keep it (an Open3D cloud
+        made with project_valid_depth_only=False): it lets the server pick the camera's model;
         chunk_points, response_chunk_points; deadline (seconds).
         """
         call, timeout = self._prepare(xyz, normals, model, voxel_size, probabilities, descriptors,
@@ -478,6 +480,7 @@ class Client:
         response_chunk_points: int = 0,
         deadline: float | None = None,
         units: str = "m",
+        shape=None,
     ) -> tuple[_Call, float]:
         """The checked request of one labeling call, and its deadline in seconds."""
         frame = (0, 0)  # width, height of an organised frame: it lets the server pick the model
@@ -492,6 +495,16 @@ class Client:
             frame = (np.shape(xyz)[1], np.shape(xyz)[0])
             xyz = np.reshape(xyz, (-1, 3))
         points = as_points(xyz, "xyz")
+        if shape is not None:  # an organised frame whose shape the container lost (Open3D)
+            try:
+                height, width = (int(v) for v in shape)
+            except (TypeError, ValueError):
+                raise InvalidInput(f"shape must be (height, width), got {shape!r}") from None
+            if height < 1 or width < 1 or height * width != len(points):
+                raise InvalidInput(
+                    f"shape {height}x{width} does not hold the cloud's {len(points)} points"
+                )
+            frame = (width, height)
         if units not in _METRES_PER_UNIT:
             raise InvalidInput(f"units must be 'm', 'cm' or 'mm', got {units!r}")
         scale = _METRES_PER_UNIT[units]

@@ -49,3 +49,14 @@ def test_a_frame_whose_size_does_not_match_its_points_is_refused(client, cloud):
     with pytest.raises(primlabel.PrimlabelError) as error:
         client.label(bad, model="tiny")
     assert "layout.width x layout.height" in error.value.message
+
+
+def test_shape_sends_a_flat_clouds_frame_size(client, cloud):
+    # An Open3D cloud of a frame is flat: shape=(H, W) gives the server its frame size back.
+    flat = np.asarray(cloud.xyz[:3000])
+    with pytest.warns(primlabel.DomainWarning, match="organised 60x50 frame"):
+        client.label(flat, model="tiny", shape=(50, 60))
+    with pytest.raises(primlabel.InvalidInput, match="does not hold"):
+        client.label(flat, model="tiny", shape=(50, 61))
+    with pytest.raises(primlabel.InvalidInput, match="height, width"):
+        client.label(flat, model="tiny", shape=50)

@@ -89,6 +89,10 @@ CloudSignature measure_signature(const std::vector<Vec3f>& xyz, const Vec3f& vie
   // A patch is read whole but at most this many points of it: a dense scan's 10 mm holds
   // thousands, and the nearest few hundred already fix the plane.
   const Neighborhood patch_hood = Neighborhood::Hybrid(kRoughnessRadius, 256);
+  // Neighbours on slanted patches, and those of them at the sampled point's exact z.
+  const double max_normal_z = std::cos(double(kTiesMinSlant) * M_PI / 180.0);
+  std::size_t tie_pairs = 0, ties = 0, slanted_patches = 0;
+  std::vector<std::uint32_t> nearest_distinct;
   std::vector<float> spacing, roughness;
   std::vector<std::pair<float, float>> by_range;  // (range, roughness) of each patch
   NeighborList found;
@@ -98,6 +102,9 @@ CloudSignature measure_signature(const std::vector<Vec3f>& xyz, const Vec3f& vie
     if (seen++ % stride != 0) continue;
     context.throw_if_stopped("measuring the cloud");
     search.find(p, nearest, found);
+    nearest_distinct.clear();
+    for (std::size_t k = 0; k < found.size(); ++k)
+      if (found.sq_dists[k] > 0.0f) nearest_distinct.push_back(found.indices[k]);
     for (float sq : found.sq_dists)
       if (sq > 0.0f) {
         spacing.push_back(std::sqrt(sq));
@@ -107,6 +114,11 @@ CloudSignature measure_signature(const std::vector<Vec3f>& xyz, const Vec3f& vie
     if (found.size() < kRoughnessMinPoints) continue;
     const PatchFit fit = fit_patch(xyz, found);
     roughness.push_back(fit.rms);
+    if (std::abs(fit.normal.z()) < max_normal_z && !nearest_distinct.empty()) {
+      ++slanted_patches;
+      for (std::uint32_t j : nearest_distinct) ties += xyz[j].z() == p.z() ? 1 : 0;
+      tie_pairs += nearest_distinct.size();
+    }
     // Sensors are noisy along the ray: the roughness across the patch is that noise times the
     // cosine of the incidence, which falls with range on a table; the growth reads it undone.
     const Eigen::Vector3d ray = fit.centre - viewpoint.cast<double>();
@@ -119,6 +131,7 @@ CloudSignature measure_signature(const std::vector<Vec3f>& xyz, const Vec3f& vie
   signature.point_spacing = quantile_of(spacing, 0.5);
   signature.roughness = quantile_of(roughness, 0.5);
   signature.noise_growth = noise_growth(std::move(by_range));
+  if (slanted_patches >= kTiesMinPatches) signature.depth_ties = float(double(ties) / double(tie_pairs));
   return signature;
 }
 

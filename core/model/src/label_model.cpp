@@ -154,6 +154,10 @@ v1::Model to_proto(const LabelModel& m) {
     t->set_noise_growth_min(m.training.noise_growth_min);
     t->set_noise_growth_max(m.training.noise_growth_max);
   }
+  if (std::isfinite(m.training.depth_ties_min) && std::isfinite(m.training.depth_ties_max)) {
+    t->set_depth_ties_min(m.training.depth_ties_min);
+    t->set_depth_ties_max(m.training.depth_ties_max);
+  }
   t->set_class_balance(m.training.class_balance);
   for (double w : m.training.class_weights) t->add_class_weights(w);
   t->set_data_attribution(m.training.data_attribution);
@@ -279,6 +283,10 @@ LabelModel from_proto(const v1::Model& in, const std::string& source) {
   if (t.has_noise_growth_min() && t.has_noise_growth_max()) {
     m.training.noise_growth_min = t.noise_growth_min();
     m.training.noise_growth_max = t.noise_growth_max();
+  }
+  if (t.has_depth_ties_min() && t.has_depth_ties_max()) {
+    m.training.depth_ties_min = t.depth_ties_min();
+    m.training.depth_ties_max = t.depth_ties_max();
   }
   m.training.class_balance = t.class_balance();
   m.training.class_weights.assign(t.class_weights().begin(), t.class_weights().end());

@@ -87,6 +87,13 @@ DomainVerdict judge_signature(const TrainingSummary& training, const CloudSignat
             signature.noise_growth <= training.noise_growth_max + kNoiseGrowthTolerance,
         "noise growth " + decimal(signature.noise_growth),
         decimal(training.noise_growth_min) + " to " + decimal(training.noise_growth_max));
+  // Quantised depth marks a depth camera: a model whose training scans showed none is not for
+  // such a cloud. The absence of ties says nothing (a frame turned into another frame loses them).
+  if (std::isfinite(training.depth_ties_max) && training.depth_ties_max < kQuantisedDepthTies / 2 &&
+      signature.depth_ties >= kQuantisedDepthTies)
+    outside.push_back("depth ties " + decimal(signature.depth_ties) +
+                      " (quantised depth, a depth camera's; trained up to " +
+                      decimal(training.depth_ties_max) + ")");
   if (!outside.empty()) return {DomainFit::kOutside, "outside: " + joined(outside, ", ")};
   return {DomainFit::kFits, joined(inside, ", ")};
 }

@@ -183,6 +183,12 @@ TrainingSummary summarize_training(std::span<const SceneData> training, std::siz
       summary.noise_growth_min = first ? g : std::min(summary.noise_growth_min, g);
       summary.noise_growth_max = first ? g : std::max(summary.noise_growth_max, g);
     }
+    if (std::isfinite(s.acquired.depth_ties)) {
+      const float ties = s.acquired.depth_ties;
+      const bool first = !std::isfinite(summary.depth_ties_min);
+      summary.depth_ties_min = first ? ties : std::min(summary.depth_ties_min, ties);
+      summary.depth_ties_max = first ? ties : std::max(summary.depth_ties_max, ties);
+    }
   }
   // An image size only when every scene was a frame of that one size.
   if (!training.empty() && training.front().image_height > 1 &&

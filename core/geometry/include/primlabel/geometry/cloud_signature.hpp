@@ -37,7 +37,18 @@ struct CloudSignature {
   // (where the flat patches are): about 2 for a depth camera, about 0 for a laser scanner. NaN
   // when the two halves' ranges are too alike or there are too few patches.
   float noise_growth = std::numeric_limits<float>::quiet_NaN();
+  // Of the nearest neighbours of sampled points on slanted patches (normal at least
+  // kTiesMinSlant degrees from the frame's z axis), the fraction at exactly the same z: a depth
+  // camera quantises depth (to disparity steps, or to whole millimetres), so neighbours share
+  // levels even where the surface slopes, while a laser scanner's or a simulator's continuous
+  // depths hardly ever tie. It reads depth along the frame's z axis, a camera frame's; a cloud
+  // turned into another frame loses its ties, so only their presence says something. NaN when
+  // fewer than kTiesMinPatches sampled patches are slanted.
+  float depth_ties = std::numeric_limits<float>::quiet_NaN();
 };
+
+inline constexpr float kTiesMinSlant = 25.0f;
+inline constexpr std::size_t kTiesMinPatches = 32;
 
 // Over an evenly strided sample of at most `max_samples` finite points (the same figures for
 // any thread count); ranges from `viewpoint`, the sensor's origin. Builds a neighbour index on

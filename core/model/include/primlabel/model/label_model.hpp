@@ -108,6 +108,10 @@ struct TrainingSummary {
   // The range of the noise growth exponent (geometry/cloud_signature.hpp); NaN: not recorded.
   float noise_growth_min = std::numeric_limits<float>::quiet_NaN();
   float noise_growth_max = std::numeric_limits<float>::quiet_NaN();
+  // The range of the depth ties (geometry/cloud_signature.hpp: how quantised the depth is); NaN:
+  // not recorded.
+  float depth_ties_min = std::numeric_limits<float>::quiet_NaN();
+  float depth_ties_max = std::numeric_limits<float>::quiet_NaN();
   // The class balance alpha of the objective (crf::class_balance_weights; 0 = unweighted, as in
   // older files) and the resulting weight per model class (empty when unweighted).
   double class_balance = 0;

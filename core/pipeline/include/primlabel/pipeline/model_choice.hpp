@@ -29,6 +29,9 @@ inline constexpr float kSignatureTolerance = 2.0f;
 // A noise growth exponent within this much of a model's training range fits it: a quarter of
 // the way between a laser scanner's (0) and a depth camera's (2).
 inline constexpr float kNoiseGrowthTolerance = 0.5f;
+// A cloud with at least this fraction of depth ties (geometry/cloud_signature.hpp) has quantised
+// depth; a model whose training scans never reached half of it does not fit such a cloud.
+inline constexpr float kQuantisedDepthTies = 0.1f;
 
 // The organisation a request announces (0 x 0: unorganised or not said).
 struct CloudShape {
