@@ -263,3 +263,54 @@ TEST(ModelChoice, TheNoiseGrowthSeparatesSensorsWhoseSpacingAndNoiseOverlap) {
 
 }  // namespace
 }  // namespace primlabel::pipeline
+
+// The receding table as a depth camera in its own frame (z ahead) sees it: depths quantised to
+// disparity steps of z^2 / 345 m (a Kinect's 1/8 pixel), or to whole millimetres (OpenNI).
+std::vector<Vec3f> quantised_table(bool whole_millimetres) {
+  std::vector<Vec3f> points;
+  for (const Vec3f& p : receding_table(0.0008f, 2.0f, 8)) {
+    const float z = p.y();  // the camera looks along y here: its depth axis becomes z
+    const double level = whole_millimetres ? std::round(z * 1000.0) / 1000.0
+                                           : 345.0 / std::round(345.0 / z);
+    points.emplace_back(p.x(), p.z(), float(level));
+  }
+  return points;
+}
+
+TEST(CloudSignature, DepthTiesTellQuantisedDepthAndNeedASlantedSurface) {
+  for (bool millimetres : {false, true}) {
+    SCOPED_TRACE(millimetres);
+    const CloudSignature camera = measure_signature(quantised_table(millimetres), Vec3f::Zero());
+    EXPECT_GT(camera.depth_ties, 2 * kQuantisedDepthTies);
+  }
+  // The same table, continuous depths (a laser scanner, a simulator without quantisation).
+  std::vector<Vec3f> continuous;
+  for (const Vec3f& p : receding_table(0.0008f, 0.0f, 9)) continuous.emplace_back(p.x(), p.z(), p.y());
+  EXPECT_LT(measure_signature(continuous, Vec3f::Zero()).depth_ties, kQuantisedDepthTies / 4);
+  // A noise-free plane at one z ties everywhere, but it is not slanted: no verdict.
+  EXPECT_TRUE(std::isnan(measure_signature(noisy_plane(0.002f, 0.0f, 10), Vec3f::Zero()).depth_ties));
+}
+
+TEST(ModelChoice, QuantisedDepthRulesOutAModelTrainedWithoutIt) {
+  TrainingSummary cam = camera(), laser = scanner();
+  laser.acquired_spacing_max = cam.acquired_spacing_max;  // spacing and noise overlap
+  laser.roughness_max = 0.005f;
+  cam.depth_ties_min = 0.3f, cam.depth_ties_max = 0.7f;
+  laser.depth_ties_min = 0.0f, laser.depth_ties_max = 0.01f;
+  const std::vector<ModelCandidate> both{{"cam", &cam}, {"laser", &laser}};
+  // A crop of a frame at one range (growth NaN): the ties alone tell it.
+  CloudSignature crop{0.002f, 0.002f};
+  crop.depth_ties = 0.45f;
+  ModelChooser chooser(both, "laser", CloudShape{});
+  chooser.consider(crop);
+  EXPECT_EQ(chooser.choice().model, "cam");
+  EXPECT_EQ(chooser.choice().reason, ChoiceReason::kDomain);
+  EXPECT_NE(chooser.choice().why.find("depth ties"), std::string::npos) << chooser.choice().why;
+  // No ties (a frame turned into base_link, or not measurable) say nothing against the camera.
+  for (const float ties : {0.0f, std::nanf("")}) {
+    CloudSignature plain{0.002f, 0.002f};
+    plain.depth_ties = ties;
+    EXPECT_EQ(judge_signature(cam, plain).fit, DomainFit::kFits);
+    EXPECT_EQ(judge_signature(laser, plain).fit, DomainFit::kFits);
+  }
+}
