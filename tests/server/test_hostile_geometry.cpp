@@ -96,9 +96,28 @@ TEST_F(HostileGeometry, FarPointsMixedWithAScanGetAnAnswerAndTheScanKeepsItsLabe
 // The same far points against a model that downsamples (as the default LMS400 and Kinect
 // models do): once "voxel leaf 0.003 is too small for the cloud's extent", INTERNAL. Now the far
 // points are answered unknown and counted, and so are a leaf of 1e-30 and a 1e6 m cube.
-TEST(HostileGeometryOnVoxels, FarPointsAnyLeafAndAHugeCubeAreAnsweredAndCounted) {
+// With shape evidence too: the table-top stage and the shape fitter see the far points as well.
+LabelModel voxel_model(bool shape_evidence) {
   LabelModel model = random_label_model("voxels", "1", 7, 0.5f);
   model.features.voxel_size = 0.003f;
+  if (shape_evidence) {
+    model.features.shape_evidence = true;
+    // The same weights and coupling, the evidence's columns 0.
+    const crf::CrfModel narrow = model.weights;
+    model.weights = crf::CrfModel::zeros(narrow.class_ids, model.features.model_input_dim());
+    const Eigen::Index d = narrow.descriptor_dim;
+    model.weights.node_weights.leftCols(d) = narrow.node_weights.leftCols(d);
+    model.weights.node_weights.rightCols(1) = narrow.node_weights.rightCols(1);  // the bias
+    model.weights.edge_weights.rightCols(1) = narrow.edge_weights.rightCols(1);
+  }
+  return model;
+}
+
+class HostileGeometryOnVoxels : public ::testing::TestWithParam<bool> {};
+INSTANTIATE_TEST_SUITE_P(ShapeEvidence, HostileGeometryOnVoxels, ::testing::Bool());
+
+TEST_P(HostileGeometryOnVoxels, FarPointsAnyLeafAndAHugeCubeAreAnsweredAndCounted) {
+  const LabelModel model = voxel_model(GetParam());
   TestServer server({model});
   const PointCloud table = table_with_box_cloud(0.01f);
   const auto send = [&](const PointCloud& cloud, float voxel_size = 0.0f) {

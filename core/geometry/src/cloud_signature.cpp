@@ -74,6 +74,22 @@ float noise_growth(std::vector<std::pair<float, float>> patches) {
                std::log(double(far_range) / near_range));
 }
 
+// Whether at least 90% of `values` lie on one decimal grid (0.01 down to 1e-5): coordinates
+// rounded for storage (a text file with three decimals) tie in every axis, which is no sensor's
+// depth quantisation.
+bool on_a_decimal_grid(const std::vector<float>& values) {
+  if (values.empty()) return false;
+  for (const double step : {1e-2, 1e-3, 1e-4, 1e-5}) {
+    std::size_t on = 0;
+    for (float v : values) {
+      const double cells = double(v) / step;
+      on += std::abs(cells - std::round(cells)) < 0.01 ? 1 : 0;
+    }
+    if (on >= values.size() * 9 / 10) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 CloudSignature measure_signature(const std::vector<Vec3f>& xyz, const Vec3f& viewpoint,
@@ -93,6 +109,7 @@ CloudSignature measure_signature(const std::vector<Vec3f>& xyz, const Vec3f& vie
   const double max_normal_z = std::cos(double(kTiesMinSlant) * M_PI / 180.0);
   std::size_t tie_pairs = 0, ties = 0, slanted_patches = 0;
   std::vector<std::uint32_t> nearest_distinct;
+  std::vector<float> sampled_x, sampled_y;
   std::vector<float> spacing, roughness;
   std::vector<std::pair<float, float>> by_range;  // (range, roughness) of each patch
   NeighborList found;
@@ -101,6 +118,7 @@ CloudSignature measure_signature(const std::vector<Vec3f>& xyz, const Vec3f& vie
     if (!is_finite(p)) continue;
     if (seen++ % stride != 0) continue;
     context.throw_if_stopped("measuring the cloud");
+    sampled_x.push_back(p.x()), sampled_y.push_back(p.y());
     search.find(p, nearest, found);
     nearest_distinct.clear();
     for (std::size_t k = 0; k < found.size(); ++k)
@@ -131,7 +149,9 @@ CloudSignature measure_signature(const std::vector<Vec3f>& xyz, const Vec3f& vie
   signature.point_spacing = quantile_of(spacing, 0.5);
   signature.roughness = quantile_of(roughness, 0.5);
   signature.noise_growth = noise_growth(std::move(by_range));
-  if (slanted_patches >= kTiesMinPatches) signature.depth_ties = float(double(ties) / double(tie_pairs));
+  if (slanted_patches >= kTiesMinPatches &&
+      !(on_a_decimal_grid(sampled_x) && on_a_decimal_grid(sampled_y)))
+    signature.depth_ties = float(double(ties) / double(tie_pairs));
   return signature;
 }
 

@@ -43,7 +43,8 @@ struct CloudSignature {
   // levels even where the surface slopes, while a laser scanner's or a simulator's continuous
   // depths hardly ever tie. It reads depth along the frame's z axis, a camera frame's; a cloud
   // turned into another frame loses its ties, so only their presence says something. NaN when
-  // fewer than kTiesMinPatches sampled patches are slanted.
+  // fewer than kTiesMinPatches sampled patches are slanted, or when x and y lie on a decimal grid
+  // too (coordinates rounded for storage tie in every axis: not a sensor's quantisation).
   float depth_ties = std::numeric_limits<float>::quiet_NaN();
 };
 
