@@ -440,6 +440,15 @@ TEST(ClientCli, WaitingForTheServerShowsProgress) {
   r = test::run_command(cli() + args + " --unary");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find(line), std::string::npos) << r.output;
+  // On a terminal (util-linux `script` gives one) the line is redrawn in place, then ended.
+  if (test::run_command("command -v script").exit_code != 0) GTEST_SKIP() << "no script(1)";
+  r = test::run_command("script -qec '" + cli() + args + "' /dev/null");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("\r" + dir.file("scan.pcd") + ": waiting for the server: "),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(" s\r\n" + dir.file("scan.pcd") + ": 300 points"), std::string::npos)
+      << r.output;
 }
 
 TEST(ClientCli, LabeledFilesDescribeThemselvesInTheirHeader) {

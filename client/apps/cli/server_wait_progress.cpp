@@ -48,15 +48,18 @@ void ServerWaitProgress::run() {
     }
     const auto waited = Clock::now() - since_;
     if (waited >= next) {
-      const double seconds = std::chrono::duration<double>(waited).count();
-      if (tty_)
-        std::fprintf(stderr, "\r%s: waiting for the server: %.1f s", what_.c_str(), seconds);
-      else
-        std::fprintf(stderr, "%s: waiting for the server: %.0f s\n", what_.c_str(), seconds);
+      if (tty_) {
+        std::fprintf(stderr, "\r%s: waiting for the server: %.1f s", what_.c_str(),
+                     std::chrono::duration<double>(waited).count());
+        next = waited + kTtyEvery;
+      } else {  // the mark passed, not the moment seen: logs read 2 s, 7 s, 12 s, ...
+        std::fprintf(
+            stderr, "%s: waiting for the server: %lld s\n", what_.c_str(),
+            static_cast<long long>(std::chrono::duration_cast<std::chrono::seconds>(next).count()));
+        next += kLogEvery;
+      }
       std::fflush(stderr);
       printed_ = true;
-      next = waited + (tty_ ? Clock::duration(kTtyEvery) : Clock::duration(kLogEvery));
-      if (!tty_) next = next - next % std::chrono::seconds(1);  // 2 s, 7 s, 12 s, ...
     }
     wake_.wait_for(lock, std::chrono::milliseconds(50));
   }
