@@ -20,6 +20,7 @@
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/primitives/primitives_json.hpp"
+#include "primlabel/render/box_outlines.hpp"
 #include "primlabel/render/colorize.hpp"
 #include "primlabel/render/primitive_outlines.hpp"
 #include "primlabel/render/render.hpp"
@@ -105,7 +106,7 @@ std::vector<Overlay> outlines_from(const std::string& path, double min_confidenc
 }
 
 // The table's hull and every table-top object's axis-aligned box in `path` (objects_json.hpp),
-// in one colour each: hull grey, boxes black.
+// in one colour each: hull grey, boxes black with their ids.
 std::vector<Overlay> object_boxes_from(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw RunError("cannot read objects file '" + path + "'");
@@ -118,20 +119,18 @@ std::vector<Overlay> object_boxes_from(const std::string& path) {
     throw RunError(path + ": " + e.what());
   }
   std::vector<Overlay> out;
-  if (objects.table && objects.table->hull.size() >= 2)
-    out.push_back({objects.table->hull, 0x808080, true});
+  if (objects.table && objects.table->hull.size() >= 2) {
+    Overlay hull;
+    hull.points = objects.table->hull;
+    hull.rgb = 0x808080;
+    hull.closed = true;
+    out.push_back(std::move(hull));
+  }
   for (const tabletop::TabletopObject& o : objects.objects) {
     if (o.points == 0) continue;
-    const auto corner = [&](int x, int y, int z) {
-      return Vec3f(float(x ? o.bounds_max.x() : o.bounds_min.x()),
-                   float(y ? o.bounds_max.y() : o.bounds_min.y()),
-                   float(z ? o.bounds_max.z() : o.bounds_min.z()));
-    };
-    for (int z = 0; z <= 1; ++z)  // bottom and top rectangles, then the four vertical edges
-      out.push_back(
-          {{corner(0, 0, z), corner(1, 0, z), corner(1, 1, z), corner(0, 1, z)}, 0x000000, true});
-    for (int x = 0; x <= 1; ++x)
-      for (int y = 0; y <= 1; ++y) out.push_back({{corner(x, y, 0), corner(x, y, 1)}, 0x000000});
+    for (Overlay& edge : box_outline(o.bounds_min.cast<float>(), o.bounds_max.cast<float>(),
+                                     0x000000, "object " + std::to_string(o.id)))
+      out.push_back(std::move(edge));
   }
   return out;
 }

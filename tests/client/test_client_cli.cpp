@@ -14,8 +14,10 @@
 
 #include "common/class_fields.hpp"
 #include "common/human_format.hpp"
+#include "common/labeled_output.hpp"
 #include "common/server_address.hpp"
 #include "fake_labeler.hpp"
+#include "png_decode.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/primitives/primitives_json.hpp"
@@ -282,6 +284,173 @@ TEST(ClientCli, ObjectsGoToTheirJsonFileAndTheObjectField) {
   }
 }
 
+// A camera frame as PCL's office1.pcd has it: organised, its points in the optical frame (a
+// table 0.4 m below the sensor, 2 m to its right so the fake labels it 2), a VIEWPOINT rotated
+// 90 degrees about x, and every fifth point NaN (no return).
+void write_rotated_viewpoint_frame(const std::string& path) {
+  PointCloud frame;
+  frame.width = 50, frame.height = 40;
+  for (int r = 0; r < 40; ++r)
+    for (int c = 0; c < 50; ++c)
+      frame.xyz.emplace_back(1.6f + 0.8f * float(c) / 49, 0.4f, 0.8f + 0.8f * float(r) / 39);
+  for (std::size_t i = 0; i < frame.size(); i += 5)
+    frame.xyz[i] = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  frame.viewpoint.orientation = Eigen::Quaternionf(Eigen::AngleAxisf(0.5f * M_PI, Vec3f::UnitX()));
+  write_cloud(path, frame);
+}
+
+// Pixels of the plot area (right of the legend and below the title) that are not background.
+std::size_t drawn_pixels(const test::Decoded& png) {
+  std::size_t n = 0;
+  for (int y = 40; y < png.height; ++y)
+    for (int x = 400; x < png.width; ++x) n += png.at(x, y) != 0xFFFFFFu;
+  return n;
+}
+
+TEST(ClientCli, PngOfAFrameWithARotatedViewpointShowsThePoints) {
+  FakeServer server;
+  test::TempDir dir;
+  write_rotated_viewpoint_frame(dir.file("office.pcd"));
+  ASSERT_NE(read_cloud(dir.file("office.pcd")).viewpoint.orientation.w(), 1.0f);
+  const auto r =
+      test::run_command(cli() + " --server " + server.address() + " label " +
+                        dir.file("office.pcd") + " -o " + dir.file("out.pcd") + " --png");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_GT(drawn_pixels(test::decode_png(dir.file("out.png"))), 3000u);  // blank: 0
+}
+
+// The summary line names the points without a position as the picture's legend does, not as
+// "unknown" (the class the server gives them).
+TEST(ClientCli, TheSummaryLineSeparatesNanPointsFromUnknownOnesAsThePictureDoes) {
+  FakeServer server;
+  test::TempDir dir;
+  write_rotated_viewpoint_frame(dir.file("office.pcd"));
+  const auto r = test::run_command(cli() + " --server " + server.address() + " label " +
+                                   dir.file("office.pcd") + " -o " + dir.file("out.pcd"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("no point (NaN) 20%"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("unknown"), std::string::npos) << r.output;
+
+  PointCloud labeled;  // and the NaN share is named even when it is not among the largest
+  labeled.resize_unorganized(100);
+  labeled.labels.resize(100);
+  for (std::size_t i = 0; i < 100; ++i) {
+    labeled.xyz[i] = Vec3f(1, 2, 3);
+    labeled.labels[i] = std::uint32_t(i % 4 + 1);
+  }
+  labeled.xyz[0] = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  const std::string line = client::tools::label_histogram(labeled, 2);
+  EXPECT_NE(line.find("no point (NaN) 1%"), std::string::npos) << line;
+  EXPECT_EQ(std::count(line.begin(), line.end(), '%'), 3) << line;
+}
+
+TEST(ClientCli, PngViewIsChosenByView) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  const std::string base =
+      cli() + " -q --server " + server.address() + " label " + dir.file("scan.pcd") + " --png -o ";
+  ASSERT_EQ(test::run_command(base + dir.file("auto.pcd")).exit_code, 0);
+  auto r = test::run_command(base + dir.file("top.pcd") + " --view top");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test::Decoded oblique = test::decode_png(dir.file("auto.png"));
+  const test::Decoded top = test::decode_png(dir.file("top.png"));
+  EXPECT_NE(oblique.height, top.height);  // a flat strip seen from above is less tall
+  r = test::run_command(base + dir.file("x.pcd") + " --view sideways");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--view"), std::string::npos) << r.output;
+}
+
+// --tabletop --png draws the table's hull and each object's box with its id over the points,
+// without --objects too (which alone adds the JSON and the `object` field).
+TEST(ClientCli, TabletopPngDrawsTheObjects) {
+  FakeServer server;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  const std::string base =
+      cli() + " -q --server " + server.address() + " label " + dir.file("scan.pcd") + " --png -o ";
+  ASSERT_EQ(test::run_command(base + dir.file("plain.pcd")).exit_code, 0);
+  const auto r = test::run_command(base + dir.file("table.pcd") + " --tabletop");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const test::Decoded plain = test::decode_png(dir.file("plain.png"));
+  const test::Decoded table = test::decode_png(dir.file("table.png"));
+  ASSERT_EQ(plain.rgb.size(), table.rgb.size());
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < plain.rgb.size(); ++i) changed += plain.rgb[i] != table.rgb[i];
+  EXPECT_GT(changed, 1000u);
+  const auto black = [](const test::Decoded& png) {
+    return png.count(0x000000, 0, 0, png.width, png.height);
+  };
+  EXPECT_GT(black(table), black(plain) + 500) << black(table) << " vs " << black(plain);
+  EXPECT_EQ(read_cloud(dir.file("table.pcd")).find_field("object"), nullptr);
+  ASSERT_EQ(server.service.options.size(), 2u);
+  EXPECT_TRUE(server.service.options[1].return_objects());
+}
+
+// A folder is its .pcd and .ply files, by name: not its subfolders, hidden files, other files or
+// the outputs of an earlier run; the outputs go into -o as for several files.
+TEST(ClientCli, AFolderLabelsEveryScanInItByName) {
+  FakeServer server;
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.file("in/sub"));
+  write_scan(dir.file("in/b.pcd"));
+  write_scan(dir.file("in/a.ply"));
+  write_scan(dir.file("in/sub/c.pcd"));
+  write_scan(dir.file("in/.hidden.pcd"));
+  write_scan(dir.file("in/old_labeled.pcd"));
+  { std::ofstream(dir.file("in/notes.txt")) << "not a scan\n"; }
+  auto r = test::run_command(cli() + " --server " + server.address() + " label " + dir.file("in") +
+                             " -o " + dir.file("out"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(server.service.scan_ids, (std::vector<std::string>{"a", "b"}));
+  EXPECT_TRUE(std::filesystem::exists(dir.file("out/a_labeled.pcd")));
+  EXPECT_TRUE(std::filesystem::exists(dir.file("out/b_labeled.pcd")));
+  // A folder with one scan still writes into the -o directory.
+  std::filesystem::create_directories(dir.file("one"));
+  write_scan(dir.file("one/only.pcd"));
+  r = test::run_command(cli() + " -q --server " + server.address() + " label " + dir.file("one") +
+                        " -o " + dir.file("out1"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(dir.file("out1/only_labeled.pcd")));
+  // A folder without a scan is said, and is a file error.
+  std::filesystem::create_directories(dir.file("empty"));
+  r = test::run_command(cli() + " -q --server " + server.address() + " label " + dir.file("empty"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("empty: no .pcd or .ply file in the folder"), std::string::npos)
+      << r.output;
+}
+
+// The server's work on a sent scan shows as progress (stderr is not a terminal here: one line
+// after 2 s, the next at 7 s), not as silence; --quiet keeps it quiet.
+TEST(ClientCli, WaitingForTheServerShowsProgress) {
+  FakeServer server;
+  server.service.delay_ms = 3500;
+  test::TempDir dir;
+  write_scan(dir.file("scan.pcd"));
+  const std::string args = " --server " + server.address() + " label " + dir.file("scan.pcd") +
+                           " -o " + dir.file("out.pcd");
+  auto r = test::run_command(cli() + args);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string line = dir.file("scan.pcd") + ": waiting for the server: 2 s\n";
+  EXPECT_NE(r.output.find(line), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("waiting for the server: 7 s"), std::string::npos) << r.output;
+  r = test::run_command(cli() + " -q" + args);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("waiting"), std::string::npos) << r.output;
+  r = test::run_command(cli() + args + " --unary");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(line), std::string::npos) << r.output;
+  // On a terminal (util-linux `script` gives one) the line is redrawn in place, then ended.
+  if (test::run_command("command -v script").exit_code != 0) GTEST_SKIP() << "no script(1)";
+  r = test::run_command("script -qec '" + cli() + args + "' /dev/null");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("\r" + dir.file("scan.pcd") + ": waiting for the server: "),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find(" s\r\n" + dir.file("scan.pcd") + ": 300 points"), std::string::npos)
+      << r.output;
+}
+
 TEST(ClientCli, LabeledFilesDescribeThemselvesInTheirHeader) {
   FakeServer server;
   test::TempDir dir;
@@ -434,8 +603,8 @@ TEST(ClientCli, UnitsScaleThePointsSentAndTheOutputKeepsTheInputs) {
   write_cloud(dir.file("mm.pcd"), scan);
   const std::string base = cli() + " --server " + server.address() + " label " +
                            dir.file("mm.pcd") + " -o " + dir.file("out.pcd");
-  for (const auto& [flag, scale] : {std::pair{"mm", 0.001f}, std::pair{"CM", 0.01f},
-                                    std::pair{"m", 1.0f}}) {
+  for (const auto& [flag, scale] :
+       {std::pair{"mm", 0.001f}, std::pair{"CM", 0.01f}, std::pair{"m", 1.0f}}) {
     SCOPED_TRACE(flag);
     const auto r = test::run_command(base + " --units " + flag);
     ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -733,5 +733,85 @@ TEST(UploadCli, WatchedDirectoryScansAreUploadedUntilASignal) {
   EXPECT_NE(uploader.log().find("uploaded 3"), std::string::npos) << uploader.log();
 }
 
+// Exit 0 promises every scan labeled: a signal that ends a run of files with scans still spooled
+// (the server away) exits 6 and says how many wait for the next run.
+TEST(UploadCli, ASignalWithScansStillSpooledExitsSixSayingHowMany) {
+  test::TempDir dir;
+  write_bytes(dir.file("a.pcd"), scan_bytes(50));
+  write_bytes(dir.file("b.pcd"), scan_bytes(51));
+  std::string dead;
+  { dead = FakeServer().address(); }
+  test::Process uploader(
+      {upload_tool(), "--retries", "1", "--server", dead, "--spool", dir.file("spool"), "-o",
+       dir.file("out"), "--status-interval", "0", dir.file("a.pcd"), dir.file("b.pcd")},
+      dir.file("upload.log"));
+  ASSERT_TRUE(uploader.wait_for_log("accepted [0-9a-f]+ .*b\\.pcd", std::chrono::seconds(20)))
+      << uploader.log();
+  EXPECT_EQ(uploader.kill(SIGTERM), 6) << uploader.log();
+  EXPECT_NE(uploader.log().find("stopped by signal with 2 scans still spooled; they resume on the "
+                                "next run"),
+            std::string::npos)
+      << uploader.log();
+  EXPECT_EQ(files_in(dir.file("spool/scans")), 2u);
+  // With nothing left to do a signal changes nothing: --watch still exits 0 (see below).
+}
+
+// A writer that closes a file between writes makes the watch read it half-written: that is no
+// input error while the file is completed later (it is retried when it changes and labeled), and
+// one only if it is still unreadable when the run ends.
+TEST(UploadCli, AWatchedFileReadHalfWrittenIsRetriedOnceComplete) {
+  FakeServer server;
+  test::TempDir dir;
+  fs::create_directories(dir.file("in"));
+  test::Process uploader(
+      {upload_tool(), "--server", server.address(), "--watch", dir.file("in"), "--spool",
+       dir.file("spool"), "-o", dir.file("out"), "--status-interval", "0"},
+      dir.file("upload.log"));
+  const std::string whole = scan_bytes(44);
+  ASSERT_TRUE(
+      test::eventually([&] { return fs::exists(dir.file("spool")); }, std::chrono::seconds(20)));
+  write_bytes(dir.file("in/slow.pcd"), whole.substr(0, whole.size() / 2));
+  ASSERT_TRUE(uploader.wait_for_log("slow\\.pcd: unreadable for now", std::chrono::seconds(20)))
+      << uploader.log();
+  write_bytes(dir.file("in/slow.pcd"), whole);  // the writer finishes
+  EXPECT_TRUE(
+      test::eventually([&] { return clouds_in(dir.file("out")) == 1; }, std::chrono::seconds(30)))
+      << uploader.log();
+  write_bytes(dir.file("in/broken.pcd"), "VERSION 0.7\nFIELDS x y z\nnot a header\n");
+  ASSERT_TRUE(uploader.wait_for_log("broken\\.pcd: unreadable for now", std::chrono::seconds(20)))
+      << uploader.log();
+  fs::remove(dir.file("in/broken.pcd"));  // a temporary file that went away is nothing to report
+  write_bytes(dir.file("in/bad.pcd"), "VERSION 0.7\nFIELDS x y z\nnot a header\n");
+  ASSERT_TRUE(uploader.wait_for_log("bad\\.pcd: unreadable for now", std::chrono::seconds(20)))
+      << uploader.log();
+  // Still unreadable when the run ends: an input error, named once.
+  EXPECT_EQ(uploader.kill(SIGTERM), 1) << uploader.log();
+  const std::string log = uploader.log();
+  EXPECT_NE(log.find("bad.pcd: not spooled, unreadable"), std::string::npos) << log;
+  EXPECT_EQ(log.find("slow.pcd: not spooled"), std::string::npos) << log;
+  EXPECT_EQ(log.find("broken.pcd: not spooled"), std::string::npos) << log;
+  EXPECT_NE(log.find("uploaded 1"), std::string::npos) << log;
+}
+
+// Without a file left unreadable, the same half-written file ends the watch with 0.
+TEST(UploadCli, AWatchWhoseHalfWrittenFileWasCompletedExitsZero) {
+  FakeServer server;
+  test::TempDir dir;
+  fs::create_directories(dir.file("in"));
+  test::Process uploader({upload_tool(), "-q", "--server", server.address(), "--watch",
+                          dir.file("in"), "--spool", dir.file("spool"), "-o", dir.file("out")},
+                         dir.file("upload.log"));
+  const std::string whole = scan_bytes(45);
+  ASSERT_TRUE(
+      test::eventually([&] { return fs::exists(dir.file("spool")); }, std::chrono::seconds(20)));
+  write_bytes(dir.file("in/slow.pcd"), whole.substr(0, whole.size() / 2));
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));  // read half-written (quietly)
+  write_bytes(dir.file("in/slow.pcd"), whole);
+  EXPECT_TRUE(
+      test::eventually([&] { return clouds_in(dir.file("out")) == 1; }, std::chrono::seconds(30)))
+      << uploader.log();
+  EXPECT_EQ(uploader.kill(SIGTERM), 0) << uploader.log();
+}
+
 }  // namespace
 }  // namespace primlabel

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "png_decode.hpp"
+#include "primlabel/render/box_outlines.hpp"
 #include "primlabel/render/colorize.hpp"
 #include "primlabel/render/primitive_outlines.hpp"
 #include "primlabel/render/raster.hpp"
@@ -75,6 +76,71 @@ TEST(Render, OrganisedFramesAreSeenFromTheSensor) {
   EXPECT_EQ(natural_view(frame), RenderView::kSensor);
   frame.width = 12, frame.height = 1;
   EXPECT_EQ(natural_view(frame), RenderView::kOblique);
+}
+
+// A camera frame in its optical frame (x right, y down, z forward): a table 0.4 m below the
+// sensor with a box standing on it, 50 x 40 points.
+PointCloud optical_table_frame() {
+  PointCloud frame;
+  frame.width = 50, frame.height = 40;
+  for (int r = 0; r < 40; ++r)
+    for (int c = 0; c < 50; ++c) {
+      const float u = float(c) / 49;
+      if (r < 10)  // the box's front face
+        frame.xyz.emplace_back(-0.1f + 0.2f * u, 0.2f + 0.02f * float(r), 0.9f);
+      else  // the table top
+        frame.xyz.emplace_back(-0.5f + u, 0.4f, 0.8f + 0.8f * float(r - 10) / 29);
+    }
+  return frame;
+}
+
+// PCL's office1.pcd: an organised frame whose VIEWPOINT holds a rotation while its points are in
+// the optical frame. Seen through that pose every point is behind the sensor; the picture still
+// shows them.
+TEST(Render, ASensorViewpointThatLooksAwayStillShowsThePoints) {
+  test::TempDir dir;
+  PointCloud frame = optical_table_frame();
+  frame.viewpoint.orientation = Eigen::Quaternionf(Eigen::AngleAxisf(0.5f * M_PI, Vec3f::UnitX()));
+  const std::vector<std::uint32_t> colors(frame.size(), 0xFF0000);
+  RenderOptions options;
+  options.width = 320;
+  options.height = 240;
+  options.view = natural_view(frame);
+  ASSERT_EQ(options.view, RenderView::kSensor);
+  render_png(frame, colors, options, dir.file("rotated.png"));
+  const Decoded rotated = decode_png(dir.file("rotated.png"));
+  EXPECT_GT(rotated.count_mostly(16, 0, 0, rotated.width, rotated.height), 5000u);
+
+  // A VIEWPOINT that sees the points is still the one used: the same frame moved into the
+  // rotated sensor's world looks as the unrotated frame did.
+  PointCloud moved = frame;
+  for (Vec3f& p : moved.xyz) p = frame.viewpoint.orientation * p;
+  render_png(moved, colors, options, dir.file("moved.png"));
+  frame.viewpoint = {};
+  render_png(frame, colors, options, dir.file("plain.png"));
+  const Decoded moved_png = decode_png(dir.file("moved.png"));
+  const Decoded plain_png = decode_png(dir.file("plain.png"));
+  ASSERT_EQ(moved_png.rgb.size(), plain_png.rgb.size());
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < plain_png.rgb.size(); ++i)
+    differ += moved_png.rgb[i] != plain_png.rgb[i];
+  EXPECT_LT(differ, plain_png.rgb.size() / 100) << differ;
+}
+
+// Box outlines: six polylines over the twelve edges, the label on the first.
+TEST(BoxOutlines, TwelveEdgesAndALabel) {
+  const std::vector<Overlay> box =
+      box_outline(Vec3f(0, 0, 0), Vec3f(1, 2, 3), 0x123456, "object 7");
+  ASSERT_EQ(box.size(), 6u);
+  std::size_t segments = 0;
+  for (const Overlay& o : box) {
+    segments += o.closed ? o.points.size() : o.points.size() - 1;
+    EXPECT_EQ(o.rgb, 0x123456u);
+  }
+  EXPECT_EQ(segments, 12u);
+  EXPECT_EQ(box.front().label, "object 7");
+  EXPECT_EQ(box.front().points.front(), Vec3f(0, 0, 3));  // at the top
+  EXPECT_TRUE(box_outline(Vec3f(0, 0, 0), Vec3f(1, NAN, 1), 0).empty());
 }
 
 TEST(Render, ViewsDifferAndNearPointsHideFarOnes) {

@@ -17,6 +17,7 @@ struct LabelCommand {
   std::vector<std::string> inputs;
   std::string output;
   bool png = false;
+  std::string view = "auto";  // of the PNG: auto, sensor, top or oblique (as primlabel-render)
   bool descriptors = false;
   bool probabilities = false;
   std::string primitives;  // --primitives: JSON file (one input) or directory (several)
@@ -24,6 +25,8 @@ struct LabelCommand {
   bool unary = false;
   bool quiet = false;
   LabelOptions options;
+  // Set by run_label: several inputs (or a folder) write one file each into -o as a directory.
+  bool into_directory = false;
 };
 
 int run_label(Client& client, LabelCommand command);

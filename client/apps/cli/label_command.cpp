@@ -13,10 +13,13 @@
 #include "commands.hpp"
 #include "common/labeled_output.hpp"
 #include "common/object_json.hpp"
+#include "common/object_overlays.hpp"
 #include "common/primitive_json.hpp"
+#include "input_files.hpp"
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "server_wait_progress.hpp"
 #include "status_exit_codes.hpp"
 
 namespace primlabel::client::tools {
@@ -31,8 +34,7 @@ std::string default_name(const fs::path& input) { return input.stem().string() +
 std::string output_path(const LabelCommand& command, const fs::path& input) {
   if (command.output.empty()) return (input.parent_path() / default_name(input)).string();
   const fs::path out(command.output);
-  if (command.inputs.size() > 1 || fs::is_directory(out))
-    return (out / default_name(input)).string();
+  if (command.into_directory || fs::is_directory(out)) return (out / default_name(input)).string();
   return out.string();
 }
 
@@ -41,14 +43,14 @@ std::string output_path(const LabelCommand& command, const fs::path& input) {
 std::string json_path(const LabelCommand& command, const std::string& target, const fs::path& input,
                       const char* what) {
   const fs::path out(target);
-  if (command.inputs.size() > 1 || fs::is_directory(out))
+  if (command.into_directory || fs::is_directory(out))
     return (out / (input.stem().string() + "_" + what + ".json")).string();
   return out.string();
 }
 
 // For several inputs the JSON goes into a directory: false (and said) when it cannot be made.
 bool make_json_directory(const LabelCommand& command, const std::string& target, const char* what) {
-  if (command.inputs.size() <= 1 || target.empty()) return true;
+  if (!command.into_directory || target.empty()) return true;
   std::error_code ec;
   fs::create_directories(target, ec);
   if (!ec) return true;
@@ -62,7 +64,7 @@ bool make_json_directory(const LabelCommand& command, const std::string& target,
 std::string not_a_directory_target(const LabelCommand& command, const std::string& flag,
                                    const std::string& target,
                                    std::initializer_list<const char*> file_extensions) {
-  if (command.inputs.size() <= 1 || target.empty()) return {};
+  if (!command.into_directory || target.empty()) return {};
   const fs::path path(target);
   std::error_code ec;
   const bool exists = fs::exists(path, ec);
@@ -79,6 +81,15 @@ std::string not_a_directory_target(const LabelCommand& command, const std::strin
 }  // namespace
 
 int run_label(Client& client, LabelCommand command) {
+  int exit_code = kExitOk;
+  InputFiles inputs = expand_input_folders(command.inputs);
+  for (const std::string& error : inputs.errors) {
+    std::fprintf(stderr, "primlabel: %s\n", error.c_str());
+    exit_code = kExitFile;
+  }
+  if (inputs.files.empty()) return exit_code;
+  command.inputs = std::move(inputs.files);
+  command.into_directory = command.inputs.size() > 1 || inputs.from_folder;
   for (const auto& [flag, target, extensions] :
        {std::tuple{std::string("-o"), command.output,
                    std::initializer_list<const char*>{".pcd", ".ply"}},
@@ -92,7 +103,7 @@ int run_label(Client& client, LabelCommand command) {
       return kExitUsage;
     }
   }
-  if (command.inputs.size() > 1 && !command.output.empty()) {
+  if (command.into_directory && !command.output.empty()) {
     std::error_code ec;
     fs::create_directories(command.output, ec);
     if (ec) {
@@ -104,8 +115,10 @@ int run_label(Client& client, LabelCommand command) {
   command.options.descriptors = command.descriptors;
   command.options.probabilities = command.probabilities;
   command.options.primitives = !command.primitives.empty();
-  command.options.objects = !command.objects.empty();
-  if (command.options.objects && !command.options.tabletop_only) {
+  // The picture draws the table-top objects, so it asks for them even without --objects.
+  command.options.objects =
+      !command.objects.empty() || (command.png && command.options.tabletop_only);
+  if (!command.objects.empty() && !command.options.tabletop_only) {
     std::fprintf(stderr,
                  "primlabel: --objects needs --tabletop (the objects are the table-top "
                  "stage's)\n");
@@ -115,7 +128,6 @@ int run_label(Client& client, LabelCommand command) {
       !make_json_directory(command, command.objects, "objects"))
     return kExitFile;
   cli::ProgressPrinter progress(command.quiet);
-  int exit_code = kExitOk;
   for (const std::string& input : command.inputs) {
     PointCloud cloud;
     try {
@@ -125,9 +137,12 @@ int run_label(Client& client, LabelCommand command) {
       if (exit_code == kExitOk) exit_code = kExitFile;
       continue;
     }
-    if (std::none_of(cloud.xyz.begin(), cloud.xyz.end(), [](const Vec3f& p) { return is_finite(p); })) {
-      std::fprintf(stderr, "primlabel: %s: no point has finite coordinates (%zu points): nothing "
-                   "to label\n", input.c_str(), cloud.size());
+    if (std::none_of(cloud.xyz.begin(), cloud.xyz.end(),
+                     [](const Vec3f& p) { return is_finite(p); })) {
+      std::fprintf(stderr,
+                   "primlabel: %s: no point has finite coordinates (%zu points): nothing "
+                   "to label\n",
+                   input.c_str(), cloud.size());
       if (exit_code == kExitOk) exit_code = kExitFile;
       continue;
     }
@@ -135,14 +150,25 @@ int run_label(Client& client, LabelCommand command) {
     if (options.scan_id.empty()) options.scan_id = fs::path(input).stem().string();
     const auto start = std::chrono::steady_clock::now();
     LabelResult result;
+    ServerWaitProgress waiting(command.quiet, input);
     try {
       if (command.unary) {
+        waiting.start();  // one message: nothing to count while it goes
         result = client.label_unary(cloud, options);
       } else {
-        result = client.label(cloud, options, progress.stage("send " + input));
+        const ProgressFn sending = progress.stage("send " + input);
+        result = client.label(cloud, options, [&](std::size_t sent, std::size_t total) {
+          if (sending) sending(sent, total);
+          if (sent == total) {
+            progress.done();
+            waiting.start();
+          }
+        });
       }
+      waiting.stop();
       progress.done();
     } catch (const ClientError& e) {
+      waiting.stop();
       progress.done();
       if (exit_code_for(e.code()) == kExitUnavailable) throw;
       std::fprintf(stderr, "primlabel: %s: %s\n", input.c_str(), e.what());
@@ -153,15 +179,21 @@ int run_label(Client& client, LabelCommand command) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const std::string out = output_path(command, input);
     const bool had_labels = cloud.has_labels();
+    std::string histogram;
     try {
       PointCloud labeled = labeled_cloud(std::move(cloud), result);
-      if (!result.object_ids.empty())
+      histogram = label_histogram(labeled);
+      if (!command.objects.empty() && !result.object_ids.empty())
         labeled.set_field("object", 1).values = object_field(result.object_ids);
       write_labeled_cloud(out, labeled, result);
-      if (command.png)
-        write_label_png(labeled, fs::path(out).replace_extension(".png").string(),
-                        fs::path(input).filename().string() + " - " + result.summary.model() + " " +
-                            result.summary.model_version());
+      if (command.png) {
+        LabelPicture picture;
+        picture.title = fs::path(input).filename().string() + " - " + result.summary.model() + " " +
+                        result.summary.model_version();
+        picture.view = render_view(command.view);
+        if (command.options.objects) picture.overlays = object_overlays(objects_of(result.summary));
+        write_label_png(labeled, fs::path(out).replace_extension(".png").string(), picture);
+      }
       if (!command.primitives.empty())
         atomic_write_file(json_path(command, command.primitives, input, "primitives"),
                           summary_primitives_json(result.summary));
@@ -192,8 +224,7 @@ int run_label(Client& client, LabelCommand command) {
       std::fprintf(stderr, "%s: %zu points -> %s in %.2f s, model %s %s %s (%s)\n", input.c_str(),
                    result.size(), out.c_str(), seconds, result.summary.model().c_str(),
                    result.summary.model_version().c_str(),
-                   model_choice_text(result.summary).c_str(),
-                   label_histogram(result.labels).c_str());
+                   model_choice_text(result.summary).c_str(), histogram.c_str());
   }
   return exit_code;
 }

@@ -48,14 +48,26 @@ int main(int argc, char** argv) {
 
   LabelCommand label_args;
   CLI::App* label = app.add_subcommand("label", "Label PCD/PLY files and write labeled clouds");
-  label->add_option("FILE", label_args.inputs, "Input .pcd or .ply files")->required();
+  label
+      ->add_option("FILE", label_args.inputs,
+                   "Input .pcd or .ply files, or folders: every .pcd and .ply directly in one, "
+                   "by name (not subfolders, hidden files or *_labeled.* outputs)")
+      ->required();
   label->add_option("-o,--output", label_args.output,
-                    "Output file (one input) or directory (several); default: "
+                    "Output file (one input) or directory (several, or a folder); default: "
                     "<input>_labeled.pcd beside the input");
-  label->add_flag("--png", label_args.png, "Also write a PNG picture beside each output");
+  label->add_flag("--png", label_args.png,
+                  "Also write a PNG picture beside each output (with --tabletop: the table and "
+                  "each object's box and id drawn over the points)");
+  label
+      ->add_option("--view", label_args.view,
+                   "The PNG's view: auto (sensor for an organised camera frame, else oblique), "
+                   "sensor (from the VIEWPOINT), top or oblique")
+      ->check(CLI::IsMember({"auto", "sensor", "top", "oblique"}));
   label->add_flag("--descriptors", label_args.descriptors, "Add the FPFH descriptors (fpfh)");
-  label->add_flag("--probabilities", label_args.probabilities,
-                  "Add the per-class probabilities (one field per class, prob_<class>, e.g. prob_plane)");
+  label->add_flag(
+      "--probabilities", label_args.probabilities,
+      "Add the per-class probabilities (one field per class, prob_<class>, e.g. prob_plane)");
   label->add_option("--primitives", label_args.primitives,
                     "Also fit primitive instances and write them as JSON (as primlabel-eval "
                     "--primitives): a file (one input) or directory (several, "

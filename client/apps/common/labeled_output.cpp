@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <stdexcept>
 
 #include "class_fields.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
@@ -109,30 +110,57 @@ void write_labeled_cloud(const std::string& path, const PointCloud& labeled,
   write_tagged_cloud(path, labeled, labeled_cloud_tags(result));
 }
 
-void write_label_png(const PointCloud& cloud, const std::string& path, const std::string& title) {
+std::optional<RenderView> render_view(const std::string& name) {
+  if (name == "auto") return std::nullopt;
+  if (name == "sensor") return RenderView::kSensor;
+  if (name == "top") return RenderView::kTop;
+  if (name == "oblique") return RenderView::kOblique;
+  throw std::invalid_argument("unknown view '" + name + "' (auto, sensor, top or oblique)");
+}
+
+void write_label_png(const PointCloud& cloud, const std::string& path,
+                     const LabelPicture& picture) {
   const Coloring coloring = color_by_class(cloud, ClassMap::taxonomy());
   RenderOptions options;
-  options.title = title;
+  options.title = picture.title;
   options.legend = coloring.legend;
-  options.view = natural_view(cloud);  // a camera frame as the camera saw it, upright
+  // By default a camera frame as the camera saw it, upright.
+  options.view = picture.view.value_or(natural_view(cloud));
+  options.overlays = picture.overlays;
   options.crop_to_points = true;
   render_png(cloud, coloring.rgb, options, path);
 }
 
-std::string label_histogram(const std::vector<std::uint32_t>& labels, int max) {
-  std::map<std::uint32_t, std::size_t> counts;
-  for (auto l : labels) ++counts[l];
-  std::vector<std::pair<std::size_t, std::uint32_t>> order;
-  for (auto [id, n] : counts) order.emplace_back(n, id);
-  std::sort(order.rbegin(), order.rend());
+std::string label_histogram(const PointCloud& labeled, int max) {
+  const std::vector<std::uint32_t>& labels = labeled.labels;
+  std::map<std::uint32_t, std::size_t> counts;  // points with a position, by label
+  std::size_t no_position = 0;
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    if (i < labeled.xyz.size() && !is_finite(labeled.xyz[i]))
+      ++no_position;
+    else
+      ++counts[labels[i]];
+  }
+  // The same name as the picture's legend (color_by_class).
+  constexpr const char* kNoPosition = "no point (NaN)";
+  std::vector<std::pair<std::size_t, std::string>> order;
+  for (auto [id, n] : counts) {
+    const auto cls = class_from_id(id);
+    order.emplace_back(n, cls ? std::string(name(*cls)) : "label " + std::to_string(id));
+  }
+  if (no_position > 0) order.emplace_back(no_position, kNoPosition);
+  std::stable_sort(order.begin(), order.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  // Points without a position are never left out: "unknown" would hide them, silence too.
+  const auto shown_at = [&](int i) {
+    return i < max || (order[i].second == kNoPosition && no_position > 0);
+  };
   std::string text;
-  for (int i = 0; i < static_cast<int>(order.size()) && i < max; ++i) {
-    const auto cls = class_from_id(order[i].second);
-    const std::string class_name =
-        cls ? std::string(name(*cls)) : "label " + std::to_string(order[i].second);
+  for (int i = 0; i < static_cast<int>(order.size()); ++i) {
+    if (!shown_at(i)) continue;
     char share[32];
     std::snprintf(share, sizeof share, " %.0f%%", 100.0 * order[i].first / labels.size());
-    text += (text.empty() ? "" : ", ") + class_name + share;
+    text += (text.empty() ? "" : ", ") + order[i].second + share;
   }
   return text;
 }

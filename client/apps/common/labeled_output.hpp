@@ -3,11 +3,14 @@
 // plus `fpfh` (or `descriptor`) and `probability` fields when the result carries them, and a PNG
 // picture coloured by class.
 
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "primlabel/client/client.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/render/render.hpp"
 
 namespace primlabel::client::tools {
 
@@ -38,10 +41,24 @@ std::string classes_json_path(const std::string& cloud_path);
 void write_labeled_cloud(const std::string& path, const PointCloud& labeled,
                          const LabelResult& result);
 
-// Renders `cloud` coloured by its labels with the taxonomy's colours and a legend.
-void write_label_png(const PointCloud& cloud, const std::string& path, const std::string& title);
+// What a label picture shows besides the points: its title, the view (natural_view() when
+// unset) and overlays such as the table-top objects (object_overlays.hpp).
+struct LabelPicture {
+  std::string title;
+  std::optional<RenderView> view;
+  std::vector<Overlay> overlays;
+};
 
-// "plane 61%, cylinder-convex 20%, ..." from the labels (largest first, at most `max` classes).
-std::string label_histogram(const std::vector<std::uint32_t>& labels, int max = 4);
+// The view named as `--view` takes it: "sensor", "top", "oblique", or "auto" (nothing: the
+// natural view). Throws std::invalid_argument for another name.
+std::optional<RenderView> render_view(const std::string& name);
+
+// Renders `cloud` coloured by its labels with the taxonomy's colours and a legend.
+void write_label_png(const PointCloud& cloud, const std::string& path, const LabelPicture& picture);
+
+// "plane 61%, no point (NaN) 38%, ..." from the labels of `labeled`, largest first, at most `max`
+// classes: shares of every point as the picture's legend gives them, points without finite
+// coordinates on their own (the server labels them unknown), always named when there are any.
+std::string label_histogram(const PointCloud& labeled, int max = 4);
 
 }  // namespace primlabel::client::tools

@@ -19,6 +19,7 @@
 #include "primlabel/build_version.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "unreadable_files.hpp"
 #include "uploader.hpp"
 
 using namespace primlabel::client;
@@ -34,6 +35,7 @@ constexpr int kExitInput = primlabel::kExitFailure;  // an input, the spool or t
 constexpr int kExitTimedOut = 3;
 constexpr int kExitRefused = 4;
 constexpr int kExitNotAccepted = 5;  // full spool, full disk or a failed spool write
+constexpr int kExitStopped = 6;      // files/stdin: a signal ended the run before every scan
 
 constexpr const char* kFooter =
     "Each scan is acknowledged on stdout as '<state> <id> <source> -> <output>' (state: "
@@ -47,7 +49,8 @@ constexpr const char* kFooter =
     "good, e.g. a --model it does not serve, or corrupt in the spool), 5 scans were not accepted: "
     "the spool was full, its disk "
     "short of --spool-min-free-mb, or the write failed (one line on stderr names the file and "
-    "the reason).";
+    "the reason), 6 a signal stopped a run of files or --stdin before every scan was labeled "
+    "(those spooled resume on the next run; one line on stderr says how many).";
 
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop = true; }
@@ -72,7 +75,9 @@ std::string read_file(const fs::path& path) {
 struct Intake {
   Uploader& uploader;
   bool remove_source = false;
+  bool quiet = false;
   int exit_code = kExitOk;
+  std::size_t files_not_read = 0;  // input files a signal left unread
 
   void raise(int code) { exit_code = std::max(exit_code, code); }
 
@@ -94,12 +99,18 @@ struct Intake {
     return true;
   }
 
-  // A file input; false when the spool could not take it (the file is left alone).
-  bool submit_file(const fs::path& path) {
+  // A file input; false when the spool could not take it (the file is left alone). When
+  // `unreadable` is given, a file that cannot be read or parsed is not an error yet: the reason
+  // goes there and the caller decides (a watched file may still be being written).
+  bool submit_file(const fs::path& path, std::string* unreadable = nullptr) {
     std::string bytes;
     try {
       bytes = read_file(path);
     } catch (const std::exception& e) {
+      if (unreadable) {
+        *unreadable = e.what();
+        return true;
+      }
       std::fprintf(stderr, "primlabel-upload: %s\n", e.what());
       raise(kExitInput);
       return true;
@@ -116,6 +127,10 @@ struct Intake {
     try {
       (void)primlabel::read_cloud(path.string());
     } catch (const std::exception& e) {
+      if (unreadable) {
+        *unreadable = e.what();
+        return true;
+      }
       std::fprintf(stderr, "primlabel-upload: %s: not spooled, unreadable: %s\n", path.c_str(),
                    e.what());
       raise(kExitInput);
@@ -130,9 +145,12 @@ struct Intake {
   }
 
   void from_files(const std::vector<std::string>& files) {
-    for (const auto& f : files) {
-      if (g_stop) return;
-      if (!submit_file(f)) raise(kExitNotAccepted);
+    for (std::size_t i = 0; i < files.size(); ++i) {
+      if (g_stop) {
+        files_not_read = files.size() - i;
+        return;
+      }
+      if (!submit_file(files[i])) raise(kExitNotAccepted);
     }
   }
 
@@ -157,17 +175,31 @@ struct Intake {
     }
   }
 
-  // Until a signal: files that do not fit wait in the watched directory and are retried.
+  // Until a signal: files that do not fit wait in the watched directory and are retried. A file
+  // that cannot be read or parsed may be one still being written (closed between writes): it is
+  // retried whenever it changes, and an error only if it is still unreadable when the run ends.
   void watch(const fs::path& dir) {
     DirectoryWatch watch(dir);
     std::vector<fs::path> deferred;
+    UnreadableFiles unreadable;
     auto offer = [&](const std::vector<fs::path>& files) {
-      for (const auto& f : files)
-        if (fs::exists(f) && !submit_file(f)) deferred.push_back(f);
+      for (const auto& f : files) {
+        if (!fs::exists(f)) continue;
+        std::string reason;
+        if (!submit_file(f, &reason)) deferred.push_back(f);
+        if (reason.empty()) {
+          unreadable.forget(f);
+        } else if (unreadable.note(f, reason) && !quiet) {
+          std::fprintf(stderr,
+                       "primlabel-upload: %s: unreadable for now, retried when it changes: %s\n",
+                       f.c_str(), reason.c_str());
+        }
+      }
     };
     offer(watch.existing());
     while (!g_stop) {
       offer(watch.next(std::chrono::milliseconds(500)));
+      offer(unreadable.changed());
       if (!deferred.empty() && uploader.queued() == 0) {
         std::vector<fs::path> again;
         again.swap(deferred);
@@ -175,6 +207,12 @@ struct Intake {
         again.erase(std::unique(again.begin(), again.end()), again.end());
         offer(again);
       }
+    }
+    offer(unreadable.changed());  // one last look: a writer may have finished meanwhile
+    for (const auto& [path, reason] : unreadable.remaining()) {
+      std::fprintf(stderr, "primlabel-upload: %s: not spooled, unreadable: %s\n", path.c_str(),
+                   reason.c_str());
+      raise(kExitInput);
     }
   }
 };
@@ -242,7 +280,7 @@ int main(int argc, char** argv) {
   app.add_flag("--descriptors", options.label.descriptors, "Keep the FPFH descriptors");
   app.add_flag("--probabilities", options.label.probabilities, "Keep the class probabilities");
   app.add_flag("--tabletop", options.label.tabletop_only, "Label only the table top");
-  add_units_flag(app, options.label.metres_per_unit);
+  tools::add_units_flag(app, options.label.metres_per_unit);
   app.add_flag("--every-point", options.label.every_point,
                "Describe and infer every point: no plane cascade (slower)");
   app.add_flag("-q,--quiet", quiet, "Only errors and the summary on stderr");
@@ -318,7 +356,7 @@ int main(int argc, char** argv) {
     }
   });
 
-  Intake intake{*uploader, remove_source};
+  Intake intake{*uploader, remove_source, quiet};
   // What is already spooled goes first: new input could fill the disk and strand it.
   if (resuming > 0 && !uploader->wait_idle(g_stop, deadline()) && !g_stop)
     std::fprintf(stderr,
@@ -346,6 +384,17 @@ int main(int argc, char** argv) {
   status.join();
   const UploadCounters counters = uploader->counters();
   if (counters.failed > 0 || counters.corrupt > 0) intake.raise(kExitRefused);
+  // Files and stdin promise every scan labeled on exit 0; a watch ends by signal anyway.
+  if (watch_dir.empty() && g_stop && (uploader->queued() > 0 || intake.files_not_read > 0)) {
+    std::string unread;
+    if (intake.files_not_read > 0)
+      unread = "; " + std::to_string(intake.files_not_read) + " input files were not read";
+    std::fprintf(stderr,
+                 "primlabel-upload: stopped by signal with %zu scans still spooled; they resume "
+                 "on the next run%s\n",
+                 uploader->queued(), unread.c_str());
+    intake.raise(kExitStopped);
+  }
   std::fprintf(stderr, "primlabel-upload: %s\n",
                summary_line(counters, uploader->queued()).c_str());
   return intake.exit_code;

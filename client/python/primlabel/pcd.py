@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import lzf
+from . import labeled, lzf
 
 _IDENTITY_VIEWPOINT = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
 _SINGLE_VALUE = ("x", "y", "z", "normal_x", "normal_y", "normal_z", "curvature", "label", "rgb",
@@ -50,6 +50,9 @@ class PointCloud:
     width: int | None = None  # points per row; None = one row of all points
     height: int = 1  # rows; > 1 means organised (e.g. a 640x480 depth frame)
     viewpoint: tuple = _IDENTITY_VIEWPOINT  # tx ty tz qw qx qy qz, as the VIEWPOINT line
+    # A labeled file's classes, label id -> name (primlabel.labeled: its header's `classes` tag
+    # or the .classes.json beside it); None when it says nothing. Not written by write().
+    classes: dict | None = None
 
     def __len__(self) -> int:
         return len(self.xyz)
@@ -373,6 +376,7 @@ def read(path: str) -> PointCloud:
         if _is_scalar_copy(name, kinds):
             continue
         cloud.fields[name] = values[:, 0] if kinds[name].count == 1 else values
+    cloud.classes = labeled.classes(path, raw)
     return cloud
 
 

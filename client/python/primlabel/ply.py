@@ -22,6 +22,7 @@ import re
 
 import numpy as np
 
+from . import labeled
 from .pcd import PointCloud, ascii_values, checked_labels
 
 _TYPES = {
@@ -375,4 +376,5 @@ def read(path) -> PointCloud:
         else:
             cloud.fields[name] = by_name[name]
         i += run
+    cloud.classes = labeled.classes(path, raw, ply=True)
     return cloud

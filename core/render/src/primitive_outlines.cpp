@@ -20,7 +20,9 @@ struct Outliner {
   bool usable(double size) const { return std::isfinite(size) && size >= options.min_extent; }
 
   void polyline(std::vector<Vec3d> points, bool closed) {
-    Overlay overlay{{}, rgb, closed};
+    Overlay overlay;
+    overlay.rgb = rgb;
+    overlay.closed = closed;
     overlay.points.reserve(points.size());
     for (const Vec3d& p : points) overlay.points.push_back(p.cast<float>());
     out.push_back(std::move(overlay));

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include "primlabel/render/raster.hpp"
@@ -40,16 +41,48 @@ Vec3f any_perpendicular(const Vec3f& v) {
   return (trial - trial.dot(v) * v).normalized();
 }
 
+// A pinhole at `eye` with the optical axes of `orientation` (sensor frames have y down).
+Camera pinhole(const Vec3f& eye, const Eigen::Quaternionf& orientation) {
+  const Eigen::Matrix3f r = orientation.normalized().toRotationMatrix();
+  Camera camera;
+  camera.perspective = true;
+  camera.eye = eye;
+  camera.forward = r.col(2);
+  camera.right = r.col(0);
+  camera.up = -r.col(1);
+  return camera;
+}
+
+// Finite points (a sample of at most ~20000) that `camera` sees in front of it.
+std::size_t points_in_front(const PointCloud& cloud, const Camera& camera) {
+  const std::size_t stride = std::max<std::size_t>(1, cloud.size() / 20000);
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < cloud.size(); i += stride) {
+    float x, y, depth;
+    n += is_finite(cloud.xyz[i]) && camera.project(cloud.xyz[i], x, y, depth);
+  }
+  return n;
+}
+
+// The sensor's view. VIEWPOINT is the sensor's pose in the cloud's frame (PCL's meaning), but
+// many camera frames keep their points in the optical frame and store a mounting rotation there
+// (PCL's office1.pcd): through that pose every point is behind the pinhole and the picture would
+// be blank. So the pose that sees more points wins, the VIEWPOINT's or the optical frame's own;
+// nothing if neither sees any.
+std::optional<Camera> sensor_camera(const PointCloud& cloud) {
+  const Camera stated = pinhole(cloud.viewpoint.origin, cloud.viewpoint.orientation);
+  const Camera optical = pinhole(Vec3f::Zero(), Eigen::Quaternionf::Identity());
+  const std::size_t seen_stated = points_in_front(cloud, stated);
+  const std::size_t seen_optical = points_in_front(cloud, optical);
+  if (seen_stated == 0 && seen_optical == 0) return std::nullopt;
+  return seen_optical > seen_stated ? optical : stated;
+}
+
 Camera make_camera(const PointCloud& cloud, const RenderOptions& options) {
   Camera camera;
   if (options.view == RenderView::kSensor) {
-    const Eigen::Matrix3f r = cloud.viewpoint.orientation.normalized().toRotationMatrix();
-    camera.perspective = true;
-    camera.eye = cloud.viewpoint.origin;
-    camera.forward = r.col(2);
-    camera.right = r.col(0);
-    camera.up = -r.col(1);  // sensor frames have y down
-    return camera;
+    if (const std::optional<Camera> sensor = sensor_camera(cloud)) return *sensor;
+    // No pose sees a point: the oblique view rather than an empty picture.
   }
   const Vec3f up = options.up.norm() > 0 ? options.up.normalized() : Vec3f::UnitZ();
   // Look the way the sensor looked (horizontally), so "oblique" resembles the scan.
@@ -94,9 +127,18 @@ std::uint32_t scale_color(std::uint32_t c, float f) {
 // reaching behind it rather than wrapping them around).
 template <class ToPixel>
 void draw_overlays(Raster& image, const Camera& camera, const std::vector<Overlay>& overlays,
-                   const ToPixel& to_pixel) {
+                   const ToPixel& to_pixel, int text_scale) {
   const int thickness = image.width() >= 600 ? 3 : 2;
   for (const Overlay& overlay : overlays) {
+    float lx, ly, ld;
+    if (!overlay.label.empty() && !overlay.points.empty() && is_finite(overlay.points.front()) &&
+        camera.project(overlay.points.front(), lx, ly, ld)) {
+      float px, py;
+      to_pixel(lx, ly, px, py);
+      image.text(int(std::lround(px)) + 2 * text_scale,
+                 int(std::lround(py)) - Raster::text_height(text_scale) - 2 * text_scale,
+                 overlay.label, overlay.rgb & 0xFFFFFF, text_scale);
+    }
     const std::size_t n = overlay.points.size();
     const std::size_t segments = overlay.closed && n > 2 ? n : (n ? n - 1 : 0);
     for (std::size_t s = 0; s < segments; ++s) {
@@ -236,7 +278,7 @@ void render_png(const PointCloud& cloud, const std::vector<std::uint32_t>& point
         if (n) shade *= std::max(0.35f, std::exp(-0.25f * std::max(0.0f, zbuffer[at] - sum / n)));
         pixels[at] = scale_color(color[at], shade);
       }
-    draw_overlays(image, camera, options.overlays, to_pixel);
+    draw_overlays(image, camera, options.overlays, to_pixel, text_scale);
   }
 
   if (!options.title.empty()) image.text(margin, margin, options.title, 0x202020, text_scale);

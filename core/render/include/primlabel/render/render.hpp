@@ -27,6 +27,7 @@ struct Overlay {
   std::vector<Vec3f> points;
   std::uint32_t rgb = 0x000000;  // 0xRRGGBB
   bool closed = false;           // also join the last point to the first
+  std::string label;             // drawn beside the first point, e.g. an object's id
 };
 
 struct RenderOptions {
