@@ -98,11 +98,12 @@ build() {
 # tabletop-lms400: trained and served on 3 mm voxels (1.8x faster than full resolution: a scan's
 #   ~500 points within 25 mm made every FPFH pass expensive), normals over 15 mm, FPFH over 30 mm
 #   and class balance 0.25 (rare classes such as corners weigh more), each scene also scanned once
-#   more with other noise, density, range and incidence (seeded by the scene). Held out
-#   (tools/robustness_sweep.sh, 2026-12-05): 98.21% at 1x noise, 97.30% at 4x, 97.28% at 25%
-#   density, corner recall 0.55 / 0.67 / 0.51 (full resolution: 98.42%, 97.26%, 97.39%, corners
-#   0.58 / 0.67 / 0.55; 4 mm voxels lost 0.36 points at 1x and corners at low density). About
-#   45 s and 0.78 GB peak.
+#   more with other noise, density, range and incidence (seeded by the scene), and shape evidence
+#   (the table-top objects fitted with boxes and cylinders as model input). Held out
+#   (tools/robustness_sweep.sh, 2026-12-06): 98.61% at 1x noise, 97.91% at 4x, 97.72% at 25%
+#   density, corner recall 0.91 / 0.74 / 0.85 (without shape evidence 98.21%, 97.30%, 97.28%,
+#   corners 0.55 / 0.67 / 0.51), for about 1.8x the time of a scan (307 -> 541 ms on 2 loaded
+#   cores). About 2.5 min and 0.8 GB peak.
 # tabletop-kinect: trained and served on 7 mm voxels (the model records the size and the server
 #   applies it: a real 640x480 frame labels in 75-86 ms in process with the plane cascade, 157-185
 #   at 5 mm, for 0.10 points of accuracy and 0.8 of object points in scene-level cross-validation,
@@ -116,7 +117,7 @@ build() {
 #   ../shared/data/mosd, so every machine gets the committed deploy/models/tabletop-kinect.plm
 #   (checked against its .sha256); `deploy/setup.sh kinect-model OUT` retrains it. docs/models.md "The default models" has its figures, time and memory.
 LMS400_RECIPE=(--sensor lms400 --voxel-size 0.003 --normal-radius 0.015 --feature-radius 0.03
-  --class-balance 0.25 --augment "$DEFAULT_AUGMENT")
+  --class-balance 0.25 --augment "$DEFAULT_AUGMENT" --shape-evidence)
 KINECT_RECIPE=(--sensor kinect --voxel-size 0.007 --normal-radius 0.03 --class-balance 0.25
   --extra-radii 0.015,0.04 --surface-variation --synth-train 8)
 MOSD_DIR=${MOSD_DIR:-$ROOT/../shared/data/mosd}
@@ -184,7 +185,7 @@ kinect_model() {
 
 # What the default models are made from; a repository made by another recipe (or before the
 # models recorded their domain, which routes requests that name no model) is retrained.
-RECIPE_STAMP="domain-1 lms400: ${LMS400_RECIPE[*]} kinect: mosd learn0-44 ${KINECT_RECIPE[*]}"
+RECIPE_STAMP="domain-2 lms400: ${LMS400_RECIPE[*]} kinect: mosd learn0-44 ${KINECT_RECIPE[*]}"
 
 default_models() {
   local repo=${1:-$BUILD_DIR/models}

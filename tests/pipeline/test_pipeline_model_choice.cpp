@@ -261,9 +261,6 @@ TEST(ModelChoice, TheNoiseGrowthSeparatesSensorsWhoseSpacingAndNoiseOverlap) {
   EXPECT_EQ(judge_signature(cam, CloudSignature{0.002f, 0.002f, 1.05f}).fit, DomainFit::kOutside);
 }
 
-}  // namespace
-}  // namespace primlabel::pipeline
-
 // The receding table as a depth camera in its own frame (z ahead) sees it: depths quantised to
 // disparity steps of z^2 / 345 m (a Kinect's 1/8 pixel), or to whole millimetres (OpenNI).
 std::vector<Vec3f> quantised_table(bool whole_millimetres) {
@@ -320,3 +317,6 @@ TEST(ModelChoice, QuantisedDepthRulesOutAModelTrainedWithoutIt) {
     EXPECT_EQ(judge_signature(laser, plain).fit, DomainFit::kFits);
   }
 }
+
+}  // namespace
+}  // namespace primlabel::pipeline
