@@ -278,7 +278,7 @@ TEST(CloudSignature, DepthTiesTellQuantisedDepthAndNeedASlantedSurface) {
   for (bool millimetres : {false, true}) {
     SCOPED_TRACE(millimetres);
     const CloudSignature camera = measure_signature(quantised_table(millimetres), Vec3f::Zero());
-    EXPECT_GT(camera.depth_ties, 2 * kQuantisedDepthTies);
+    EXPECT_GT(camera.depth_ties, kQuantisedDepthTies);
   }
   // The same table, continuous depths (a laser scanner, a simulator without quantisation).
   std::vector<Vec3f> continuous;
@@ -308,7 +308,9 @@ TEST(ModelChoice, QuantisedDepthRulesOutAModelTrainedWithoutIt) {
   chooser.consider(crop);
   EXPECT_EQ(chooser.choice().model, "cam");
   EXPECT_EQ(chooser.choice().reason, ChoiceReason::kDomain);
-  EXPECT_NE(chooser.choice().why.find("depth ties"), std::string::npos) << chooser.choice().why;
+  const DomainVerdict laser_verdict = judge_signature(laser, crop);
+  EXPECT_EQ(laser_verdict.fit, DomainFit::kOutside);
+  EXPECT_NE(laser_verdict.why.find("depth ties 0.45"), std::string::npos) << laser_verdict.why;
   // No ties (a frame turned into base_link, or not measurable) say nothing against the camera.
   for (const float ties : {0.0f, std::nanf("")}) {
     CloudSignature plain{0.002f, 0.002f};
