@@ -86,7 +86,9 @@ TEST(ModelChoice, SeveralOrNoneFittingFallBackToTheDefault) {
   EXPECT_EQ(none.choice().model, "cam");
   EXPECT_EQ(none.choice().reason, ChoiceReason::kDefault);
   EXPECT_NE(none.choice().why.find("no model fits"), std::string::npos) << none.choice().why;
-  EXPECT_NE(none.choice().why.find("spacing 50.00 mm"), std::string::npos) << none.choice().why;
+  // The spacing as acquired, named so: the domain warning speaks of the spacing as described.
+  EXPECT_NE(none.choice().why.find("acquired spacing 50.00 mm"), std::string::npos)
+      << none.choice().why;
 }
 
 TEST(ModelChoice, WithoutADefaultTheRefusalNamesTheCandidates) {

@@ -189,5 +189,29 @@ TEST(TabletopObjects, JsonRoundTrips) {
   EXPECT_THROW(parse_objects_json("not json"), std::invalid_argument);
 }
 
+// The stage orders its clusters by voxels; the answer counts input points, and a near object's
+// voxel holds more of them. Objects come largest first by those points, ids renumbered to match.
+TEST(TabletopObjects, ObjectsAreLargestFirstByTheirPointsAndIdsFollow) {
+  TabletopObjects objects;
+  objects.table = TabletopTable{};
+  objects.table->plane = Eigen::Vector4f(0, 0, 1, 0);
+  objects.objects.resize(3);
+  for (std::uint32_t k = 0; k < 3; ++k) objects.objects[k].id = k + 1;
+  // Object 1 (the stage's largest by voxels) has 2 points, object 2 has 5, object 3 has 2.
+  objects.point_object = {1, 2, 2, kTableObject, 2, 3, 2, 1, kNoObject, 2, 3};
+  std::vector<Vec3f> xyz;
+  for (std::size_t i = 0; i < objects.point_object.size(); ++i) xyz.emplace_back(float(i), 0, 0.1f);
+  describe_objects(xyz, objects);
+  ASSERT_EQ(objects.objects.size(), 3u);
+  EXPECT_EQ(objects.objects[0].points, 5u);
+  EXPECT_EQ(objects.objects[1].points, 2u);
+  EXPECT_EQ(objects.objects[2].points, 2u);
+  for (std::uint32_t k = 0; k < 3; ++k) EXPECT_EQ(objects.objects[k].id, k + 1);
+  // Ties keep their order: the old object 1 before the old object 3.
+  EXPECT_EQ(objects.point_object,
+            (std::vector<std::uint32_t>{2, 1, 1, kTableObject, 1, 3, 1, 2, kNoObject, 1, 3}));
+  EXPECT_DOUBLE_EQ(objects.objects[0].centroid.x(), (1 + 2 + 4 + 6 + 9) / 5.0);
+}
+
 }  // namespace
 }  // namespace primlabel::tabletop

@@ -75,7 +75,7 @@ DomainVerdict judge_signature(const TrainingSummary& training, const CloudSignat
   check(
       spacing_known,
       within(signature.point_spacing, training.acquired_spacing_min, training.acquired_spacing_max),
-      "spacing " + millimetres(signature.point_spacing) + " mm",
+      "acquired spacing " + millimetres(signature.point_spacing) + " mm",
       millimetres(training.acquired_spacing_min) + "-" +
           millimetres(training.acquired_spacing_max) + " mm");
   check(roughness_known,
@@ -172,7 +172,7 @@ void ModelChooser::consider(const CloudSignature& signature) {
                           "the only model that fits: " + fits_why};
     return;
   }
-  const std::string measured = "spacing " + millimetres(signature.point_spacing) +
+  const std::string measured = "acquired spacing " + millimetres(signature.point_spacing) +
                                " mm, roughness " + millimetres(signature.roughness) +
                                " mm, noise growth " + decimal(signature.noise_growth);
   const std::string what = fitting.empty() ? "no model fits the cloud (" + measured + ")"

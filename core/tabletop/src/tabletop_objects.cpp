@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 namespace primlabel::tabletop {
@@ -68,6 +69,24 @@ void describe_objects(const std::vector<Vec3f>& xyz, TabletopObjects& objects) {
     }
     object.centroid = sums[k] / double(object.points);
   }
+  // Largest first by the points counted here: the stage ordered its clusters by voxels, and a
+  // voxel of a near object holds more points than one of a far object.
+  std::vector<std::uint32_t> order(count);
+  std::iota(order.begin(), order.end(), 0u);
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return objects.objects[a].points > objects.objects[b].points;
+  });
+  std::vector<std::uint32_t> new_id(count + 1, 0);
+  std::vector<TabletopObject> sorted;
+  sorted.reserve(count);
+  for (std::uint32_t rank = 0; rank < count; ++rank) {
+    new_id[order[rank] + 1] = rank + 1;
+    sorted.push_back(std::move(objects.objects[order[rank]]));
+    sorted.back().id = rank + 1;
+  }
+  objects.objects = std::move(sorted);
+  for (std::uint32_t& id : objects.point_object)
+    if (id != kNoObject && id != kTableObject) id = new_id[id];
 }
 
 void assign_primitives(std::span<const std::uint32_t> point_segment,

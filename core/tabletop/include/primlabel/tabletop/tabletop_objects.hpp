@@ -50,8 +50,9 @@ struct TabletopObjects {
 TabletopObjects object_ids(const TabletopResult& result, std::size_t num_points);
 
 // Fills the table's point count and every object from `objects.point_object` and the points'
-// coordinates (one per id). Objects keep the order of their ids; an id without points still
-// gets its (empty) object, so ids and indices agree.
+// coordinates (one per id), then renumbers the objects largest first by those points (ties keep
+// their order), in `point_object` too; an id without points still gets its (empty) object, last,
+// so ids and indices agree.
 void describe_objects(const std::vector<Vec3f>& xyz, TabletopObjects& objects);
 
 // Gives the table and every object the ids of the primitive segments more than half of whose
