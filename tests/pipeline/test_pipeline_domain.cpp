@@ -5,6 +5,8 @@
 
 #include "primlabel/geometry/point_spacing.hpp"
 #include "primlabel/pipeline/domain.hpp"
+#include "primlabel/pipeline/labeling.hpp"
+#include "random_label_model.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -96,6 +98,24 @@ TEST(UnitsHint, NamesMillimetresAndCentimetresOnlyWhenScalingFitsTheModel) {
   EXPECT_EQ(pipeline::units_hint(kinect, far_scan), "");
   // Nothing recorded, nothing to say.
   EXPECT_EQ(pipeline::units_hint(TrainingSummary{}, frame_in_units(1000.0f)), "");
+}
+
+// Through label_cloud: a Kinect model given a frame in millimetres labels nothing, counts every
+// point isolated, and its warning opens with how to fix it. In metres: neither.
+TEST(UnitsHint, LabelCloudSaysWhenEveryPointIsLostToTheUnits) {
+  LabelModel model = testing::random_label_model();
+  model.features.voxel_size = 0.007f;
+  model.training.point_spacing_min = 0.0042f, model.training.point_spacing_max = 0.005f;
+  model.training.acquired_spacing_min = 0.00135f, model.training.acquired_spacing_max = 0.00203f;
+  PointCloud millimetres = frame_in_units(1000.0f);
+  const pipeline::LabelingResult lost = pipeline::label_cloud(model, millimetres);
+  EXPECT_EQ(lost.isolated_points, millimetres.size());
+  EXPECT_EQ(lost.domain_warning.rfind("the cloud looks like millimetres", 0), 0u)
+      << lost.domain_warning;
+  PointCloud metres = frame_in_units(1.0f);
+  const pipeline::LabelingResult fine = pipeline::label_cloud(model, metres);
+  EXPECT_EQ(fine.isolated_points, 0u);
+  EXPECT_EQ(fine.domain_warning.find("looks like"), std::string::npos) << fine.domain_warning;
 }
 
 TEST(SurfaceVariation, IsTheMedianOfTheFiniteValues) {
