@@ -118,21 +118,12 @@ std::vector<Overlay> object_boxes_from(const std::string& path) {
   } catch (const std::invalid_argument& e) {
     throw RunError(path + ": " + e.what());
   }
-  std::vector<Overlay> out;
-  if (objects.table && objects.table->hull.size() >= 2) {
-    Overlay hull;
-    hull.points = objects.table->hull;
-    hull.rgb = 0x808080;
-    hull.closed = true;
-    out.push_back(std::move(hull));
-  }
-  for (const tabletop::TabletopObject& o : objects.objects) {
-    if (o.points == 0) continue;
-    for (Overlay& edge : box_outline(o.bounds_min.cast<float>(), o.bounds_max.cast<float>(),
-                                     0x000000, "object " + std::to_string(o.id)))
-      out.push_back(std::move(edge));
-  }
-  return out;
+  std::vector<LabeledBox> boxes;
+  for (const tabletop::TabletopObject& o : objects.objects)
+    if (o.points > 0)
+      boxes.push_back({o.bounds_min.cast<float>(), o.bounds_max.cast<float>(),
+                       "object " + std::to_string(o.id)});
+  return table_top_outlines(objects.table ? objects.table->hull : std::vector<Vec3f>{}, boxes);
 }
 
 int run(const Arguments& args) {

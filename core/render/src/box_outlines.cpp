@@ -25,4 +25,20 @@ std::vector<Overlay> box_outline(const Vec3f& low, const Vec3f& high, std::uint3
   return out;
 }
 
+std::vector<Overlay> table_top_outlines(const std::vector<Vec3f>& hull,
+                                        const std::vector<LabeledBox>& boxes) {
+  std::vector<Overlay> out;
+  if (hull.size() >= 2) {
+    Overlay outline;
+    outline.points = hull;
+    outline.rgb = 0x808080;
+    outline.closed = true;
+    out.push_back(std::move(outline));
+  }
+  for (const LabeledBox& box : boxes)
+    for (Overlay& edge : box_outline(box.low, box.high, 0x000000, box.label))
+      out.push_back(std::move(edge));
+  return out;
+}
+
 }  // namespace primlabel

@@ -15,4 +15,13 @@ namespace primlabel {
 std::vector<Overlay> box_outline(const Vec3f& low, const Vec3f& high, std::uint32_t rgb,
                                  const std::string& label = {});
 
+// A table top as the label picture shows it: the table's hull (when it has 2 points or more) in
+// grey, each box in black with its label.
+struct LabeledBox {
+  Vec3f low, high;
+  std::string label;
+};
+std::vector<Overlay> table_top_outlines(const std::vector<Vec3f>& hull,
+                                        const std::vector<LabeledBox>& boxes);
+
 }  // namespace primlabel
