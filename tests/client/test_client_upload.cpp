@@ -638,6 +638,28 @@ TEST(UploadCli, AnUnreadableInputFileExitsOneWithOneLineAndIsNotSpooled) {
   EXPECT_EQ(files_in(dir.file("spool/failed")), 0u);
 }
 
+// A cloud with no finite point has nothing to label: the same input error, saying why.
+TEST(UploadCli, ACloudWithNoFinitePointExitsOneAndIsNotSpooled) {
+  FakeServer server;
+  test::TempDir dir;
+  PointCloud blind;
+  blind.resize_unorganized(40);
+  for (Vec3f& p : blind.xyz) p = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  write_cloud(dir.file("blind.pcd"), blind);
+  write_bytes(dir.file("good.pcd"), scan_bytes(63));
+  const auto r =
+      test::run_command("( " + upload_tool() + " -q --server " + server.address() + " --spool " +
+                        dir.file("spool") + " -o " + dir.file("out") + " " + dir.file("blind.pcd") +
+                        " " + dir.file("good.pcd") + " >/dev/null )");
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("blind.pcd: not spooled, unreadable: no point has finite coordinates "
+                          "(40 points)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(server.service.label_calls, 1);  // the good file only
+  EXPECT_EQ(clouds_in(dir.file("out")), 1u);
+}
+
 TEST(UploadCli, TheServerComesFromPrimlabelServerWhenNoFlagGivesIt) {
   FakeServer server;
   test::TempDir dir;

@@ -5,6 +5,7 @@
 #include <signal.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <fstream>
@@ -124,15 +125,24 @@ struct Intake {
     }
     // A file that does not parse is the caller's input error (exit 1), found here before it is
     // spooled, not a scan the server refused (exit 4) once the upload parses it.
+    // So is a cloud with no finite point (a covered lens): nothing in it can be labeled.
+    std::string why;
     try {
-      (void)primlabel::read_cloud(path.string());
+      const primlabel::PointCloud cloud = primlabel::read_cloud(path.string());
+      if (std::none_of(cloud.xyz.begin(), cloud.xyz.end(),
+                       [](const primlabel::Vec3f& p) { return primlabel::is_finite(p); }))
+        why = "no point has finite coordinates (" + std::to_string(cloud.size()) +
+              " points): nothing to label";
     } catch (const std::exception& e) {
+      why = e.what();
+    }
+    if (!why.empty()) {
       if (unreadable) {
-        *unreadable = e.what();
+        *unreadable = why;
         return true;
       }
       std::fprintf(stderr, "primlabel-upload: %s: not spooled, unreadable: %s\n", path.c_str(),
-                   e.what());
+                   why.c_str());
       raise(kExitInput);
       return true;
     }
