@@ -269,8 +269,8 @@ std::vector<Vec3f> quantised_table(bool whole_millimetres) {
   std::vector<Vec3f> points;
   for (const Vec3f& p : receding_table(0.0008f, 2.0f, 8)) {
     const float z = p.y();  // the camera looks along y here: its depth axis becomes z
-    const double level = whole_millimetres ? std::round(z * 1000.0) / 1000.0
-                                           : 345.0 / std::round(345.0 / z);
+    const double level =
+        whole_millimetres ? std::round(z * 1000.0) / 1000.0 : 345.0 / std::round(345.0 / z);
     points.emplace_back(p.x(), p.z(), float(level));
   }
   return points;
@@ -284,7 +284,8 @@ TEST(CloudSignature, DepthTiesTellQuantisedDepthAndNeedASlantedSurface) {
   }
   // The same table, continuous depths (a laser scanner, a simulator without quantisation).
   std::vector<Vec3f> continuous;
-  for (const Vec3f& p : receding_table(0.0008f, 0.0f, 9)) continuous.emplace_back(p.x(), p.z(), p.y());
+  for (const Vec3f& p : receding_table(0.0008f, 0.0f, 9))
+    continuous.emplace_back(p.x(), p.z(), p.y());
   EXPECT_LT(measure_signature(continuous, Vec3f::Zero()).depth_ties, kQuantisedDepthTies / 4);
   // Every coordinate rounded to millimetres for storage (a text file with three decimals): the
   // ties are the file's, not the sensor's: no verdict.
@@ -293,7 +294,8 @@ TEST(CloudSignature, DepthTiesTellQuantisedDepthAndNeedASlantedSurface) {
     for (int axis = 0; axis < 3; ++axis) p[axis] = std::round(p[axis] * 1000.0f) / 1000.0f;
   EXPECT_TRUE(std::isnan(measure_signature(rounded, Vec3f::Zero()).depth_ties));
   // A noise-free plane at one z ties everywhere, but it is not slanted: no verdict.
-  EXPECT_TRUE(std::isnan(measure_signature(noisy_plane(0.002f, 0.0f, 10), Vec3f::Zero()).depth_ties));
+  EXPECT_TRUE(
+      std::isnan(measure_signature(noisy_plane(0.002f, 0.0f, 10), Vec3f::Zero()).depth_ties));
 }
 
 TEST(ModelChoice, QuantisedDepthRulesOutAModelTrainedWithoutIt) {

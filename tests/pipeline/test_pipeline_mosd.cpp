@@ -130,7 +130,7 @@ TEST(PipelineMosd, ACropOfARealFrameShowsItsQuantisedDepth) {
   ASSERT_GT(crop.size(), 10000u);
   const CloudSignature whole = measure_signature(frame.xyz, frame.viewpoint.origin);
   const CloudSignature cropped = measure_signature(crop, frame.viewpoint.origin);
-  EXPECT_GT(whole.depth_ties, 0.4f);  // 2026-12-06: 0.54 (learn20, 36: 0.55)
+  EXPECT_GT(whole.depth_ties, 0.4f);    // 2026-12-06: 0.54 (learn20, 36: 0.55)
   EXPECT_GT(cropped.depth_ties, 0.4f);  // 0.46
   EXPECT_TRUE(std::isnan(cropped.noise_growth));
 }

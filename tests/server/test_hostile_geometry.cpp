@@ -1,7 +1,7 @@
 // Hostile geometry against a real server on 127.0.0.1: far points (1e6 up to FLT_MAX) mixed with
-// a normal scan, with and without voxels, 100k coincident points, 20k points packed into a 1 mm cube. Each request ends
-// with a clear status in bounded time and memory, and the server goes on serving the next
-// legitimate client with the same labels as before.
+// a normal scan, with and without voxels, 100k coincident points, 20k points packed into a 1 mm
+// cube. Each request ends with a clear status in bounded time and memory, and the server goes on
+// serving the next legitimate client with the same labels as before.
 
 #include <cfloat>
 #include <fstream>

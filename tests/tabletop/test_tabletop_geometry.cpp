@@ -91,7 +91,7 @@ TEST(TabletopVoxelGrid, ATinyLeafOrAHugeCubeNeedsNoMoreThanOneVoxelAPoint) {
   std::mt19937 rng(12);
   std::vector<Vec3f> points;
   add_blob(points, Vec3f::Zero(), 5e5f, 100000, rng);  // 100k points in a 1e6 m cube
-  points.push_back(points[7]);                          // an exact copy shares its voxel
+  points.push_back(points[7]);                         // an exact copy shares its voxel
   std::vector<std::uint32_t> shuffled = all_indices(points.size());
   std::shuffle(shuffled.begin(), shuffled.end(), rng);
   for (const float leaf : {1e-30f, 0.003f}) {

@@ -19,7 +19,8 @@ constexpr const char* kUsage =
     "(points), publishes ~output_topic (points_labeled, the input's fields plus uint32 label) and\n"
     "~summary_topic (points_labeled_summary, std_msgs/String JSON).\n"
     "Parameters: server model model_version token token_file tls tls_ca tls_cert tls_key\n"
-    "tls_server_name deadline retries voxel_size units every_point viewpoint tabletop_only confidence\n"
+    "tls_server_name deadline retries voxel_size units every_point viewpoint tabletop_only "
+    "confidence\n"
     "probabilities objects primitives\n"
     "input_topic output_topic summary_topic (client/ros/README.md).\n";
 

@@ -71,14 +71,14 @@ struct LabelOptions {
   bool every_point = false;
   float normal_radius = 0;
   float feature_radius = 0;
-  bool reject_non_finite = false;     // NaN/Inf points fail the call instead of being labeled 0
-  bool send_normals = false;          // send the cloud's normals (the server then skips estimation)
-  std::optional<Vec3f> viewpoint;     // default: the cloud's viewpoint origin
+  bool reject_non_finite = false;  // NaN/Inf points fail the call instead of being labeled 0
+  bool send_normals = false;       // send the cloud's normals (the server then skips estimation)
+  std::optional<Vec3f> viewpoint;  // default: the cloud's viewpoint origin
   // The cloud's unit in metres: 0.001 when its coordinates are millimetres, 0.01 centimetres.
   // Points and viewpoint are scaled on the way out (the cloud itself is untouched); what comes
   // back in coordinates (primitives, objects) is in metres. Must be finite and > 0.
   float metres_per_unit = 1.0f;
-  std::size_t chunk_points = 65'536;  // points per streamed request message
+  std::size_t chunk_points = 65'536;                  // points per streamed request message
   std::uint32_t response_chunk_points = 0;            // 0 = the server's default
   std::optional<std::chrono::milliseconds> deadline;  // default: ClientOptions::deadline
 

@@ -51,8 +51,9 @@ struct NodeParameters {
 
 // Checks `parameters` once read and writes the server address with its port. Throws
 // std::invalid_argument naming the parameter (as `prefix` + name: "~voxel_size" for ROS 1's
-// private parameters): a negative or non-finite voxel size, units other than m, cm and mm, a deadline <= 0, retries < 1, an
-// empty topic, a malformed server address, objects without tabletop_only.
+// private parameters): a negative or non-finite voxel size, units other than m, cm and mm, a
+// deadline <= 0, retries < 1, an empty topic, a malformed server address, objects without
+// tabletop_only.
 void check_parameters(NodeParameters& parameters, const std::string& prefix);
 
 // The connection: address, deadline, retries, TLS and the bearer token (read from token_file or

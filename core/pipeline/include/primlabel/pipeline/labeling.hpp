@@ -131,9 +131,9 @@ struct LabelingResult {
   // radii of them (a far outlier, a lonely return): they could not be described. Points the
   // table-top stage leaves out are not counted.
   std::size_t isolated_points = 0;
-  StageSeconds seconds;              // where the time went, stage by stage
-  float point_spacing = 0;           // median point spacing of the described cloud (m)
-  float surface_variation = 0;       // median surface variation of its computed normals
+  StageSeconds seconds;         // where the time went, stage by stage
+  float point_spacing = 0;      // median point spacing of the described cloud (m)
+  float surface_variation = 0;  // median surface variation of its computed normals
   // Not empty when point_spacing is far outside what the model was trained for (domain.hpp):
   // the labels are then unreliable, and the caller should be told so.
   std::string domain_warning;

@@ -28,8 +28,9 @@ struct VoxelGrid {
 // ordered by their integer coordinates (z, then y, then x), so the output does not depend on the
 // order of `indices`. Cells count from the cloud's lowest corner while the extent fits 2^21 of
 // them an axis; beyond (a far outlier, a tiny leaf) from the origin, so a far point is a voxel of
-// its own and cannot coarsen the scan's. Throws std::invalid_argument when leaf is not positive and finite, and Cancelled when
-// context.stop is requested (checked every 64k points and between the sort's runs and merges).
+// its own and cannot coarsen the scan's. Throws std::invalid_argument when leaf is not positive and
+// finite, and Cancelled when context.stop is requested (checked every 64k points and between the
+// sort's runs and merges).
 VoxelGrid voxel_downsample(const std::vector<Vec3f>& points,
                            const std::vector<std::uint32_t>& indices, float leaf,
                            const RunContext& context = {});
