@@ -575,10 +575,7 @@ TEST(ClientCli, MissingOrBrokenInputExitsOne) {
 TEST(ClientCli, ACloudWithNoFinitePointExitsOneSayingSo) {
   FakeServer server;
   test::TempDir dir;
-  PointCloud blind;
-  blind.resize_unorganized(50);
-  for (Vec3f& p : blind.xyz) p = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
-  write_cloud(dir.file("blind.pcd"), blind);
+  write_cloud(dir.file("blind.pcd"), test::nan_cloud(50));
   write_scan(dir.file("scan.pcd"));
   const auto r = test::run_command(cli() + " --server " + server.address() + " label " +
                                    dir.file("blind.pcd") + " " + dir.file("scan.pcd") + " -o " +

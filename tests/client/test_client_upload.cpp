@@ -642,10 +642,7 @@ TEST(UploadCli, AnUnreadableInputFileExitsOneWithOneLineAndIsNotSpooled) {
 TEST(UploadCli, ACloudWithNoFinitePointExitsOneAndIsNotSpooled) {
   FakeServer server;
   test::TempDir dir;
-  PointCloud blind;
-  blind.resize_unorganized(40);
-  for (Vec3f& p : blind.xyz) p = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
-  write_cloud(dir.file("blind.pcd"), blind);
+  write_cloud(dir.file("blind.pcd"), test::nan_cloud(40));
   write_bytes(dir.file("good.pcd"), scan_bytes(63));
   const auto r =
       test::run_command("( " + upload_tool() + " -q --server " + server.address() + " --spool " +

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
@@ -98,6 +99,14 @@ class TempDir {
  private:
   std::filesystem::path path_;
 };
+
+// `n` points none of which has finite coordinates (a depth frame with its lens covered).
+inline PointCloud nan_cloud(std::size_t n) {
+  PointCloud cloud;
+  cloud.resize_unorganized(n);
+  for (Vec3f& p : cloud.xyz) p = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+  return cloud;
+}
 
 // Points on z = a x + b y over [-extent, extent]^2 at the given spacing.
 inline PointCloud plane_grid(float a, float b, float extent, float spacing) {

@@ -137,8 +137,7 @@ int run_label(Client& client, LabelCommand command) {
       if (exit_code == kExitOk) exit_code = kExitFile;
       continue;
     }
-    if (std::none_of(cloud.xyz.begin(), cloud.xyz.end(),
-                     [](const Vec3f& p) { return is_finite(p); })) {
+    if (count_finite(cloud) == 0) {
       std::fprintf(stderr,
                    "primlabel: %s: no point has finite coordinates (%zu points): nothing "
                    "to label\n",

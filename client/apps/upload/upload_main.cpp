@@ -129,8 +129,7 @@ struct Intake {
     std::string why;
     try {
       const primlabel::PointCloud cloud = primlabel::read_cloud(path.string());
-      if (std::none_of(cloud.xyz.begin(), cloud.xyz.end(),
-                       [](const primlabel::Vec3f& p) { return primlabel::is_finite(p); }))
+      if (primlabel::count_finite(cloud) == 0)
         why = "no point has finite coordinates (" + std::to_string(cloud.size()) +
               " points): nothing to label";
     } catch (const std::exception& e) {

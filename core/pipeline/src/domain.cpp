@@ -5,7 +5,8 @@
 #include <cstdio>
 #include <vector>
 
-#include "primlabel/geometry/cloud_signature.hpp"
+#include "primlabel/geometry/neighbor_search.hpp"
+#include "primlabel/geometry/point_spacing.hpp"
 
 namespace primlabel::pipeline {
 
@@ -51,32 +52,34 @@ std::string domain_warning(const TrainingSummary& training, float point_spacing,
 std::string units_hint(const TrainingSummary& training, const PointCloud& cloud,
                        const RunContext& context) {
   if (!(training.acquired_spacing_min > 0.0f) || cloud.empty()) return {};
-  const CloudSignature signature =
-      measure_signature(cloud.xyz, cloud.viewpoint.origin, context, kUnitsSamples);
+  // The spacing as acquired (the figure the model's acquired range records), nothing more.
+  const float spacing_in_units =
+      median_point_spacing(cloud.xyz, NeighborSearch(cloud.xyz, context.stop), kUnitsSamples);
   // The median range from the sensor, over the same kind of strided sample.
   std::vector<float> ranges;
   const std::size_t stride = std::max<std::size_t>(1, cloud.size() / kUnitsSamples);
   for (std::size_t i = 0; i < cloud.size(); i += stride)
     if (is_finite(cloud.xyz[i])) ranges.push_back((cloud.xyz[i] - cloud.viewpoint.origin).norm());
-  if (ranges.empty() || !(signature.point_spacing > 0.0f)) return {};
-  std::nth_element(ranges.begin(), ranges.begin() + std::ptrdiff_t(ranges.size() / 2), ranges.end());
+  if (ranges.empty() || !(spacing_in_units > 0.0f)) return {};
+  std::nth_element(ranges.begin(), ranges.begin() + std::ptrdiff_t(ranges.size() / 2),
+                   ranges.end());
   const float range = ranges[ranges.size() / 2];
   struct Unit {
     float scale;
     const char *name, *flag;
   };
   for (const Unit& unit : {Unit{0.001f, "millimetres", "mm"}, Unit{0.01f, "centimetres", "cm"}}) {
-    const float spacing = signature.point_spacing * unit.scale;
+    const float spacing = spacing_in_units * unit.scale;
     const float metres = range * unit.scale;
     if (spacing < training.acquired_spacing_min / kSpacingTolerance ||
-        spacing > training.acquired_spacing_max * kSpacingTolerance ||
-        metres < kTableTopRangeMin || metres > kTableTopRangeMax)
+        spacing > training.acquired_spacing_max * kSpacingTolerance || metres < kTableTopRangeMin ||
+        metres > kTableTopRangeMax)
       continue;
     char text[240];
     std::snprintf(text, sizeof text,
                   "the cloud looks like %s (acquired spacing %.3g, median range %.4g in its "
                   "units): scale it by %g or pass --units %s",
-                  unit.name, double(signature.point_spacing), double(range), double(unit.scale),
+                  unit.name, double(spacing_in_units), double(range), double(unit.scale),
                   unit.flag);
     return text;
   }

@@ -36,8 +36,8 @@ std::string domain_warning(const TrainingSummary& training, float point_spacing,
 // When the cloud's acquired spacing, scaled by 0.001 (or 0.01), fits the model's training scans
 // and its median range from the viewpoint then lies within [kTableTopRangeMin, kTableTopRangeMax]
 // m, one line saying so and how to fix it ("... pass --units mm"); empty otherwise, and when the
-// model did not record its acquired spacing. Measures the cloud's signature: call it only for a
-// cloud already found sparser than the model's domain.
+// model did not record its acquired spacing. Builds a neighbour index to measure the spacing:
+// call it only for a cloud already found sparser than the model's domain.
 inline constexpr float kTableTopRangeMin = 0.1f, kTableTopRangeMax = 10.0f;
 inline constexpr std::size_t kUnitsSamples = 1024;
 std::string units_hint(const TrainingSummary& training, const PointCloud& cloud,
