@@ -103,6 +103,28 @@ TEST(Normals, IdenticalForAnyThreadCount) {
   }
 }
 
+TEST(Normals, OnlyTheWantedPointsGetOneAndAllServeAsNeighbours) {
+  PointCloud cloud = test::sphere(Vec3f(0, 0, 1), 0.2f, 5000, 0.002f, 3);
+  NormalOptions options;
+  options.neighborhood = Neighborhood::Radius(0.03f);
+  estimate_normals(cloud, options);
+  const std::vector<Vec3f> everyone = cloud.normals;
+  std::vector<std::uint8_t> wanted(cloud.size(), 0);
+  for (std::size_t i = 0; i < wanted.size(); i += 3) wanted[i] = 1;
+  options.wanted = wanted;
+  const NormalStats stats = estimate_normals(cloud, options, RunContext{2});
+  EXPECT_EQ(stats.estimated, (cloud.size() + 2) / 3);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (wanted[i])
+      EXPECT_EQ(cloud.normals[i], everyone[i]) << i;  // the same neighbours: the same normal
+    else
+      EXPECT_TRUE(std::isnan(cloud.normals[i].x())) << i;
+  }
+  const std::vector<std::uint8_t> too_short(3, 1);
+  options.wanted = too_short;
+  EXPECT_THROW(estimate_normals(cloud, options), std::invalid_argument);
+}
+
 TEST(Normals, MatchPclOnTheBunny) {
   const std::string path = test::shared_data("pcl/bun0.pcd");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";

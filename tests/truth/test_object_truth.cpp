@@ -9,8 +9,8 @@
 
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
-#include "primlabel/synth/fitted_truth.hpp"
 #include "primlabel/research/truth_check.hpp"
+#include "primlabel/synth/fitted_truth.hpp"
 #include "primlabel/synth/scanners.hpp"
 #include "primlabel/synth/scene.hpp"
 #include "test_util.hpp"
@@ -155,6 +155,27 @@ TEST(ObjectTruthMosd, CylinderSceneGetsUprightCylinders) {
   for (const FittedObject& o : truth.objects) {
     EXPECT_EQ(o.kind, FittedKind::kUprightCylinder) << o.segment;
     EXPECT_GE(o.inlier_share(), 0.9) << o.segment;
+  }
+}
+
+// The objects are fitted in parallel and normals may come from the caller's index: neither
+// changes a label or a fit.
+TEST(ObjectTruthMosd, TheSameWhateverTheThreadsAndWithTheCallersIndex) {
+  const std::string path = mosd("learn40");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+  const PointCloud cloud = read_cloud(path);
+  const std::vector<int> segments = mosd_segments(cloud.labels);
+  const ObjectTruth one = fit_object_truth(cloud, segments, {}, RunContext{1});
+  ASSERT_GE(one.objects.size(), 2u);
+  const NeighborSearch index(cloud.xyz);
+  const ObjectTruth two = fit_object_truth(cloud, segments, {}, RunContext{2}, &index);
+  EXPECT_EQ(one.labels, two.labels);
+  ASSERT_EQ(one.objects.size(), two.objects.size());
+  for (std::size_t k = 0; k < one.objects.size(); ++k) {
+    EXPECT_EQ(one.objects[k].kind, two.objects[k].kind) << k;
+    EXPECT_EQ(one.objects[k].inliers, two.objects[k].inliers) << k;
+    EXPECT_TRUE(one.objects[k].table_from_local.isApprox(two.objects[k].table_from_local, 0.0))
+        << k;
   }
 }
 

@@ -52,6 +52,8 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
                          options.neighborhood.radius <= lists->neighborhood().radius;
   const Vec3f viewpoint = options.viewpoint.value_or(cloud.viewpoint.origin);
   const std::size_t n = cloud.size();
+  if (!options.wanted.empty() && options.wanted.size() != n)
+    throw std::invalid_argument("normal estimation: one `wanted` flag per point is needed");
   detail::assign_checked(cloud.normals, n, Vec3f(Vec3f::Constant(kNaN)), stop, "normal estimation");
   detail::assign_checked(cloud.curvature, n, kNaN, stop, "normal estimation");
 
@@ -69,6 +71,7 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
         for (std::size_t i = first; i < last; ++i) {
           // Checked per point: a stop is then honoured within one (capped) neighbourhood's time.
           if (stop.stop_requested()) return;
+          if (!options.wanted.empty() && !options.wanted[i]) continue;
           const Vec3f& p = cloud.xyz[i];
           if (!is_finite(p)) {
             ++block_invalid;

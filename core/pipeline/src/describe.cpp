@@ -8,13 +8,13 @@
 #include <stdexcept>
 
 #include "multi_scale_input.hpp"
-#include "primlabel/pipeline/shape_evidence.hpp"
 #include "plane_cascade.hpp"
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/normals.hpp"
 #include "primlabel/geometry/point_spacing.hpp"
 #include "primlabel/pipeline/feature_sample.hpp"
 #include "primlabel/pipeline/labeling.hpp"
+#include "primlabel/pipeline/shape_evidence.hpp"
 
 namespace primlabel::pipeline {
 
@@ -163,7 +163,8 @@ DescribedCloud describe_cloud(PointCloud& cloud, const FeatureSettings& settings
   out.seconds.descriptors = seconds_since(start);
   if (settings.shape_evidence) {
     const auto shapes_start = std::chrono::steady_clock::now();
-    out.descriptors = with_shape_evidence(cloud, std::move(out.descriptors), stage);
+    out.descriptors =
+        with_shape_evidence(cloud, std::move(out.descriptors), stage, out.search.get());
     out.seconds.shapes = seconds_since(shapes_start);
   }
   return out;

@@ -18,7 +18,8 @@ namespace {
 constexpr float kEvidenceValue = 100.0f;
 }  // namespace
 
-std::vector<std::uint32_t> shape_evidence(const PointCloud& cloud, const RunContext& context) {
+std::vector<std::uint32_t> shape_evidence(const PointCloud& cloud, const RunContext& context,
+                                          const NeighborSearch* search) {
   std::vector<std::uint32_t> none(cloud.size(), 0u);
   const tabletop::TabletopResult objects =
       tabletop::segment_tabletop(cloud, tabletop::TabletopOptions{}, context);
@@ -26,15 +27,16 @@ std::vector<std::uint32_t> shape_evidence(const PointCloud& cloud, const RunCont
   const std::vector<std::int32_t> ids = tabletop::segment_ids(objects, cloud.size());
   const std::vector<int> segments(ids.begin(), ids.end());
   try {
-    return synth::fit_object_truth(cloud, segments, synth::ObjectTruthOptions{}, context).labels;
+    return synth::fit_object_truth(cloud, segments, synth::ObjectTruthOptions{}, context, search)
+        .labels;
   } catch (const std::invalid_argument&) {
     return none;  // no table plane among the table's points: no frame to fit shapes in
   }
 }
 
 Descriptors with_shape_evidence(const PointCloud& cloud, Descriptors descriptors,
-                                const RunContext& context) {
-  const std::vector<std::uint32_t> evidence = shape_evidence(cloud, context);
+                                const RunContext& context, const NeighborSearch* search) {
+  const std::vector<std::uint32_t> evidence = shape_evidence(cloud, context, search);
   const std::size_t n = descriptors.size();
   const int d = descriptors.dim;
   Descriptors out = Descriptors::filled(n, d + kShapeEvidenceDim, std::nanf(""));
@@ -45,7 +47,8 @@ Descriptors with_shape_evidence(const PointCloud& cloud, Descriptors descriptors
     std::copy(row.begin(), row.end(), widened.begin());
     std::fill(widened.begin() + d, widened.end(), 0.0f);
     const std::uint32_t c = evidence[i];
-    if (c >= 1 && c <= std::uint32_t(kShapeEvidenceDim)) widened[std::size_t(d) + c - 1] = kEvidenceValue;
+    if (c >= 1 && c <= std::uint32_t(kShapeEvidenceDim))
+      widened[std::size_t(d) + c - 1] = kEvidenceValue;
   }
   return out;
 }

@@ -48,7 +48,14 @@ std::optional<std::pair<double, double>> extent(const Cylinder& c, const Segment
   for (std::size_t i : idx)
     if (c.radial(s.p[i]).norm() < c.radius + s.bound[i]) along.push_back(c.axis.dot(s.p[i]));
   if (along.size() < 10) return std::nullopt;
-  double ends[2] = {quantile(along, 0.005), quantile(along, 0.995)};
+  // quantile()'s 0.5% and 99.5% order statistics from one copy: the upper one lies past the lower.
+  const std::size_t last = along.size() - 1;
+  const auto rank = [&](double q) { return std::min(last, std::size_t(q * double(last) + 0.5)); };
+  const auto lower = along.begin() + std::ptrdiff_t(rank(0.005));
+  std::nth_element(along.begin(), lower, along.end());
+  const auto upper = along.begin() + std::ptrdiff_t(rank(0.995));
+  std::nth_element(lower + 1, upper, along.end());
+  double ends[2] = {*lower, *upper};
   for (double& end : ends) {
     double sum = 0;
     std::size_t n = 0;
@@ -64,13 +71,18 @@ std::optional<std::pair<double, double>> extent(const Cylinder& c, const Segment
 }
 
 // Mean truncated cost of the closed cylinder (side and both caps at the points' extent), so a
-// hypothesis is judged on the whole object, a can's lid included.
-double msac_cost(const Cylinder& c, const SegmentPoints& s, const std::vector<std::size_t>& idx) {
+// hypothesis is judged on the whole object, a can's lid included. Infinite once the mean cannot
+// come below `beaten` (the best so far): the terms are never negative.
+double msac_cost(const Cylinder& c, const SegmentPoints& s, const std::vector<std::size_t>& idx,
+                 double beaten = INFINITY) {
   const auto range = extent(c, s, idx);
   if (!range) return INFINITY;
   const auto [lo, hi] = *range;
+  // A margin over the bound, so that rounding of the mean can never lose the hypothesis that wins.
+  const double give_up = beaten * double(idx.size()) * (1 + 1e-9);
   double cost = 0;
   for (std::size_t i : idx) {
+    if (cost > give_up) return INFINITY;
     const double t2 = s.bound[i] * s.bound[i];
     const double rho = c.radial(s.p[i]).norm(), along = c.axis.dot(s.p[i]);
     const double side = std::hypot(rho - c.radius, std::max({lo - along, along - hi, 0.0}));
@@ -190,7 +202,7 @@ std::optional<FittedObject> fit_cylinder(const SegmentPoints& s, const FitSettin
   for (int it = 0; it < 400; ++it) {
     const auto c = hypothesis(s, with_normal[rng.below(n)], with_normal[rng.below(n)]);
     if (!c || !upright_or_lying(*c)) continue;
-    const double cost = msac_cost(*c, s, scoring);
+    const double cost = msac_cost(*c, s, scoring, best_cost);
     if (cost < best_cost) best_cost = cost, best = c;
   }
   if (!best) return std::nullopt;

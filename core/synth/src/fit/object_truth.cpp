@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "primlabel/geometry/normals.hpp"
+#include "primlabel/geometry/parallel.hpp"
 #include "primlabel/synth/fitted_truth.hpp"
 #include "primlabel/tabletop/plane_fit.hpp"
 #include "shape_fit.hpp"
@@ -45,7 +46,7 @@ Eigen::Isometry3d fit_table_frame(const PointCloud& cloud, const std::vector<int
 FittedObject choose_model(int segment, const fit::SegmentPoints& points,
                           const ObjectTruthOptions& options) {
   const fit::FitSettings settings{options.contact_tolerance,
-                                    options.seed + static_cast<std::uint64_t>(segment)};
+                                  options.seed + static_cast<std::uint64_t>(segment)};
   FittedObject chosen;
   chosen.segment = segment;
   chosen.points = points.p.size();
@@ -143,7 +144,8 @@ std::vector<int> synthetic_segments(const PointCloud& cloud) {
 }
 
 ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& segments,
-                             const ObjectTruthOptions& options, const RunContext& context) {
+                             const ObjectTruthOptions& options, const RunContext& context,
+                             const NeighborSearch* search) {
   if (segments.size() != cloud.size())
     throw std::invalid_argument("fit_object_truth: one segment id per point is needed");
   ObjectTruth truth;
@@ -155,9 +157,13 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
   work.width = cloud.width;
   work.height = cloud.height;
   work.viewpoint = cloud.viewpoint;
+  // Only the objects' points need a normal (the table is fitted by position alone).
+  std::vector<std::uint8_t> on_object(cloud.size(), 0);
+  for (std::size_t i = 0; i < cloud.size(); ++i) on_object[i] = segments[i] > 0;
   NormalOptions normal_options;
   normal_options.neighborhood = Neighborhood::Hybrid(options.normal_radius, 256);
-  estimate_normals(work, normal_options, context);
+  normal_options.wanted = on_object;
+  estimate_normals(work, normal_options, context, search);
 
   // Per point: residual bound from its depth along the sensor's view axis.
   const Eigen::Isometry3d& t = truth.table_from_cloud;
@@ -175,19 +181,27 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
   std::map<int, std::vector<std::uint32_t>> members;
   for (std::uint32_t i = 0; i < cloud.size(); ++i)
     if (segments[i] > 0 && is_finite(cloud.xyz[i])) members[segments[i]].push_back(i);
-  std::vector<fit::SegmentPoints> points;
-  for (const auto& [segment, indices] : members) {
-    fit::SegmentPoints s;
-    s.viewpoint = t * origin;
-    for (auto i : indices) {
-      s.p.push_back(t * cloud.xyz[i].cast<double>());
-      s.n.push_back(t.linear() * work.normals[i].cast<double>());
-      s.bound.push_back(bound(cloud.xyz[i]));
-      s.depth.push_back(depth(cloud.xyz[i]));
-    }
-    truth.objects.push_back(choose_model(segment, s, options));
-    points.push_back(std::move(s));
-  }
+  const std::vector<std::pair<int, std::vector<std::uint32_t>>> segment_list(members.begin(),
+                                                                             members.end());
+  std::vector<fit::SegmentPoints> points(segment_list.size());
+  truth.objects.resize(segment_list.size());
+  // One object an iteration (dynamic: objects differ in size); each fit has its own seed, so the
+  // thread count changes nothing.
+  detail::parallel_for(std::ptrdiff_t(segment_list.size()), context.threads,
+                       detail::Schedule::Dynamic(1), [&](std::ptrdiff_t k) {
+                         if (context.stop.stop_requested()) return;
+                         const auto& [segment, indices] = segment_list[std::size_t(k)];
+                         fit::SegmentPoints& s = points[std::size_t(k)];
+                         s.viewpoint = t * origin;
+                         for (auto i : indices) {
+                           s.p.push_back(t * cloud.xyz[i].cast<double>());
+                           s.n.push_back(t.linear() * work.normals[i].cast<double>());
+                           s.bound.push_back(bound(cloud.xyz[i]));
+                           s.depth.push_back(depth(cloud.xyz[i]));
+                         }
+                         truth.objects[std::size_t(k)] = choose_model(segment, s, options);
+                       });
+  context.throw_if_stopped("fitting the objects' shapes");
   reject_nested(truth.objects, points);
 
   // The fitted scene: the table slab (top face z = 0, far wider than any view) and the shapes.
@@ -216,7 +230,7 @@ ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& se
     const Eigen::Isometry3d local_from_table = object.table_from_local.inverse();
     for (std::size_t j = 0; j < indices.size(); ++j) {
       const fit::SurfacePoint sp = fit::closest_surface(object, local_from_table * s.p[j],
-                                                            local_from_table.linear() * s.n[j]);
+                                                        local_from_table.linear() * s.n[j]);
       if (sp.distance >= s.bound[j]) continue;
       rule_points.push_back({index, sp.part, object.table_from_local * sp.point});
       rule_index.push_back(indices[j]);

@@ -3,7 +3,9 @@
 // of the neighbourhood covariance), oriented toward a viewpoint, and curvature
 // lambda0 / (lambda0 + lambda1 + lambda2). Matches PCL's NormalEstimation.
 
+#include <cstdint>
 #include <optional>
+#include <span>
 
 #include "primlabel/geometry/neighbor_lists.hpp"
 #include "primlabel/geometry/neighbor_search.hpp"
@@ -17,6 +19,9 @@ struct NormalOptions {
   Neighborhood neighborhood = Neighborhood::Knn(10);
   // Normals are flipped to face this point; defaults to the cloud's VIEWPOINT origin.
   std::optional<Vec3f> viewpoint;
+  // Per point, whether it wants a normal (empty: all); the others keep NaN and are not counted.
+  // Their coordinates still serve as neighbours.
+  std::span<const std::uint8_t> wanted;
 };
 
 struct NormalStats {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "primlabel/geometry/descriptors.hpp"
+#include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/run_context.hpp"
 
@@ -19,13 +20,15 @@ namespace primlabel::pipeline {
 
 // Per point of `cloud` the taxonomy class id its object's fitted shape gives it, 0 (unknown)
 // where no fitted surface explains it: no table, no object, or no fit accepted. Deterministic
-// whatever context.threads; throws Cancelled when context.stop is requested.
-std::vector<std::uint32_t> shape_evidence(const PointCloud& cloud, const RunContext& context);
+// whatever context.threads; throws Cancelled when context.stop is requested. `search`, an index
+// on cloud.xyz, saves building one.
+std::vector<std::uint32_t> shape_evidence(const PointCloud& cloud, const RunContext& context,
+                                          const NeighborSearch* search = nullptr);
 
 // `descriptors` (one row per point of `cloud`) widened by kShapeEvidenceDim values: 100 (the
 // scale of an FPFH bin's percentage) in the column of the point's evidence class, 0 elsewhere.
 // Rows without a descriptor (NaN) stay NaN.
 Descriptors with_shape_evidence(const PointCloud& cloud, Descriptors descriptors,
-                                const RunContext& context);
+                                const RunContext& context, const NeighborSearch* search = nullptr);
 
 }  // namespace primlabel::pipeline

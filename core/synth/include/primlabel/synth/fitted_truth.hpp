@@ -25,6 +25,7 @@
 #include <string_view>
 #include <vector>
 
+#include "primlabel/geometry/neighbor_search.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/run_context.hpp"
 #include "primlabel/synth/generate.hpp"
@@ -85,8 +86,10 @@ std::vector<int> mosd_segments(const std::vector<std::uint32_t>& mosd_labels);  
 std::vector<int> synthetic_segments(const PointCloud& cloud);  // the `object` field of synth
 
 // Throws std::invalid_argument when segments does not match the cloud or no table plane is found.
+// `search`, an index on cloud.xyz, saves building one; objects are fitted in parallel, each with
+// its own seed, so the result does not depend on context.threads.
 ObjectTruth fit_object_truth(const PointCloud& cloud, const std::vector<int>& segments,
-                             const ObjectTruthOptions& options = {},
-                             const RunContext& context = {});
+                             const ObjectTruthOptions& options = {}, const RunContext& context = {},
+                             const NeighborSearch* search = nullptr);
 
 }  // namespace primlabel::synth
