@@ -10,19 +10,31 @@
 
 namespace primlabel::pipeline {
 
+namespace {
+// Whether the model recorded its spacing range and the cloud has a spacing to hold against it.
+bool comparable(const TrainingSummary& training, float point_spacing) {
+  const float low = training.point_spacing_min, high = training.point_spacing_max;
+  return low > 0.0f && high >= low && point_spacing > 0.0f && std::isfinite(point_spacing);
+}
+}  // namespace
+
+bool sparser_than_trained(const TrainingSummary& training, float point_spacing) {
+  return comparable(training, point_spacing) &&
+         point_spacing > training.point_spacing_max * kSpacingTolerance;
+}
+
 std::string spacing_warning(const TrainingSummary& training, float point_spacing) {
   const float low = training.point_spacing_min, high = training.point_spacing_max;
-  if (!(low > 0.0f) || !(high >= low) || !(point_spacing > 0.0f) || !std::isfinite(point_spacing))
-    return {};
-  if (point_spacing >= low / kSpacingTolerance && point_spacing <= high * kSpacingTolerance)
-    return {};
+  if (!comparable(training, point_spacing)) return {};
+  const bool sparser = sparser_than_trained(training, point_spacing);
+  if (!sparser && point_spacing >= low / kSpacingTolerance) return {};
   char text[240];
   std::snprintf(
       text, sizeof text,
       "point spacing %.2f mm as described (after any voxel filter) is %s than the %.2f-%.2f mm "
       "of this model's training scenes described alike (more than %gx): labels are unreliable; "
       "use a model for this sensor or a voxel size",
-      point_spacing * 1e3, point_spacing > high ? "sparser" : "denser", low * 1e3, high * 1e3,
+      point_spacing * 1e3, sparser ? "sparser" : "denser", low * 1e3, high * 1e3,
       double(kSpacingTolerance));
   return text;
 }

@@ -181,7 +181,7 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
   result.seconds.duplicates = plan.seconds.duplicates;
   result.domain_warning =
       domain_warning(model.training, result.point_spacing, result.surface_variation);
-  if (result.point_spacing > model.training.point_spacing_max * kSpacingTolerance) {
+  if (sparser_than_trained(model.training, result.point_spacing)) {
     const std::string units = units_hint(model.training, cloud, context);
     if (!units.empty()) result.domain_warning = units + "; " + result.domain_warning;
   }

@@ -19,6 +19,10 @@ inline constexpr float kSpacingTolerance = 2.0f;
 // otherwise, and for models that did not record their range or clouds without a spacing.
 std::string spacing_warning(const TrainingSummary& training, float point_spacing);
 
+// Whether `point_spacing` (m) is more than kSpacingTolerance sparser than the model's training
+// scenes (the case of a cloud in millimetres read as metres); false without a recorded range.
+bool sparser_than_trained(const TrainingSummary& training, float point_spacing);
+
 // Surface variation grows with the square of the noise: this factor is twice the noise.
 inline constexpr float kSurfaceVariationTolerance = 4.0f;
 
