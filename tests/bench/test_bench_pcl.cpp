@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "pcl_availability.hpp"
+#include "primlabel/geometry/json_text.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -43,6 +44,28 @@ TEST(BenchPcl, ComparePclRunsOrSaysWhyInOneLine) {
     EXPECT_TRUE(contains(r.output, "libpcl-dev")) << r.output;
   } else {
     EXPECT_TRUE(contains(r.output, "-DPRIMLABEL_WITH_PCL=OFF")) << r.output;
+  }
+}
+
+// `scaling` prints a row per thread count and one JSON line, with PCL's figures when the build
+// has PCL (null otherwise).
+TEST(BenchScaling, ARowPerThreadCountAndPclWhenBuilt) {
+  if (!std::filesystem::exists(test::binary("primlabel-bench")))
+    GTEST_SKIP() << "benchmarks not built";
+  const auto r = test::run_command(test::binary("primlabel-bench") + " scaling --input " +
+                                   test::test_data("samples/bun0.pcd") +
+                                   " --threads 1,3 --repeat 1 --normal-radius 0.004"
+                                   " --feature-radius 0.008 2>/dev/null");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json::Json line = json::Json::parse(r.output.substr(r.output.rfind("{\"bench\"")));
+  ASSERT_EQ(line["rows"].size(), 2u) << r.output;
+  EXPECT_EQ(line["rows"][1]["threads"], 3);
+  for (const auto& row : line["rows"]) {
+    EXPECT_GT(row["normals_pts_s"].get<double>(), 0.0) << r.output;
+    EXPECT_GT(row["fpfh_pts_s"].get<double>(), 0.0) << r.output;
+    const json::Json& pcl = row["pcl_fpfh_pts_s"];
+    EXPECT_TRUE(pcl.is_null() || pcl.get<double>() > 0.0) << r.output;
+    if (!PRIMLABEL_WITH_PCL_OPTION) EXPECT_TRUE(pcl.is_null()) << r.output;
   }
 }
 
