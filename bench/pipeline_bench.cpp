@@ -14,6 +14,7 @@
 //
 //   primlabel-bench pipeline --threads 1,2 --repeat 3
 //   primlabel-bench pipeline --model FOLD.plm --scans learn1_truth.pcd --compare-cascade
+//   primlabel-bench pipeline --model kinect.plm --scans kinect-3000.pcd --compare-crease
 //   primlabel-bench pipeline --stop-latency 20
 
 #include <sys/resource.h>
@@ -56,6 +57,7 @@ struct Arguments {
   int repeat = 1;
   bool compare_unshared = false;  // also each case without the shared neighbour lists
   bool compare_cascade = false;   // also each case with the plane cascade
+  bool compare_crease = false;    // also each case with crease_points the other way
   int stop_latency = 0;           // > 0: stops per input
 };
 
@@ -126,13 +128,14 @@ LabelModel quick_model(synth::SensorKind sensor) {
 }
 
 Row measure(const LabelModel& model, const PointCloud& scene, int threads, int repeat, float voxel,
-            bool share_lists, bool cascade) {
+            bool share_lists, bool cascade, bool crease) {
   Row best;
   best.total_s = std::numeric_limits<double>::infinity();
   pipeline::LabelingOptions options;
   if (voxel >= 0.0f) options.voxel_size = voxel;
   options.share_neighbor_lists = share_lists;
   options.plane_cascade = cascade;
+  options.crease_points = crease;
   std::vector<double> totals, cpu;
   std::vector<pipeline::StageSeconds> runs;
   for (int r = 0; r < repeat; ++r) {
@@ -277,10 +280,15 @@ int run_pipeline_bench(const Arguments& args) {
   std::printf("%-7s %-18s %3s %6s %8s %8s %8s %8s %8s %7s %8s %6s", "sensor", "model", "thr",
               "voxel", "points", "voxels", "cascaded", "p50 ms", "p90 ms", "frame/s", "cpu ms",
               "acc %");
-  // (shared lists, plane cascade) per case: the default first, then the comparisons asked for.
-  std::vector<std::pair<bool, bool>> variants = {{true, false}};
-  if (args.compare_unshared) variants.insert(variants.begin(), {false, false});
-  if (args.compare_cascade) variants.emplace_back(true, true);
+  // Per case the default first, then the comparisons asked for.
+  struct Variant {
+    bool share, cascade, crease;
+  };
+  const bool crease = pipeline::LabelingOptions{}.crease_points;
+  std::vector<Variant> variants = {{true, false, crease}};
+  if (args.compare_unshared) variants.insert(variants.begin(), {false, false, crease});
+  if (args.compare_cascade) variants.push_back({true, true, crease});
+  if (args.compare_crease) variants.push_back({true, false, !crease});
   for (const pipeline::LabelingStage& c : pipeline::kLabelingStages)
     std::printf(" %*s", bench::stage_column_width(c), c.name);
   std::printf("\n");
@@ -306,10 +314,14 @@ int run_pipeline_bench(const Arguments& args) {
     for (const auto& [model_name, model] : models)
       for (float voxel : args.voxel_sizes)
         for (int threads : args.threads)
-          for (const auto& [share, cascade] : variants) {
-            Row row = measure(model, scene, threads, args.repeat, voxel, share, cascade);
+          for (const Variant& v : variants) {
+            Row row =
+                measure(model, scene, threads, args.repeat, voxel, v.share, v.cascade, v.crease);
             row.sensor = name;
-            row.model = model_name + (share ? "" : "-unshared") + (cascade ? "-cascade" : "");
+            row.model = model_name + (v.share ? "" : "-unshared") + (v.cascade ? "-cascade" : "") +
+                        (v.crease == crease ? ""
+                         : v.crease         ? "-crease"
+                                            : "-nocrease");
             std::printf("%-7s %-18s %3d %6.3f %8zu %8zu %8zu %8.1f %8.1f %7.2f %8.1f %6.2f",
                         row.sensor.c_str(), row.model.c_str(), row.threads, row.voxel, row.points,
                         row.described, row.cascaded, row.p50_ms, row.p90_ms, 1e3 / row.p50_ms,
@@ -382,6 +394,9 @@ BenchCommand add_pipeline_command(CLI::App& parent) {
                 "also run every case with each stage searching itself (no shared neighbour lists)");
   cmd->add_flag("--compare-cascade", args->compare_cascade,
                 "also run every case with the plane cascade (LabelingOptions::plane_cascade)");
+  cmd->add_flag("--compare-crease", args->compare_crease,
+                "also run every case with LabelingOptions::crease_points the other way (the "
+                "per-point labels near creases)");
   cmd->add_option("--repeat", args->repeat, "runs per case, the fastest counts (default 1)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--stop-latency", args->stop_latency,

@@ -35,6 +35,7 @@ struct Arguments {
   std::string model, classes, out, primitives_json, objects_json, confusion_png;
   std::vector<std::string> files;
   bool json = false, no_truth = false, tabletop_only = false, quiet = false, plane_cascade = false;
+  bool crease_points = pipeline::LabelingOptions{}.crease_points;
   int threads = 0;
 };
 
@@ -112,6 +113,7 @@ int evaluate_files(const Arguments& args) {
     pipeline::LabelingOptions options;
     options.tabletop_only = args.tabletop_only;
     options.plane_cascade = args.plane_cascade;
+    options.crease_points = args.crease_points;
     options.want_primitives = !args.primitives_json.empty();
     options.want_objects = !args.objects_json.empty();
     const pipeline::LabelingResult result =
@@ -236,6 +238,10 @@ int main(int argc, char** argv) {
   app.add_flag("--plane-cascade", args.plane_cascade,
                "label points that are planar within the scene's plane noise plane without "
                "describing them (faster; see LabelingOptions::plane_cascade)");
+  app.add_flag("--crease-points,!--no-crease-points", args.crease_points,
+               "near creases label each input point at its own position, not by its voxel "
+               "(see LabelingOptions::crease_points)")
+      ->default_str(args.crease_points ? "on" : "off");
   app.add_option("--threads", args.threads, "worker threads")
       ->check(CLI::PositiveNumber)
       ->default_str("all cores");

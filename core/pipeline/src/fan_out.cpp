@@ -10,7 +10,7 @@
 namespace primlabel::pipeline {
 
 void fan_out(const LabelingPlan& plan, const PointCloud& described, const LabelingOptions& options,
-             PointCloud& cloud, LabelingResult& result) {
+             PointCloud& cloud, LabelingResult& result, const CreaseAnswers* crease) {
   const auto start = std::chrono::steady_clock::now();
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
   const std::vector<std::uint32_t>& slot_of = plan.slot_of;
@@ -24,6 +24,10 @@ void fan_out(const LabelingPlan& plan, const PointCloud& described, const Labeli
       labels[i] = result.labels[slot_of[i]];
       labeled += labels[i] != unknown ? 1 : 0;
     }
+  // A crease point's slot was labeled, and so is the point: the count stands.
+  if (crease)
+    for (std::size_t j = 0; j < crease->points.size(); ++j)
+      labels[crease->points[j]] = crease->labels[j];
   result.labels = std::move(labels);
   // With one input point per slot the description's own count stands.
   if (plan.merges_points) result.labeled_points = labeled;
@@ -35,7 +39,13 @@ void fan_out(const LabelingPlan& plan, const PointCloud& described, const Labeli
       for (std::size_t i = 0; i < n; ++i)
         if (slot_of[i] != kNoSlot)
           probabilities.row(Eigen::Index(i)) = result.probabilities.row(Eigen::Index(slot_of[i]));
+    if (crease)
+      for (std::size_t j = 0; j < crease->points.size(); ++j)
+        probabilities.row(Eigen::Index(crease->points[j])) =
+            crease->probabilities.row(Eigen::Index(j));
     result.probabilities = std::move(probabilities);
+  } else {
+    result.probabilities = {};  // the marginals the crease decision asked for
   }
   if (options.want_descriptors) {
     Descriptors descriptors = Descriptors::filled(n, result.descriptors.dim, kNaN);

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -15,6 +17,7 @@
 #include "multi_scale_input.hpp"
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/pipeline/crease_points.hpp"
 #include "primlabel/pipeline/domain.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/svm_model.hpp"
@@ -81,12 +84,20 @@ void label_cascaded_planes(const std::vector<std::uint8_t>& cascaded,
   result.labeled_points += result.cascaded_points;
 }
 
+// What the crease decision needs of the described cloud once it is labeled (crease_points.hpp).
+struct SlotIndex {
+  std::unique_ptr<NeighborSearch> search;  // over the described cloud
+  std::vector<std::uint8_t> inferred;      // per point: the CRF labeled it; empty: no marginals
+};
+
 // Every point of `cloud` described and labeled, one row per point. `is_input`: `cloud` is the
 // caller's cloud itself, so wanted primitives are fitted here, while the description's neighbour
-// index and lists are alive to be reused.
+// index and lists are alive to be reused. `slot_index` (may be null): asks for the CRF's
+// marginals (in result.probabilities, even unless wanted) and keeps the index and the inferred
+// points there for the crease decision.
 LabelingResult label_described(const LabelModel& model, const FeatureSettings& features,
                                PointCloud& cloud, const LabelingOptions& options,
-                               const RunContext& context, bool is_input) {
+                               const RunContext& context, bool is_input, SlotIndex* slot_index) {
   LabelingResult result;
   result.class_ids = model.class_ids();
   DescribeOptions describe_options;
@@ -121,13 +132,13 @@ LabelingResult label_described(const LabelModel& model, const FeatureSettings& f
   const auto inference_start = std::chrono::steady_clock::now();
   crf::InferenceOutputs outputs;
   outputs.unknown_label = class_id(PrimitiveClass::kUnknown);
-  outputs.marginals = options.want_probabilities;
+  outputs.marginals = options.want_probabilities || slot_index;
   crf::InferenceResult inferred =
       infer(model.weights, described.descriptors, graph, model.inference, outputs, context);
   result.seconds.inference = seconds_since(inference_start);
 
   result.labels = std::move(inferred.labels);
-  if (options.want_probabilities) result.probabilities = std::move(inferred.marginals);
+  if (outputs.marginals) result.probabilities = std::move(inferred.marginals);
   if (options.want_descriptors)
     result.descriptors =
         leading_values(std::move(described.descriptors), model.features.descriptor_dim());
@@ -137,6 +148,10 @@ LabelingResult label_described(const LabelModel& model, const FeatureSettings& f
     fit_primitives_of_input(
         cloud, options, context,
         {described.search.get(), described.lists.get(), described.point_spacing}, result);
+  if (slot_index) {
+    slot_index->search = std::move(described.search);
+    slot_index->inferred = graph.active;  // not the cascade's points, whose rows are not the CRF's
+  }
   return result;
 }
 
@@ -174,8 +189,12 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
   // Down once: the one cloud to describe, and every input point's slot in it.
   LabelingPlan plan = plan_labeling(cloud, effective_voxel_size(model, options), options, context);
   PointCloud& described = plan.described_cloud(cloud);
-  LabelingResult result = label_described(model, features, described, options, context,
-                                          /*is_input=*/plan.in_place);
+  // Points decided on their own near creases need voxels and the CRF's marginals.
+  const bool creases = options.crease_points && plan.voxel_size > 0.0f;
+  SlotIndex slot_index;
+  LabelingResult result =
+      label_described(model, features, described, options, context,
+                      /*is_input=*/plan.in_place, creases ? &slot_index : nullptr);
   result.seconds.voxels = plan.seconds.voxels;
   result.seconds.tabletop = plan.seconds.tabletop;
   result.seconds.duplicates = plan.seconds.duplicates;
@@ -187,7 +206,18 @@ LabelingResult label_cloud(const LabelModel& model, PointCloud& cloud,
   }
 
   // Back once: every input point gets its slot's answer; primitives and objects are the input's.
-  if (!plan.in_place) fan_out(plan, described, options, cloud, result);
+  if (!plan.in_place) {
+    std::optional<CreaseAnswers> crease;
+    if (!slot_index.inferred.empty()) {
+      const auto start = std::chrono::steady_clock::now();
+      crease = decide_crease_points(cloud.xyz, plan.slot_of,
+                                    {&described.xyz, slot_index.search.get(), slot_index.inferred,
+                                     result.labels, &result.probabilities, result.class_ids},
+                                    plan.voxel_size, context);
+      result.seconds.fanout += seconds_since(start);
+    }
+    fan_out(plan, described, options, cloud, result, crease ? &*crease : nullptr);
+  }
   if (options.want_primitives && !result.primitives)
     fit_primitives_of_input(cloud, options, context, {}, result);
   if (plan.objects) {

@@ -114,6 +114,7 @@ LabelingPlan plan_labeling(const PointCloud& cloud, float voxel_size,
         cloud.xyz, tabletop::finite_indices(cloud.xyz), voxel_size, context);
     voxels = voxel_cloud(cloud, grid, with_normals);
     voxel_of_point = std::move(grid.voxel_of_point);
+    plan.voxel_size = voxel_size;
     plan.seconds.voxels = seconds_since(voxels_start);
     context.throw_if_stopped("labeling");
   }

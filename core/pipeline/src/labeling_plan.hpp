@@ -28,6 +28,7 @@ struct LabelingPlan {
   PointCloud described;
   std::vector<std::uint32_t> slot_of;  // per input point its slot or kNoSlot; empty when in_place
   bool merges_points = false;          // some slot stands for several input points
+  float voxel_size = 0.0f;             // the voxels' edge; 0: no voxels
   // With want_objects: the table-top stage's object id of every input point (the counts and
   // shapes are left to describe_objects).
   std::optional<tabletop::TabletopObjects> objects;

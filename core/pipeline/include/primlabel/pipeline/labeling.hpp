@@ -93,7 +93,8 @@ struct LabelingOptions {
   // Keep the cloud's own normals (cloud.normals, one per point) instead of estimating them.
   bool use_cloud_normals = false;
   // > 0: downsample to voxels of this edge before describing (replaces the model's voxel_size);
-  // every input point gets its voxel's label, probabilities, descriptor and normal.
+  // every input point gets its voxel's label, probabilities, descriptor and normal (near creases
+  // its own label and probabilities: crease_points).
   float voxel_size = 0.0f;
   // > 0: replace the model's normal / feature radius. Only for models whose FeatureSettings
   // allow it (radii_overridable), else label_cloud throws std::invalid_argument.
@@ -116,6 +117,12 @@ struct LabelingOptions {
   // for models without a plane class. The service turns it on unless a request asks for
   // every_point.
   bool plane_cascade = false;
+  // With voxels (voxel_size or the model's), for CRF and node-only models: an input point whose
+  // voxel has a described neighbour voxel with another label (a crease cuts through it) is
+  // labeled at its own position, from the CRF marginals of the nearest described voxels weighted
+  // by inverse squared distance (crease_points.hpp); its probabilities are those interpolated
+  // ones. Every other point keeps its voxel's answer, the cascade's planes theirs.
+  bool crease_points = true;
 };
 
 struct LabelingResult {
