@@ -129,7 +129,7 @@ TEST(CreasePoints, LabelCloudGivesTheSameLabelsAndProbabilitiesOnOneAndTwoThread
   pipeline::LabelingOptions options;
   options.voxel_size = 0.005f;
   options.want_probabilities = true;
-  ASSERT_TRUE(options.crease_points);  // the default
+  options.crease_points = true;
   PointCloud cloud = testing::table_with_box_cloud(0.0025f);
   const pipeline::LabelingResult one = pipeline::label_cloud(model, cloud, options, RunContext{1});
   PointCloud again = testing::table_with_box_cloud(0.0025f);

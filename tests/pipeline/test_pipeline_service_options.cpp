@@ -239,7 +239,7 @@ TEST(PipelineServiceOptions, VoxelDownsamplingGivesEveryPointItsVoxelsResults) {
   options.voxel_size = 0.005f;
   options.want_descriptors = true;
   options.want_probabilities = true;
-  options.crease_points = false;  // near creases points take their own answers (crease_points)
+  options.crease_points = false;  // the default, said here: the test is of per-voxel answers
   const auto result = pipeline::label_cloud(model, cloud, options, RunContext{1});
   ASSERT_EQ(result.labels.size(), cloud.size());
   ASSERT_EQ(result.probabilities.rows(), Eigen::Index(cloud.size()));

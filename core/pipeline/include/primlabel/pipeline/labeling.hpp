@@ -93,8 +93,8 @@ struct LabelingOptions {
   // Keep the cloud's own normals (cloud.normals, one per point) instead of estimating them.
   bool use_cloud_normals = false;
   // > 0: downsample to voxels of this edge before describing (replaces the model's voxel_size);
-  // every input point gets its voxel's label, probabilities, descriptor and normal (near creases
-  // its own label and probabilities: crease_points).
+  // every input point gets its voxel's label, probabilities, descriptor and normal (near creases,
+  // with crease_points, its own label and probabilities).
   float voxel_size = 0.0f;
   // > 0: replace the model's normal / feature radius. Only for models whose FeatureSettings
   // allow it (radii_overridable), else label_cloud throws std::invalid_argument.
@@ -121,8 +121,9 @@ struct LabelingOptions {
   // voxel has a described neighbour voxel with another label (a crease cuts through it) is
   // labeled at its own position, from the CRF marginals of the nearest described voxels weighted
   // by inverse squared distance (crease_points.hpp); its probabilities are those interpolated
-  // ones. Every other point keeps its voxel's answer, the cascade's planes theirs.
-  bool crease_points = true;
+  // ones. Every other point keeps its voxel's answer, the cascade's planes theirs. Off by
+  // default: +0.1-0.2 points on Kinect frames for tens of ms a frame (results.md).
+  bool crease_points = false;
 };
 
 struct LabelingResult {
