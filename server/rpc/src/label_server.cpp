@@ -176,7 +176,7 @@ void LabelServer::shutdown(std::chrono::milliseconds drain) {
   std::lock_guard shutdown_lock(shutdown_mutex_);
   if (shut_down_) return;
   shut_down_ = true;
-  ops::log_info("service::shutting_down")
+  ops::log_info("shutting_down")
       .kv("drain_ms", std::int64_t(drain.count()))
       .kv("in_flight", requests_.in_flight());
   {
