@@ -123,7 +123,7 @@ std::vector<v1::LabelRequest> requests_for(const PointCloud& cloud, std::size_t 
 pipeline::LabelingOptions served_options(const PointCloud& cloud, const std::string& model) {
   PointCloud empty;
   empty.viewpoint = cloud.viewpoint;
-  return server::labeling_options(requests_for(empty, 1, model).front().header());
+  return service::labeling_options(requests_for(empty, 1, model).front().header());
 }
 
 // One streamed request; returns the labels it got (empty on failure) and, when asked, the
@@ -263,14 +263,14 @@ FrameFigures frame_figures(const std::string& label, const std::string& name,
   return out;
 }
 
-double inflight(server::LabelServer& server) {
+double inflight(rpc::LabelServer& server) {
   const std::string text = server.metrics().serialize();
   return scrape::sum_samples(scrape::parse_exposition(text), "primlabel_inflight_requests");
 }
 
 // Streams the cloud, cancels `after_ms` after the upload ended, and measures cancel -> request
 // slot freed (the worker has stopped computing and the call's reactor is gone).
-double cancel_latency(server::LabelServer& server, v1::Labeler::Stub& stub,
+double cancel_latency(rpc::LabelServer& server, v1::Labeler::Stub& stub,
                       const std::vector<v1::LabelRequest>& requests, int after_ms) {
   grpc::ClientContext context;
   auto stream = stub.Label(&context);
@@ -298,7 +298,7 @@ struct Arguments {
 };
 
 int run_server_bench(const Arguments& args) {
-  server::set_log_level(server::LogLevel::kWarn);
+  ops::set_log_level(ops::LogLevel::kWarn);
   const fs::path repo = fs::temp_directory_path() / ("primlabel_bench_" + std::to_string(getpid()));
   const LabelModel model = bench_model();
   fs::create_directories(repo / "bench" / "1");
@@ -331,7 +331,7 @@ int run_server_bench(const Arguments& args) {
     fs::copy_file(file, repo / frame.name / "1" / "model.plm");
     frame_cases.push_back(std::move(frame));
   }
-  server::ServerConfig config;
+  ops::ServerConfig config;
   config.models_dir = repo.string();
   config.listen = "127.0.0.1:0";
   config.metrics_listen = "";
@@ -339,7 +339,7 @@ int run_server_bench(const Arguments& args) {
   config.workers = 1;
   config.threads_per_job = args.threads;
   config.max_points = std::max<std::uint64_t>(config.max_points, args.cancel_points);
-  server::LabelServer server(config);
+  rpc::LabelServer server(config);
   grpc::ChannelArguments channel_args;
   channel_args.SetMaxReceiveMessageSize(64 << 20);
   auto stub = v1::Labeler::NewStub(

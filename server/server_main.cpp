@@ -14,16 +14,15 @@
 
 int main(int argc, char** argv) {
   using namespace primlabel;
-  using namespace primlabel::server;
-  ServerConfig config;
+  ops::ServerConfig config;
   try {
-    config = parse_server_config(argc, argv);
-  } catch (const ConfigError& error) {
+    config = ops::parse_server_config(argc, argv);
+  } catch (const ops::ConfigError& error) {
     std::fputs(error.message.c_str(), error.exit_code == 0 ? stdout : stderr);
     if (!error.message.empty() && error.message.back() != '\n') std::fputc('\n', stderr);
     return error.exit_code;
   }
-  set_log_level(parse_log_level(config.log_level));
+  ops::set_log_level(ops::parse_log_level(config.log_level));
 
   // Signals are taken synchronously by this thread; block them before any thread starts so no
   // other thread receives them.
@@ -33,19 +32,20 @@ int main(int argc, char** argv) {
   sigaddset(&signals, SIGINT);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-  std::unique_ptr<LabelServer> server;
+  std::unique_ptr<rpc::LabelServer> server;
   try {
-    server = std::make_unique<LabelServer>(config);
-  } catch (const ConfigError& error) {  // settings that contradict the repository: as bad usage
+    server = std::make_unique<rpc::LabelServer>(config);
+  } catch (const ops::ConfigError& error) {
+    // Settings that contradict the repository: as bad usage.
     std::fprintf(stderr, "%s\n", error.message.c_str());
     return error.exit_code;
   } catch (const std::exception& e) {
-    log_error("startup_failed").kv("error", e.what());
+    ops::log_error("startup_failed").kv("error", e.what());
     return kExitFailure;
   }
   int signal_number = 0;
   sigwait(&signals, &signal_number);
-  log_info("signal").kv("signal", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
+  ops::log_info("signal").kv("signal", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
   server->shutdown(std::chrono::milliseconds(static_cast<long long>(config.drain_seconds * 1e3)));
   server.reset();
   return kExitOk;

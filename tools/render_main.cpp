@@ -19,8 +19,8 @@
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
+#include "primlabel/overlays/object_overlays.hpp"
 #include "primlabel/primitives/primitives_json.hpp"
-#include "primlabel/render/box_outlines.hpp"
 #include "primlabel/render/colorize.hpp"
 #include "primlabel/render/primitive_outlines.hpp"
 #include "primlabel/render/render.hpp"
@@ -105,8 +105,8 @@ std::vector<Overlay> outlines_from(const std::string& path, double min_confidenc
   }
 }
 
-// The table's hull and every table-top object's axis-aligned box in `path` (objects_json.hpp),
-// in one colour each: hull grey, boxes black with their ids.
+// The table's hull and every table-top object's axis-aligned box in `path` (objects_json.hpp), as
+// primlabel label --png draws them (object_overlays.hpp).
 std::vector<Overlay> object_boxes_from(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw RunError("cannot read objects file '" + path + "'");
@@ -118,12 +118,7 @@ std::vector<Overlay> object_boxes_from(const std::string& path) {
   } catch (const std::invalid_argument& e) {
     throw RunError(path + ": " + e.what());
   }
-  std::vector<LabeledBox> boxes;
-  for (const tabletop::TabletopObject& o : objects.objects)
-    if (o.points > 0)
-      boxes.push_back({o.bounds_min.cast<float>(), o.bounds_max.cast<float>(),
-                       "object " + std::to_string(o.id)});
-  return table_top_outlines(objects.table ? objects.table->hull : std::vector<Vec3f>{}, boxes);
+  return object_overlays(objects);
 }
 
 int run(const Arguments& args) {

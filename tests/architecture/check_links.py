@@ -24,6 +24,15 @@ def project_library(entry):
     return entry if entry.startswith("primlabel_") else None
 
 
+def report(errors, passed):
+    """Prints each error as a FAIL line, or `passed` when there is none; the exit code."""
+    for error in errors:
+        print("FAIL:", error)
+    if not errors:
+        print(passed)
+    return 1 if errors else 0
+
+
 def main():
     links, allowed = read(sys.argv[1]), read(sys.argv[2])
     errors = []
@@ -35,11 +44,7 @@ def main():
             library = project_library(entry)
             if library and library not in allowed[target]:
                 errors.append(f"{target} links {library}, which its layer does not allow")
-    for error in errors:
-        print("FAIL:", error)
-    if not errors:
-        print(f"{len(links)} libraries keep to their layers")
-    return 1 if errors else 0
+    return report(errors, f"{len(links)} libraries keep to their layers")
 
 
 if __name__ == "__main__":

@@ -7,7 +7,7 @@ import os
 import re
 import sys
 
-from check_links import project_library, read
+from check_links import project_library, read, report
 
 GRPC_LIBRARY = re.compile(r"grpc", re.IGNORECASE)
 GRPC_INCLUDE = re.compile(r'^\s*#\s*include\s*[<"](grpc[^>"]*|[^>"]*\.grpc\.pb\.h)[>"]', re.M)
@@ -47,11 +47,7 @@ def main():
                 files += 1
                 for match in GRPC_INCLUDE.finditer(open(path, encoding="utf-8").read()):
                     errors.append(f"{path} includes {match.group(1)}")
-    for error in errors:
-        print("FAIL:", error)
-    if not errors:
-        print(f"{target}: {len(libraries)} libraries reached and {files} files, none of gRPC")
-    return 1 if errors else 0
+    return report(errors, f"{target}: {len(libraries)} libraries reached and {files} files, none of gRPC")
 
 
 if __name__ == "__main__":

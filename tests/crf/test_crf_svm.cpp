@@ -5,9 +5,9 @@
 #include <fstream>
 #include <stop_token>
 
+#include "crf_scenes.hpp"
 #include "primlabel/geometry/cancellation.hpp"
 #include "primlabel/model/svm_baseline.hpp"
-#include "crf_scenes.hpp"
 #include "test_util.hpp"
 
 namespace primlabel::crf {
@@ -24,10 +24,8 @@ TEST(CrfSvm, LearnsASeparableProblem) {
   spec.num_classes = 3;
   spec.dim = 8;
   spec.noise = 5.0f;  // prototypes are ~100 apart: separable
-  spec.seed = 1;
-  const std::vector<LabeledGraph> train = {testing::make_grid_scene(spec)};
-  spec.seed = 2;
-  LabeledGraph test = testing::make_grid_scene(spec);
+  auto [train_scene, test] = testing::held_out_scenes(spec, 1, 2);
+  const std::vector<LabeledGraph> train = {std::move(train_scene)};
   test.descriptors.row(5)[0] = std::nanf("");
 
   SvmOptions options;
@@ -68,10 +66,8 @@ NoisyProblem noisy_problem() {
   spec.num_classes = 3;
   spec.dim = 8;
   spec.noise = 40.0f;
-  spec.seed = 3;
-  const std::vector<LabeledGraph> train = {testing::make_grid_scene(spec)};
-  spec.seed = 4;
-  LabeledGraph test = testing::make_grid_scene(spec);
+  auto [train_scene, test] = testing::held_out_scenes(spec, 3, 4);
+  const std::vector<LabeledGraph> train = {std::move(train_scene)};
   SvmOptions options;
   options.max_training_points = 200;
   return {spec, std::move(test), SvmClassifier::train(train, {11, 12, 13}, options)};

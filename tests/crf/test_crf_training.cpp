@@ -5,12 +5,13 @@
 #include <cstdio>
 #include <random>
 #include <sstream>
+#include <string>
 
 #include "brute_force.hpp"
+#include "crf_scenes.hpp"
 #include "learning/objectives.hpp"  // white-box: the objectives behind train_crf
 #include "primlabel/crf/inference.hpp"
 #include "primlabel/crf/training.hpp"
-#include "crf_scenes.hpp"
 
 namespace primlabel::crf {
 namespace {
@@ -67,65 +68,66 @@ detail::ParameterShape shape_of(const CrfModel& like, bool edges) {
   return {like.num_classes(), like.node_feature_dim() - 1, like.descriptor_dim, edges};
 }
 
-TEST(CrfTraining, PseudoLikelihoodAndNodeOnlyGradientsMatchFiniteDifferences) {
+// Calls check(prepared, shape, what) on scenes 1 and 2 prepared for three classes in each basis
+// (linear, tent knots), with edges (pseudo-likelihood) and without (node-only); `what` names the
+// case for a failure message.
+template <class Check>
+void for_each_objective_setup(Check check) {
   const std::vector<LabeledGraph> scenes = {small_scene(1), small_scene(2)};
   for (const auto& knots : {std::vector<float>{}, kKnots}) {
     const CrfModel like = CrfModel::zeros(ids(3), 5, 0.01f, knots);
     for (const bool edges : {true, false}) {
       const auto prepared = detail::prepare_scenes(scenes, like, edges);
-      const detail::ParameterShape shape = shape_of(like, edges);
-      auto objective = detail::make_pseudo_likelihood(prepared, shape, 2);
-      const Eigen::VectorXd x = random_parameters(shape.size(), 3, 1.0);
-      EXPECT_LT(gradient_error(*objective, x, 1e-5), 1e-7)
-          << (edges ? "PL" : "node-only") << ", " << knots.size() << " knots";
+      const std::string what =
+          std::string(edges ? "PL" : "node-only") + ", " + std::to_string(knots.size()) + " knots";
+      check(prepared, shape_of(like, edges), what);
     }
   }
+}
+
+TEST(CrfTraining, PseudoLikelihoodAndNodeOnlyGradientsMatchFiniteDifferences) {
+  for_each_objective_setup(
+      [](const auto& prepared, const detail::ParameterShape& shape, const std::string& what) {
+        auto objective = detail::make_pseudo_likelihood(prepared, shape, 2);
+        const Eigen::VectorXd x = random_parameters(shape.size(), 3, 1.0);
+        EXPECT_LT(gradient_error(*objective, x, 1e-5), 1e-7) << what;
+      });
 }
 
 // Class weights scale each point's term by its label's weight: the analytic gradient still matches
 // central differences, for pseudo-likelihood and node-only, in both bases.
 TEST(CrfTraining, WeightedGradientsMatchFiniteDifferences) {
-  const std::vector<LabeledGraph> scenes = {small_scene(1), small_scene(2)};
   const std::vector<double> weights = {0.3, 1.0, 4.5};
-  for (const auto& knots : {std::vector<float>{}, kKnots}) {
-    const CrfModel like = CrfModel::zeros(ids(3), 5, 0.01f, knots);
-    for (const bool edges : {true, false}) {
-      const auto prepared = detail::prepare_scenes(scenes, like, edges);
-      const detail::ParameterShape shape = shape_of(like, edges);
-      auto weighted = detail::make_pseudo_likelihood(prepared, shape, 2, weights);
-      auto plain = detail::make_pseudo_likelihood(prepared, shape, 2);
-      const Eigen::VectorXd x = random_parameters(shape.size(), 3, 1.0);
-      EXPECT_LT(gradient_error(*weighted, x, 1e-5), 1e-7)
-          << (edges ? "PL" : "node-only") << ", " << knots.size() << " knots";
-      Eigen::VectorXd g(x.size());
-      EXPECT_GT(std::abs(weighted->evaluate(x, g) - plain->evaluate(x, g)), 1e-3);  // it bites
-    }
-  }
+  for_each_objective_setup(
+      [&](const auto& prepared, const detail::ParameterShape& shape, const std::string& what) {
+        auto weighted = detail::make_pseudo_likelihood(prepared, shape, 2, weights);
+        auto plain = detail::make_pseudo_likelihood(prepared, shape, 2);
+        const Eigen::VectorXd x = random_parameters(shape.size(), 3, 1.0);
+        EXPECT_LT(gradient_error(*weighted, x, 1e-5), 1e-7) << what;
+        Eigen::VectorXd g(x.size());
+        EXPECT_GT(std::abs(weighted->evaluate(x, g) - plain->evaluate(x, g)), 1e-3);  // it bites
+      });
 }
 
 // alpha = 0 is today's objective exactly: unit weights give the same value and gradient bit for
 // bit, equal weights of any size within rounding (only ratios matter), and train_crf the same
 // model.
 TEST(CrfTraining, UnitClassWeightsAreTheUnweightedObjective) {
+  for_each_objective_setup([](const auto& prepared, const detail::ParameterShape& shape,
+                              const std::string& what) {
+    const Eigen::VectorXd x = random_parameters(shape.size(), 5, 1.0);
+    Eigen::VectorXd g_plain(x.size()), g_unit(x.size()), g_equal(x.size());
+    const double plain = detail::make_pseudo_likelihood(prepared, shape, 2)->evaluate(x, g_plain);
+    const double unit =
+        detail::make_pseudo_likelihood(prepared, shape, 2, {1.0, 1.0, 1.0})->evaluate(x, g_unit);
+    const double equal =
+        detail::make_pseudo_likelihood(prepared, shape, 2, {2.5, 2.5, 2.5})->evaluate(x, g_equal);
+    EXPECT_EQ(plain, unit) << what;
+    EXPECT_TRUE(g_plain.cwiseEqual(g_unit).all()) << what;
+    EXPECT_NEAR(plain, equal, 1e-12) << what;
+    EXPECT_LT((g_plain - g_equal).cwiseAbs().maxCoeff(), 1e-12) << what;
+  });
   const std::vector<LabeledGraph> scenes = {small_scene(1), small_scene(2)};
-  for (const auto& knots : {std::vector<float>{}, kKnots}) {
-    const CrfModel like = CrfModel::zeros(ids(3), 5, 0.01f, knots);
-    for (const bool edges : {true, false}) {
-      const auto prepared = detail::prepare_scenes(scenes, like, edges);
-      const detail::ParameterShape shape = shape_of(like, edges);
-      const Eigen::VectorXd x = random_parameters(shape.size(), 5, 1.0);
-      Eigen::VectorXd g_plain(x.size()), g_unit(x.size()), g_equal(x.size());
-      const double plain = detail::make_pseudo_likelihood(prepared, shape, 2)->evaluate(x, g_plain);
-      const double unit =
-          detail::make_pseudo_likelihood(prepared, shape, 2, {1.0, 1.0, 1.0})->evaluate(x, g_unit);
-      const double equal =
-          detail::make_pseudo_likelihood(prepared, shape, 2, {2.5, 2.5, 2.5})->evaluate(x, g_equal);
-      EXPECT_EQ(plain, unit);
-      EXPECT_TRUE(g_plain.cwiseEqual(g_unit).all());
-      EXPECT_NEAR(plain, equal, 1e-12);
-      EXPECT_LT((g_plain - g_equal).cwiseAbs().maxCoeff(), 1e-12);
-    }
-  }
   const std::vector<std::uint64_t> counts = {500, 30, 2};
   TrainingOptions options;
   options.objective = TrainingObjective::kNodeOnly;
@@ -272,10 +274,9 @@ TEST(CrfTraining, CrfBeatsNodeOnlyOnHeldOutData) {
   spec.height = 48;
   spec.num_classes = 3;
   spec.noise = 100.0f;
-  spec.seed = 1;
-  const std::vector<LabeledGraph> train = {testing::make_grid_scene(spec)};
-  spec.seed = 2;
-  const std::vector<LabeledGraph> test = {testing::make_grid_scene(spec)};
+  auto scenes = testing::held_out_scenes(spec, 1, 2);
+  const std::vector<LabeledGraph> train = {std::move(scenes.train)};
+  const std::vector<LabeledGraph> test = {std::move(scenes.test)};
   InferenceSettings inference;
   const auto run = [&](TrainingObjective objective) {
     TrainingOptions options;

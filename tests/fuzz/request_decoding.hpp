@@ -11,17 +11,17 @@
 
 namespace primlabel::fuzz {
 
-inline bool refused(const std::optional<server::ServiceError>& error) { return error.has_value(); }
+inline bool refused(const std::optional<service::ServiceError>& error) { return error.has_value(); }
 
 // The server's defaults (server_config.hpp: --max-points, --max-request-bytes).
-inline server::ScanLimits server_default_limits() { return {10'000'000, 512ull << 20}; }
+inline service::ScanLimits server_default_limits() { return {10'000'000, 512ull << 20}; }
 
 // Decodes one scan: `header`, then `chunks` in order. True when the server would label it.
 inline bool decode_scan(const v1::ScanHeader& header,
                         const std::vector<const v1::PointChunk*>& chunks,
-                        const server::ScanLimits& limits) {
-  if (refused(server::check_header(header, limits))) return false;
-  server::ScanAssembler assembler(header, limits);
+                        const service::ScanLimits& limits) {
+  if (refused(service::check_header(header, limits))) return false;
+  service::ScanAssembler assembler(header, limits);
   for (const v1::PointChunk* chunk : chunks)
     if (refused(assembler.add(*chunk))) return false;
   return !refused(assembler.finish());

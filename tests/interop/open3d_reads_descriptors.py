@@ -12,19 +12,15 @@ import sys
 import tempfile
 from pathlib import Path
 
-try:
-    import numpy as np
-    import open3d as o3d
-except ImportError:
-    print("python3-open3d not installed: skipped")
-    sys.exit(77)
+from open3d_support import import_open3d, synth_scene
+
+np, o3d = import_open3d()
 
 build = Path(sys.argv[1])
 with tempfile.TemporaryDirectory() as tmp:
     scene = Path(tmp) / "scene.pcd"
     features = Path(tmp) / "features.pcd"
-    subprocess.run([build / "bin/primlabel-synth", "--sensor", "lms400", "--seed", "5", "-o", scene,
-                    "-q"], check=True)
+    synth_scene(build, scene)
     subprocess.run([build / "bin/primlabel-features", scene, "-o", features], check=True,
                    stdout=subprocess.DEVNULL)
     cloud = o3d.t.io.read_point_cloud(str(features))

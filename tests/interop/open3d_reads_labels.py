@@ -5,23 +5,18 @@ Usage: open3d_reads_labels.py BUILD_DIR. Writes a synthetic labeled scene as PLY
 Open3D's tensor reader and checks every point's label against the file's body read with numpy
 from the header's layout. Exits 77 (skipped) without open3d.
 """
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
-try:
-    import numpy as np
-    import open3d as o3d
-except ImportError:
-    print("python3-open3d not installed: skipped")
-    sys.exit(77)
+from open3d_support import import_open3d, synth_scene
+
+np, o3d = import_open3d()
 
 build = Path(sys.argv[1])
 with tempfile.TemporaryDirectory() as tmp:
     ply = Path(tmp) / "scene.ply"
-    subprocess.run([build / "bin/primlabel-synth", "--sensor", "lms400", "--seed", "5", "-o", ply,
-                    "-q"], check=True)
+    synth_scene(build, ply)
     cloud = o3d.t.io.read_point_cloud(str(ply))
     assert "label" in cloud.point, f"Open3D found no label attribute: {cloud.point}"
     labels = cloud.point["label"].numpy().ravel()

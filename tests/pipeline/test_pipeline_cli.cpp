@@ -20,6 +20,7 @@
 #include "primlabel/primitives/primitives_json.hpp"
 #include "primlabel/synth/generate.hpp"
 #include "primlabel/tabletop/objects_json.hpp"
+#include "random_label_model.hpp"
 #include "tabletop_objects_scene.hpp"
 #include "test_util.hpp"
 
@@ -42,10 +43,7 @@ class PipelineCli : public ::testing::Test {
                         ("primlabel_pipeline_cli_" + std::to_string(::getpid())));
     fs::create_directories(*dir_);
     // An all-zero node-only model: loads and labels instantly (the trained one is tested below).
-    LabelModel zero;
-    zero.kind = ModelKind::kNodeOnly;
-    zero.weights = crf::CrfModel::zeros({1, 2, 4}, kFpfhSize);
-    save_model(zero_model_path(), zero);
+    save_model(zero_model_path(), testing::zero_node_model());
     synth::GenerateOptions options;
     options.seed = synth::set_seed(synth::SceneSet::kTest, 0);
     const synth::Generated scene = synth::generate(options);

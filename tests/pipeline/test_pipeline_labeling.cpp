@@ -15,6 +15,7 @@
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
 #include "primlabel/synth/generate.hpp"
+#include "random_label_model.hpp"
 #include "training_scenes.hpp"
 
 namespace primlabel {
@@ -57,12 +58,6 @@ LabelModel with_coupling(LabelModel model, float coupling) {
 }
 
 // Untrained: all-zero weights over three classes (labels every described point "plane").
-LabelModel zero_model() {
-  LabelModel model;
-  model.kind = ModelKind::kNodeOnly;
-  model.weights = crf::CrfModel::zeros({1, 2, 4}, kFpfhSize);
-  return model;
-}
 
 PointCloud small_scene() {
   PointCloud scene = synth::synthetic_scene(synth::SceneSet::kTest, 1, synth::SensorKind::kLms400);
@@ -237,7 +232,7 @@ TEST(PipelineLabeling, UnlabelablePointsGetUnknown) {
   cloud.xyz.push_back(Vec3f(50, 50, 50));  // isolated: no normal, so no descriptor
   cloud.labels.push_back(0);
   cloud.width = std::uint32_t(cloud.xyz.size());
-  const auto result = pipeline::label_cloud(zero_model(), cloud, {});
+  const auto result = pipeline::label_cloud(testing::zero_node_model(), cloud, {});
   EXPECT_EQ(result.labels.front(), 0u);
   EXPECT_EQ(result.labels.back(), 0u);
   EXPECT_GT(result.labeled_points, cloud.size() / 2);

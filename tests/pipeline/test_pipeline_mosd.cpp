@@ -13,6 +13,7 @@
 #include "primlabel/geometry/cloud_signature.hpp"
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/research/mosd_report.hpp"
+#include "random_label_model.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -22,15 +23,8 @@ std::string mosd(const std::string& name) {
   return std::string(PRIMLABEL_SHARED_DATA) + "/mosd/" + name + ".pcd";
 }
 
-LabelModel zero_model() {
-  LabelModel model;
-  model.kind = ModelKind::kNodeOnly;
-  model.weights = crf::CrfModel::zeros({1, 2, 4}, kFpfhSize);
-  // Small radii: fast on 300k points; the labels do not matter here.
-  model.features.normals = Neighborhood::Radius(0.008f);
-  model.features.features = Neighborhood::Radius(0.012f);
-  return model;
-}
+// Small radii: fast on 300k points; the labels do not matter here.
+LabelModel zero_model() { return testing::zero_node_model(0.008f, 0.012f); }
 
 TEST(PipelineMosd, ReportCountsTablePointsAndDrawsTheScene) {
   const std::string path = mosd("learn0");

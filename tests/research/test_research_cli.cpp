@@ -16,6 +16,7 @@
 #include "primlabel/geometry/json_text.hpp"
 #include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/model/label_model.hpp"
+#include "random_label_model.hpp"
 #include "test_util.hpp"
 
 namespace primlabel {
@@ -39,12 +40,7 @@ class ResearchCli : public ::testing::Test {
                         ("primlabel_research_cli_" + std::to_string(::getpid())));
     fs::create_directories(*dir_);
     // An all-zero node-only model with small radii: fast on a 640x480 frame, labels all plane.
-    LabelModel zero;
-    zero.kind = ModelKind::kNodeOnly;
-    zero.weights = crf::CrfModel::zeros({1, 2, 4}, kFpfhSize);
-    zero.features.normals = Neighborhood::Radius(0.008f);
-    zero.features.features = Neighborhood::Radius(0.012f);
-    save_model(model_path(), zero);
+    save_model(model_path(), testing::zero_node_model(0.008f, 0.012f));
   }
   static void TearDownTestSuite() {
     fs::remove_all(*dir_);

@@ -44,8 +44,8 @@ inline fs::path write_model(const fs::path& root, const LabelModel& model) {
   return dir / "model.plm";
 }
 
-inline server::ServerConfig test_config(const fs::path& models) {
-  server::ServerConfig config;
+inline ops::ServerConfig test_config(const fs::path& models) {
+  ops::ServerConfig config;
   config.models_dir = models.string();
   config.listen = "127.0.0.1:0";
   config.metrics_listen = "127.0.0.1:0";

@@ -155,18 +155,18 @@ inline std::string health_status(const std::shared_ptr<grpc::Channel>& channel,
 // An in-process server over a fresh repository holding `models`.
 struct TestServer {
   explicit TestServer(const std::vector<LabelModel>& models,
-                      const std::function<void(server::ServerConfig&)>& adjust = {})
+                      const std::function<void(ops::ServerConfig&)>& adjust = {})
       : repo("repo") {
     for (const LabelModel& model : models) write_model(repo.path(), model);
-    server::ServerConfig config = test_config(repo.path());
+    ops::ServerConfig config = test_config(repo.path());
     if (adjust) adjust(config);
-    server = std::make_unique<server::LabelServer>(config);
+    server = std::make_unique<rpc::LabelServer>(config);
     channel = channel_to(server->port());
     stub = v1::Labeler::NewStub(channel);
     admin = v1::ModelAdmin::NewStub(channel);
   }
   TempDir repo;
-  std::unique_ptr<server::LabelServer> server;
+  std::unique_ptr<rpc::LabelServer> server;
   std::shared_ptr<grpc::Channel> channel;
   std::unique_ptr<v1::Labeler::Stub> stub;
   std::unique_ptr<v1::ModelAdmin::Stub> admin;
@@ -175,7 +175,7 @@ struct TestServer {
 // The reference: label_cloud in process with the same model and the options the server takes
 // from a header that asks for nothing (service/label_options.hpp: the plane cascade on).
 inline std::vector<std::uint32_t> reference_labels(const LabelModel& model, PointCloud cloud) {
-  return pipeline::label_cloud(model, cloud, server::labeling_options(v1::ScanHeader{})).labels;
+  return pipeline::label_cloud(model, cloud, service::labeling_options(v1::ScanHeader{})).labels;
 }
 
 }  // namespace primlabel::servertest

@@ -26,7 +26,7 @@ grpc::Status call_with_token(Call call, const Request& request, Response& respon
 
 TEST(AdminService, LoadUnloadAndReloadFollowHealthAndMetrics) {
   TestServer server({random_label_model("m", "1")},
-                    [](server::ServerConfig& c) { c.insecure_admin = true; });
+                    [](ops::ServerConfig& c) { c.insecure_admin = true; });
   auto& admin = *server.admin;
   v1::UnloadModelRequest unload;
   unload.set_model("m");
@@ -80,7 +80,7 @@ TEST(AdminService, LoadUnloadAndReloadFollowHealthAndMetrics) {
 
 TEST(AdminService, PollingPicksUpNewVersions) {
   TestServer server({random_label_model("m", "1")},
-                    [](server::ServerConfig& c) { c.reload_seconds = 0.05; });
+                    [](ops::ServerConfig& c) { c.reload_seconds = 0.05; });
   write_model(server.repo.path(), random_label_model("m", "2"));
   std::string served;
   for (int i = 0; i < 400 && served != "2"; ++i) {
@@ -95,7 +95,7 @@ TEST(AdminService, PollingPicksUpNewVersions) {
 
 TEST(TokenAuth, AdminNeedsTheTokenLabelingOnlyWhenAskedTo) {
   TestServer server({random_label_model("m", "1")},
-                    [](server::ServerConfig& c) { c.token = "s3cret"; });
+                    [](ops::ServerConfig& c) { c.token = "s3cret"; });
   auto reload = [&](grpc::ClientContext* c, const v1::ReloadModelsRequest& r,
                     v1::ReloadModelsResponse* out) {
     return server.admin->ReloadModels(c, r, out);
@@ -110,7 +110,7 @@ TEST(TokenAuth, AdminNeedsTheTokenLabelingOnlyWhenAskedTo) {
   const PointCloud cloud = table_with_box_cloud(0.02f);
   EXPECT_TRUE(label_stream(*server.stub, scan_requests(cloud, header_for())).status.ok());
 
-  TestServer strict({random_label_model("m", "1")}, [](server::ServerConfig& c) {
+  TestServer strict({random_label_model("m", "1")}, [](ops::ServerConfig& c) {
     c.token = "s3cret";
     c.token_for_all = true;
   });
@@ -176,7 +176,7 @@ TEST(Tls, ServerTlsAndMutualTls) {
     return label_stream(*stub, scan_requests(cloud, header_for()), std::chrono::seconds(20)).status;
   };
   {
-    TestServer server({random_label_model()}, [&](server::ServerConfig& c) {
+    TestServer server({random_label_model()}, [&](ops::ServerConfig& c) {
       c.tls_cert = certs.path("server.pem");
       c.tls_key = certs.path("server.key");
     });
@@ -184,7 +184,7 @@ TEST(Tls, ServerTlsAndMutualTls) {
     EXPECT_TRUE(secure.ok()) << secure.error_message();
     EXPECT_EQ(labels_over(server.channel).error_code(), grpc::StatusCode::UNAVAILABLE);
   }
-  TestServer mutual({random_label_model()}, [&](server::ServerConfig& c) {
+  TestServer mutual({random_label_model()}, [&](ops::ServerConfig& c) {
     c.tls_cert = certs.path("server.pem");
     c.tls_key = certs.path("server.key");
     c.tls_client_ca = certs.path("ca.pem");

@@ -9,7 +9,7 @@
 
 #include "primlabel/service/admission.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 namespace {
 
 TEST(Admission, AdmitsWorkersPlusQueueThenRefuses) {
@@ -81,4 +81,4 @@ TEST(Admission, JobsRunInSubmissionOrderOnOneWorker) {
 }
 
 }  // namespace
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -7,7 +7,7 @@
 #include "primlabel/service/answer_size.hpp"
 #include "primlabel/service/label_response.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 namespace {
 
 pipeline::LabelingResult every_array(std::size_t points, int dim, int classes) {
@@ -48,4 +48,4 @@ TEST(AnswerSize, AChunkCarriesTheArraysPerPointAndAsManyPointsAsFit) {
 }
 
 }  // namespace
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -18,7 +18,7 @@ class BadInput : public ::testing::Test {
   BadInput()
       : model_(random_label_model("m", "1")),
         server_({model_},
-                [](server::ServerConfig& c) {
+                [](ops::ServerConfig& c) {
                   c.max_points = 50000;
                   c.insecure_admin = true;  // the reload race below needs ReloadModels
                   c.max_receiving_streams = 3;

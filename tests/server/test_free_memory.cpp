@@ -7,7 +7,7 @@
 
 #include "primlabel/service/free_memory.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 namespace {
 
 using std::chrono::milliseconds;
@@ -60,4 +60,4 @@ TEST(IdleMemoryTrimmer, APendingTrimGoesWithTheTrimmer) {
 }
 
 }  // namespace
-}  // namespace primlabel::server
+}  // namespace primlabel::service

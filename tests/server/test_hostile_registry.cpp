@@ -16,15 +16,15 @@
 namespace primlabel::servertest {
 namespace {
 
-using server::kLabelerServiceName;
-using server::ModelRegistry;
-using server::RegistryError;
+using rpc::kLabelerServiceName;
+using service::ModelRegistry;
+using service::RegistryError;
 using testing::random_label_model;
 using testing::table_with_box_cloud;
 
 constexpr std::size_t kShortMessage = 1000;  // a status naming a huge string stays this short
 
-void insecure_admin(server::ServerConfig& config) { config.insecure_admin = true; }
+void insecure_admin(ops::ServerConfig& config) { config.insecure_admin = true; }
 
 grpc::Status unload(TestServer& server, const std::string& model, const std::string& version = "") {
   v1::UnloadModelRequest request;
@@ -146,7 +146,7 @@ TEST(HostileAdmin, AnUnloadLastsUntilTheNextReload) {
 
 TEST(HostileRegistry, AModelDirectoryMovedAwayAndBackUnderLoadKeepsServing) {
   // Polls every 50 ms; a version must be missing at 40 scans in a row (2 s) to go.
-  TestServer server({random_label_model("m", "1")}, [](server::ServerConfig& c) {
+  TestServer server({random_label_model("m", "1")}, [](ops::ServerConfig& c) {
     c.reload_seconds = 0.05;
     c.unload_after_missing_polls = 40;
   });
@@ -174,7 +174,7 @@ TEST(HostileRegistry, AVersionGoesOnlyAfterMissingAtSeveralScans) {
   const fs::path away = repo.path() / ".away";
   fs::rename(repo.path() / "m", away);
   for (int scan = 1; scan <= 2; ++scan) {
-    const server::ReloadReport report = registry.rescan();
+    const service::ReloadReport report = registry.rescan();
     EXPECT_EQ(report.missing, 1u) << scan;
     EXPECT_EQ(report.removed, 0u) << scan;
     EXPECT_EQ(registry.resolve("", "")->version, "1");
@@ -376,7 +376,7 @@ TEST(HostileInput, MegabyteNamesAndScanIdsGiveShortStatusesLogsAndNoMetricSeries
 
 TEST(HostileRegistry, HealthAndGaugesFollowTheRegistryWhoeverChangesIt) {
   TestServer server({random_label_model("m", "1")},
-                    [](server::ServerConfig& c) { c.unload_after_missing_polls = 1; });
+                    [](ops::ServerConfig& c) { c.unload_after_missing_polls = 1; });
   auto& registry = server.server->registry();
   auto gauge = [&] {
     return scrape::sum_samples(scrape_metrics(server.server->metrics_port()),

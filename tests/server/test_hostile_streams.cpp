@@ -60,7 +60,7 @@ struct OpenStream {
 
 TEST(HostileStreams, IdleStreamsBeyondTheBudgetDoNotStopALegitimateRequest) {
   const LabelModel model = random_label_model("m", "1");
-  TestServer server({model}, [](server::ServerConfig& c) {
+  TestServer server({model}, [](ops::ServerConfig& c) {
     c.max_receiving_streams = 4;
     c.stream_idle_seconds = 0.5;
   });
@@ -117,7 +117,7 @@ TEST(HostileStreams, IdleStreamsBeyondTheBudgetDoNotStopALegitimateRequest) {
 
 TEST(HostileStreams, SlowDripBelowTheMinimumRateIsCut) {
   const LabelModel model = random_label_model("m", "1");
-  TestServer server({model}, [](server::ServerConfig& c) {
+  TestServer server({model}, [](ops::ServerConfig& c) {
     c.min_receive_bytes_per_second = 50000;
     c.receive_rate_window_seconds = 0.25;
   });
@@ -140,7 +140,7 @@ TEST(HostileStreams, SlowDripBelowTheMinimumRateIsCut) {
 
 TEST(HostileStreams, ClientsThatNeverReadAreCancelledAndTheirMemoryFreed) {
   const LabelModel model = random_label_model("m", "1");
-  TestServer server({model}, [](server::ServerConfig& c) {
+  TestServer server({model}, [](ops::ServerConfig& c) {
     c.send_timeout_seconds = 0.5;
     c.workers = 1;
     c.queue = 8;
@@ -193,7 +193,7 @@ TEST(HostileStreams, ClientsThatNeverReadAreCancelledAndTheirMemoryFreed) {
 }
 
 TEST(HostileStreams, FiveHundredIdleStreamsDoNotTakeFiveHundredThreads) {
-  TestServer server({random_label_model("m", "1")}, [](server::ServerConfig& c) {
+  TestServer server({random_label_model("m", "1")}, [](ops::ServerConfig& c) {
     c.max_receiving_streams = 600;
     c.stream_idle_seconds = 60;
   });
@@ -212,7 +212,7 @@ TEST(HostileStreams, FiveHundredIdleStreamsDoNotTakeFiveHundredThreads) {
 
 TEST(HostileStreams, DeadlinesAreCountedAsDeadlineExceeded) {
   TestServer server({random_label_model("m", "1")},
-                    [](server::ServerConfig& c) { c.max_request_seconds = 0.3; });
+                    [](ops::ServerConfig& c) { c.max_request_seconds = 0.3; });
   // ~130k points: about a second of work on an idle machine, several under load, so both
   // deadlines below (150 ms, 0.3 s) always expire first.
   const PointCloud big = table_with_box_cloud(0.002f);
@@ -239,7 +239,7 @@ TEST(HostileStreams, DeadlinesAreCountedAsDeadlineExceeded) {
 
 TEST(HostileStreams, LabelCloudOverTheMessageLimitIsRefusedBeforeLabeling) {
   TestServer server({random_label_model("m", "1")},
-                    [](server::ServerConfig& c) { c.max_message_bytes = 1 << 20; });
+                    [](ops::ServerConfig& c) { c.max_message_bytes = 1 << 20; });
   const PointCloud cloud = table_with_box_cloud(0.004f);  // ~33k points: 400 kB in, 4.5 MB out
   v1::ScanHeader header = header_for();
   header.mutable_options()->set_return_descriptors(true);

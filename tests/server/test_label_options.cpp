@@ -8,7 +8,7 @@
 #include "primlabel/service/label_options.hpp"
 #include "random_label_model.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 namespace {
 
 TEST(LabelOptions, EveryFieldOfTheRequestReachesThePipeline) {
@@ -68,4 +68,4 @@ TEST(LabelOptions, RefusalsNameTheRequestsFieldsAndTheModel) {
 }
 
 }  // namespace
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -330,7 +330,7 @@ TEST(LabelService, LatestOrPinnedVersionAndExplicitVersions) {
     EXPECT_EQ(answer.summary->model_version(), "2");
     EXPECT_EQ(answer.labels, reference_labels(v2, cloud));
   }
-  TestServer pinned({v2, v10}, [](server::ServerConfig& c) { c.pins["m"] = "2"; });
+  TestServer pinned({v2, v10}, [](ops::ServerConfig& c) { c.pins["m"] = "2"; });
   const LabelAnswer answer = label_cloud(*pinned.stub, cloud, header_for("m"));
   ASSERT_TRUE(answer.status.ok());
   EXPECT_EQ(answer.summary->model_version(), "2");
@@ -340,7 +340,7 @@ TEST(LabelService, ListModelsAndMetadata) {
   LabelModel a = random_label_model("alpha", "1");
   a.validation.accuracy = 0.75;
   const LabelModel b = random_label_model("beta", "3");
-  TestServer server({a, b}, [](server::ServerConfig& c) { c.default_model = "beta"; });
+  TestServer server({a, b}, [](ops::ServerConfig& c) { c.default_model = "beta"; });
   grpc::ClientContext context;
   v1::ListModelsResponse list;
   ASSERT_TRUE(server.stub->ListModels(&context, {}, &list).ok());

@@ -14,9 +14,9 @@
 namespace primlabel::servertest {
 namespace {
 
-using server::ModelRegistry;
-using server::RegistryError;
-using server::version_less;
+using service::ModelRegistry;
+using service::RegistryError;
+using service::version_less;
 using testing::random_label_model;
 
 ModelRegistry registry_over(const fs::path& root, const std::string& default_model = "",

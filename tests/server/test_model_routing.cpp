@@ -62,7 +62,7 @@ TEST(ModelRouting, AFrameNamingNoModelGoesToTheModelTrainedOnFramesOfItsSize) {
   // The scanner model fits the cloud's signature too: the frame's shape decides before it.
   const LabelModel camera = model_with_domain("cam", width, 2, signature, false);
   const LabelModel scanner = model_with_domain("laser", 0, 0, signature, true);
-  TestServer server({camera, scanner}, [](server::ServerConfig& c) { c.default_model = "laser"; });
+  TestServer server({camera, scanner}, [](ops::ServerConfig& c) { c.default_model = "laser"; });
   for (bool streamed : {true, false}) {
     const LabelAnswer answer =
         streamed ? label_stream(*server.stub, scan_requests(cloud, frame_header(cloud)))
@@ -96,7 +96,7 @@ TEST(ModelRouting, AnUnorganisedCloudGoesToTheOnlyModelItsSignatureFits) {
   const auto signature = measure_signature(cloud.xyz, cloud.viewpoint.origin);
   const LabelModel near = model_with_domain("near", 640, 480, signature, true);
   const LabelModel far = model_with_domain("far", 0, 0, signature, false);
-  TestServer server({far, near}, [](server::ServerConfig& c) { c.default_model = "far"; });
+  TestServer server({far, near}, [](ops::ServerConfig& c) { c.default_model = "far"; });
   const LabelAnswer answer = label_stream(*server.stub, scan_requests(cloud, header_for("")));
   ASSERT_TRUE(answer.status.ok()) << answer.status.error_message();
   EXPECT_EQ(answer.summary->model(), "near");
@@ -142,7 +142,7 @@ TEST(ModelRouting, TheDefaultFlagOverridesTheRepositorysFile) {
   const auto signature = measure_signature(cloud.xyz, cloud.viewpoint.origin);
   TestServer server({model_with_domain("a", 0, 0, signature, true),
                      model_with_domain("b", 0, 0, signature, true)},
-                    [](server::ServerConfig& c) { c.default_model = "a"; });
+                    [](ops::ServerConfig& c) { c.default_model = "a"; });
   declare_default(server, "b");
   EXPECT_EQ(server.server->registry().default_model(), "a");
   EXPECT_EQ(server.server->registry().default_source(), "flag");
@@ -194,7 +194,7 @@ TEST(ModelRouting, HostileCloudsNamingNoModelAreChosenForInBoundedTime) {
   const auto signature = measure_signature(table.xyz, table.viewpoint.origin);
   TestServer server({model_with_domain("a", 0, 0, signature, true),
                      model_with_domain("b", 0, 0, signature, false)},
-                    [](server::ServerConfig& c) { c.default_model = "b"; });
+                    [](ops::ServerConfig& c) { c.default_model = "b"; });
   const float nan = std::nanf("");
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> mm(0.0f, 0.001f);

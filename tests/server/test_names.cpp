@@ -9,7 +9,7 @@
 #include "primlabel/ops/stage_times.hpp"
 #include "primlabel/wire/status_names.hpp"
 
-namespace primlabel::server {
+namespace primlabel::ops {
 namespace {
 
 TEST(SharedNames, StatusCodesHaveTheirCanonicalNames) {
@@ -45,4 +45,4 @@ TEST(SharedNames, EachStageNamesItsOwnField) {
 }
 
 }  // namespace
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -19,9 +19,9 @@
 namespace primlabel::servertest {
 namespace {
 
+using ops::civetweb_listening_port;
+using ops::MetricsEndpoint;
 using scrape::sum_samples;
-using server::civetweb_listening_port;
-using server::MetricsEndpoint;
 using testing::random_label_model;
 using testing::table_with_box_cloud;
 
@@ -36,7 +36,7 @@ std::set<std::string> label_values(const std::vector<scrape::Sample>& samples,
 }
 
 TEST(ServerMetrics, ModelLabelTakesOnlyLoadedModels) {
-  server::ServerMetrics metrics;
+  ops::ServerMetrics metrics;
   metrics.set_models({{"tabletop", "2"}}, 2);
   for (int i = 0; i < 1000; ++i) {
     const std::string fake = "fake-" + std::to_string(i);
@@ -81,7 +81,7 @@ TEST(ServerMetrics, ARequestForAModelThatDoesNotExistCountsAsUnknown) {
 }
 
 TEST(ServerMetrics, BuildInfoNamesTheVersionAndGit) {
-  const auto samples = scrape::parse_exposition(server::ServerMetrics().serialize());
+  const auto samples = scrape::parse_exposition(ops::ServerMetrics().serialize());
   std::vector<scrape::Sample> info;
   for (const auto& sample : samples)
     if (sample.name == "primlabel_build_info") info.push_back(sample);
@@ -95,7 +95,7 @@ TEST(ServerMetrics, BuildInfoNamesTheVersionAndGit) {
 TEST(ProcessMetrics, ReadFromProcSelf) {
   const auto value = [](const std::string& name) {
     const auto samples = scrape::parse_exposition(
-        prometheus::TextSerializer().Serialize(server::ProcessCollector().Collect()));
+        prometheus::TextSerializer().Serialize(ops::ProcessCollector().Collect()));
     std::size_t found = 0;
     for (const auto& sample : samples) found += sample.name == name;
     EXPECT_EQ(found, 1u) << name;
@@ -119,8 +119,7 @@ TEST(ProcessMetrics, ReadFromProcSelf) {
 }
 
 TEST(ProcessMetrics, WithoutProcOnlyTheLimitsAreLeft) {
-  const auto families =
-      server::ProcessCollector("/nonexistent/proc", "/nonexistent/stat").Collect();
+  const auto families = ops::ProcessCollector("/nonexistent/proc", "/nonexistent/stat").Collect();
   ASSERT_LE(families.size(), 1u);  // none when RLIMIT_NOFILE is unlimited
   for (const auto& family : families) EXPECT_EQ(family.name, "process_max_fds");
 }
@@ -130,24 +129,24 @@ TEST(ProcSelf, ParsesStatLinesWhoseCommandNameHasBlanksAndParentheses) {
       "4242 (a) (b c)) S 1 4242 4242 0 -1 4194560 500 0 0 0 "
       "250 125 0 0 20 0 8 0 98765 123456789 3000 18446744073709551615 1 1 0 0 0 0 0 0 0 0 0 0 "
       "17 1 0 0 0 0 0\n";
-  const auto stat = server::parse_proc_stat(line);
+  const auto stat = ops::parse_proc_stat(line);
   ASSERT_TRUE(stat);
   EXPECT_EQ(stat->utime_ticks, 250u);
   EXPECT_EQ(stat->stime_ticks, 125u);
   EXPECT_EQ(stat->start_ticks, 98765u);
   EXPECT_EQ(stat->virtual_bytes, 123456789u);
   EXPECT_EQ(stat->resident_pages, 3000);
-  EXPECT_FALSE(server::parse_proc_stat(""));
-  EXPECT_FALSE(server::parse_proc_stat("4242 (x) S 1 2 3"));  // truncated
-  EXPECT_FALSE(server::parse_proc_stat(")( S 1"));
-  EXPECT_FALSE(server::parse_proc_stat(std::regex_replace(line, std::regex(" 250 "), " x50 ")));
-  EXPECT_FALSE(server::parse_proc_stat(std::regex_replace(line, std::regex(" 250 "), " -250 ")));
+  EXPECT_FALSE(ops::parse_proc_stat(""));
+  EXPECT_FALSE(ops::parse_proc_stat("4242 (x) S 1 2 3"));  // truncated
+  EXPECT_FALSE(ops::parse_proc_stat(")( S 1"));
+  EXPECT_FALSE(ops::parse_proc_stat(std::regex_replace(line, std::regex(" 250 "), " x50 ")));
+  EXPECT_FALSE(ops::parse_proc_stat(std::regex_replace(line, std::regex(" 250 "), " -250 ")));
 
-  EXPECT_EQ(server::parse_boot_time("cpu 1 2 3\nintr 5 6\nbtime 1700000000\nprocesses 9\n"),
+  EXPECT_EQ(ops::parse_boot_time("cpu 1 2 3\nintr 5 6\nbtime 1700000000\nprocesses 9\n"),
             1700000000u);
-  EXPECT_FALSE(server::parse_boot_time("cpu 1 2 3\n"));
-  EXPECT_FALSE(server::parse_boot_time("btime soon\n"));
-  EXPECT_FALSE(server::parse_boot_time("btime 1 2\n"));
+  EXPECT_FALSE(ops::parse_boot_time("cpu 1 2 3\n"));
+  EXPECT_FALSE(ops::parse_boot_time("btime soon\n"));
+  EXPECT_FALSE(ops::parse_boot_time("btime 1 2\n"));
 }
 
 TEST(MetricsEndpoint, AcceptsOnePlainHostAndPort) {
@@ -162,7 +161,7 @@ TEST(MetricsEndpoint, AcceptsOnePlainHostAndPort) {
 }
 
 TEST(MetricsEndpoint, PortZeroPicksAPortAndABusyOneIsAClearError) {
-  server::ServerMetrics metrics;
+  ops::ServerMetrics metrics;
   MetricsEndpoint endpoint("127.0.0.1:0", metrics.collectables());
   ASSERT_GT(endpoint.port(), 0);
   EXPECT_EQ(sum_samples(scrape_metrics(endpoint.port()), "primlabel_build_info"), 1.0);

@@ -240,7 +240,7 @@ TEST_F(ServerBinary, StartupErrorsExitNonZeroWithAReason) {
   }
   {
     // A /metrics address that is taken, or one this build cannot serve: a reason, no abort.
-    server::MetricsEndpoint taken("127.0.0.1:0", {});
+    ops::MetricsEndpoint taken("127.0.0.1:0", {});
     const std::string busy = "127.0.0.1:" + std::to_string(taken.port());
     for (const std::string& address : {busy, std::string("[::1]:9464"), std::string("x:99999")}) {
       ServerProcess server({"--models", repo_.path().string(), "--listen", "127.0.0.1:0",

@@ -55,7 +55,7 @@ void expect_summary_matches(const v1::LabelSummary& summary,
   EXPECT_EQ(table.point_count(), want.table->points);
   EXPECT_EQ(std::vector<std::uint32_t>(table.primitive_ids().begin(), table.primitive_ids().end()),
             want.table->primitive_ids);
-  EXPECT_LE(table.ByteSizeLong(), server::kMaxTableMessageBytes);
+  EXPECT_LE(table.ByteSizeLong(), service::kMaxTableMessageBytes);
   ASSERT_EQ(std::size_t(summary.objects_size()), want.objects.size());
   for (std::size_t k = 0; k < want.objects.size(); ++k) {
     const v1::TabletopObject& got = summary.objects(int(k));
@@ -71,7 +71,7 @@ void expect_summary_matches(const v1::LabelSummary& summary,
               o.primitive_ids);
     v1::TabletopObject without_ids = got;
     without_ids.clear_primitive_ids();
-    EXPECT_LE(without_ids.ByteSizeLong(), server::kMaxObjectMessageBytes);
+    EXPECT_LE(without_ids.ByteSizeLong(), service::kMaxObjectMessageBytes);
   }
 }
 

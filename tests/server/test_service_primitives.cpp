@@ -59,7 +59,7 @@ TEST(ServicePrimitives, MatchLabelCloudInProcess) {
   for (std::size_t s = 0; s < primitives.size(); ++s) {
     const primitives::Primitive& want = primitives[s];
     const v1::Primitive& got = summary.primitives(int(s));
-    EXPECT_LE(got.ByteSizeLong(), server::kMaxPrimitiveMessageBytes) << s;
+    EXPECT_LE(got.ByteSizeLong(), service::kMaxPrimitiveMessageBytes) << s;
     kinds.insert(got.kind());
     EXPECT_EQ(got.segment_id(), s);
     EXPECT_EQ(std::uint32_t(got.kind()), std::uint32_t(want.kind())) << s;

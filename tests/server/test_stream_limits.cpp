@@ -8,14 +8,14 @@
 
 #include "primlabel/service/stream_limits.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 namespace {
 
 using Clock = StreamLimits::Clock;
 using std::chrono::milliseconds;
 
-ServerConfig limits_config() {
-  ServerConfig config;
+ops::ServerConfig limits_config() {
+  ops::ServerConfig config;
   config.stream_idle_seconds = 2;
   config.min_receive_bytes_per_second = 1000;
   config.receive_rate_window_seconds = 1;
@@ -53,7 +53,7 @@ TEST(StreamLimits, AHeaderFirstThenChunksOrTheEnd) {
 }
 
 TEST(StreamLimits, AStreamWithoutMessagesForTheIdleTimeEnds) {
-  const ServerConfig config = limits_config();
+  const ops::ServerConfig config = limits_config();
   const Clock::time_point t0{};
   StreamLimits limits(config, t0);
   EXPECT_EQ(limits.next_check(StreamPhase::kHeader), t0 + std::chrono::seconds(2));
@@ -69,7 +69,7 @@ TEST(StreamLimits, AStreamWithoutMessagesForTheIdleTimeEnds) {
 }
 
 TEST(StreamLimits, TheRateIsJudgedAfterAGraceWindowThenPerWindow) {
-  const ServerConfig config = limits_config();
+  const ops::ServerConfig config = limits_config();
   const Clock::time_point t0{};
   StreamLimits limits(config, t0);
   limits.message_arrived(100, t0);
@@ -89,7 +89,7 @@ TEST(StreamLimits, TheRateIsJudgedAfterAGraceWindowThenPerWindow) {
 }
 
 TEST(StreamLimits, AnAnswerMessageNotTakenInTimeEndsTheCall) {
-  const ServerConfig config = limits_config();
+  const ops::ServerConfig config = limits_config();
   const Clock::time_point t0{};
   StreamLimits limits(config, t0);
   EXPECT_EQ(limits.next_check(StreamPhase::kSending), Clock::time_point::max());
@@ -105,4 +105,4 @@ TEST(StreamLimits, AnAnswerMessageNotTakenInTimeEndsTheCall) {
 }
 
 }  // namespace
-}  // namespace primlabel::server
+}  // namespace primlabel::service

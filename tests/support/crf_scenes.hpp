@@ -1,7 +1,7 @@
 #pragma once
-// Synthetic labelled scenes for the CRF tests and `primlabel-bench crf`: points on a jittered grid whose labels form square
-// regions (spatially smooth), with descriptors = a class prototype + Gaussian noise (so a
-// node-only classifier makes clear mistakes that neighbours can correct).
+// Synthetic labelled scenes for the CRF tests and `primlabel-bench crf`: points on a jittered grid
+// whose labels form square regions (spatially smooth), with descriptors = a class prototype +
+// Gaussian noise (so a node-only classifier makes clear mistakes that neighbours can correct).
 
 #include <algorithm>
 #include <cstdint>
@@ -66,6 +66,20 @@ inline LabeledGraph make_grid_scene(const SceneSpec& spec,
 
 // A plausible model for the scene family: node weights point at the class prototypes, a positive
 // edge bias rewards agreeing neighbours.
+// A scene to train on and a held-out one of the same classes: `spec` with two noise seeds.
+struct HeldOutScenes {
+  LabeledGraph train, test;
+};
+inline HeldOutScenes held_out_scenes(SceneSpec spec, std::uint32_t train_seed,
+                                     std::uint32_t test_seed) {
+  HeldOutScenes scenes;
+  spec.seed = train_seed;
+  scenes.train = make_grid_scene(spec);
+  spec.seed = test_seed;
+  scenes.test = make_grid_scene(spec);
+  return scenes;
+}
+
 inline CrfModel prototype_model(const SceneSpec& spec, float node_gain, float edge_bias) {
   std::vector<std::uint32_t> ids(spec.num_classes);
   for (int k = 0; k < spec.num_classes; ++k) ids[k] = static_cast<std::uint32_t>(k + 1);

@@ -1,7 +1,7 @@
 #pragma once
 // Small, fast fixtures for tests that need a model and a cloud but not a trained one: a model
-// with seeded random weights (labels vary from point to point, so mix-ups show), and a
-// box-on-a-table cloud with planes, edges and corners.
+// with seeded random weights (labels vary from point to point, so mix-ups show), an all-zero
+// one, and a box-on-a-table cloud with planes, edges and corners.
 
 #include <cmath>
 #include <cstdint>
@@ -34,6 +34,17 @@ inline LabelModel random_label_model(const std::string& name = "random",
   if (coupling > 0.0f)
     model.weights.edge_weights.col(model.weights.edge_feature_dim() - 1).setConstant(coupling);
   model.created_by = "random_label_model";
+  return model;
+}
+
+// A node-only FPFH model over three classes with all-zero weights: loads and labels at once, every
+// point the same class. `normals`, `features` > 0: those radii (small ones are fast on big frames).
+inline LabelModel zero_node_model(float normals = 0.0f, float features = 0.0f) {
+  LabelModel model;
+  model.kind = ModelKind::kNodeOnly;
+  model.weights = crf::CrfModel::zeros({1, 2, 4}, kFpfhSize);
+  if (normals > 0.0f) model.features.normals = Neighborhood::Radius(normals);
+  if (features > 0.0f) model.features.features = Neighborhood::Radius(features);
   return model;
 }
 

@@ -13,12 +13,12 @@
 #include "commands.hpp"
 #include "common/labeled_output.hpp"
 #include "common/object_json.hpp"
-#include "common/object_overlays.hpp"
 #include "common/primitive_json.hpp"
 #include "input_files.hpp"
 #include "primlabel/cli/cli_common.hpp"
 #include "primlabel/geometry/atomic_file.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/overlays/object_overlays.hpp"
 #include "server_wait_progress.hpp"
 #include "status_exit_codes.hpp"
 

@@ -42,7 +42,7 @@ void write_labeled_cloud(const std::string& path, const PointCloud& labeled,
                          const LabelResult& result);
 
 // What a label picture shows besides the points: its title, the view (natural_view() when
-// unset) and overlays such as the table-top objects (object_overlays.hpp).
+// unset) and overlays such as the table-top objects (primlabel/overlays/object_overlays.hpp).
 struct LabelPicture {
   std::string title;
   std::optional<RenderView> view;

@@ -5,7 +5,7 @@
 
 #include "primlabel/ops/server_config.hpp"
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 namespace {
 
@@ -62,4 +62,4 @@ std::vector<std::string> with_config_file(CLI::App& app, int argc, const char* c
   return out;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 // The command line with the config file's settings (--config, else PRIMLABEL_CONFIG) put in
 // front of it, leaving out every setting that a flag or an environment variable gives: flags >
 // environment > file. Throws ConfigError naming the file and line.
 std::vector<std::string> with_config_file(CLI::App& app, int argc, const char* const* argv);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

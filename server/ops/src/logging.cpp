@@ -8,7 +8,7 @@
 #include <mutex>
 #include <stdexcept>
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 namespace {
 
@@ -122,4 +122,4 @@ LogLine& LogLine::kv(std::string_view key, std::int64_t value) {
   return enabled_ ? kv(key, std::string_view(std::to_string(value))) : *this;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <thread>
 
-namespace primlabel::server {
+namespace primlabel::ops {
 namespace {
 
 bool is_host_char(char c) {
@@ -115,4 +115,4 @@ MetricsEndpoint::~MetricsEndpoint() {
   stopped.store(true);
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -3,7 +3,7 @@
 #include <charconv>
 #include <vector>
 
-namespace primlabel::server {
+namespace primlabel::ops {
 namespace {
 
 template <typename T>
@@ -60,4 +60,4 @@ std::optional<std::uint64_t> parse_boot_time(std::string_view proc_stat_text) {
   return std::nullopt;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -9,7 +9,7 @@
 
 #include "primlabel/ops/proc_self.hpp"
 
-namespace primlabel::server {
+namespace primlabel::ops {
 namespace {
 
 // /proc files report a size of 0, so read until the end; they are small (/proc/stat grows with
@@ -89,4 +89,4 @@ std::vector<prometheus::MetricFamily> ProcessCollector::Collect() const {
   return families;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -10,7 +10,7 @@
 #include "config_file.hpp"
 #include "primlabel/build_version.hpp"
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 namespace {
 
@@ -246,4 +246,4 @@ ServerConfig parse_server_config(int argc, const char* const* argv) {
   return config;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

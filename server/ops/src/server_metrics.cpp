@@ -6,7 +6,7 @@
 #include "primlabel/ops/process_collector.hpp"
 #include "primlabel/ops/stage_times.hpp"
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 namespace {
 
@@ -160,4 +160,4 @@ void ServerMetrics::reloads(unsigned loaded, unsigned failed) {
   reload_failures_.Increment(failed);
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 namespace {
 
@@ -33,25 +33,26 @@ TokenAuth::TokenAuth(std::string token, bool required_for_all, bool insecure_adm
       required_for_all_(required_for_all),
       insecure_admin_(insecure_admin) {}
 
-std::optional<ServiceError> TokenAuth::check(const grpc::ServerContextBase& context,
-                                             bool admin) const {
+std::optional<service::ServiceError> TokenAuth::check(const grpc::ServerContextBase& context,
+                                                      bool admin) const {
   if (admin && token_.empty() && !insecure_admin_)
-    return ServiceError{ErrorCode::kPermissionDenied,
-                        "admin RPCs are disabled: this server has no token; start it with "
-                        "--token-file (or PRIMLABEL_TOKEN) to require one, or with "
-                        "--insecure-admin to allow them without one"};
+    return service::ServiceError{service::ErrorCode::kPermissionDenied,
+                                 "admin RPCs are disabled: this server has no token; start it with "
+                                 "--token-file (or PRIMLABEL_TOKEN) to require one, or with "
+                                 "--insecure-admin to allow them without one"};
   if (token_.empty() || (!admin && !required_for_all_)) return std::nullopt;
   const auto& metadata = context.client_metadata();
   auto found = metadata.find("authorization");
   if (found == metadata.end())
-    return ServiceError{ErrorCode::kUnauthenticated,
-                        std::string(admin ? "admin RPCs" : "this server") +
-                            " require an 'authorization: Bearer <token>' header"};
+    return service::ServiceError{service::ErrorCode::kUnauthenticated,
+                                 std::string(admin ? "admin RPCs" : "this server") +
+                                     " require an 'authorization: Bearer <token>' header"};
   const std::string value(found->second.data(), found->second.size());
   const std::string prefix = "Bearer ";
   if (value.compare(0, prefix.size(), prefix) != 0 ||
       !constant_time_equal(value.substr(prefix.size()), token_))
-    return ServiceError{ErrorCode::kUnauthenticated, "the bearer token is not valid"};
+    return service::ServiceError{service::ErrorCode::kUnauthenticated,
+                                 "the bearer token is not valid"};
   return std::nullopt;
 }
 
@@ -65,4 +66,4 @@ std::shared_ptr<grpc::ServerCredentials> server_credentials(const TlsFiles& file
   return grpc::SslServerCredentials(options);
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

@@ -4,15 +4,17 @@
 
 #include "primlabel/service/job_plan.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
-std::optional<ServiceError> may_start(const ServiceEnvironment& env, const TokenAuth& auth,
-                                      const grpc::ServerContextBase& context) {
-  if (env.draining->load()) return shutting_down();
+std::optional<service::ServiceError> may_start(const service::ServiceEnvironment& env,
+                                               const TokenAuth& auth,
+                                               const grpc::ServerContextBase& context) {
+  if (env.draining->load()) return service::shutting_down();
   return auth.check(context, false);
 }
 
-CallDeadline CallDeadline::of(const grpc::ServerContextBase& context, const ServerConfig& config) {
+CallDeadline CallDeadline::of(const grpc::ServerContextBase& context,
+                              const ops::ServerConfig& config) {
   using namespace std::chrono;
   CallDeadline deadline;
   deadline.server_limit_seconds = config.max_request_seconds;
@@ -30,32 +32,34 @@ CallDeadline CallDeadline::of(const grpc::ServerContextBase& context, const Serv
   return deadline;
 }
 
-ServiceError CallDeadline::passed(const char* while_doing) const {
+service::ServiceError CallDeadline::passed(const char* while_doing) const {
   if (from_client)
-    return {ErrorCode::kDeadlineExceeded,
+    return {service::ErrorCode::kDeadlineExceeded,
             std::string("the client's deadline passed while ") + while_doing};
   char limit[32];
   std::snprintf(limit, sizeof limit, "%g", server_limit_seconds);
-  return {ErrorCode::kDeadlineExceeded, std::string("the request took longer than the server's ") +
-                                            limit + " s limit (--max-request-seconds) while " +
-                                            while_doing + "; set a deadline to allow more"};
+  return {service::ErrorCode::kDeadlineExceeded,
+          std::string("the request took longer than the server's ") + limit +
+              " s limit (--max-request-seconds) while " + while_doing +
+              "; set a deadline to allow more"};
 }
 
-ServiceError cancel_reason(const ServiceEnvironment& env, const grpc::ServerContextBase& context,
-                           const char* while_doing) {
+service::ServiceError cancel_reason(const service::ServiceEnvironment& env,
+                                    const grpc::ServerContextBase& context,
+                                    const char* while_doing) {
   if (env.draining->load())
-    return {ErrorCode::kUnavailable,
+    return {service::ErrorCode::kUnavailable,
             std::string("the server shut down while ") + while_doing + "; retry elsewhere"};
   // The client's own timer fires first: the server's copy of the deadline was computed when the
   // call arrived, after the client's connection set-up and send had already used some of it.
   constexpr auto kClockLag = std::chrono::milliseconds(250);
   if (std::chrono::system_clock::now() + kClockLag >= context.deadline())
-    return {ErrorCode::kDeadlineExceeded,
+    return {service::ErrorCode::kDeadlineExceeded,
             std::string("the client's deadline passed while ") + while_doing};
-  return {ErrorCode::kCancelled, std::string("the client cancelled while ") + while_doing};
+  return {service::ErrorCode::kCancelled, std::string("the client cancelled while ") + while_doing};
 }
 
-ServiceError internal_error(const char* while_doing, std::exception_ptr error) {
+service::ServiceError internal_error(const char* while_doing, std::exception_ptr error) {
   std::string what = "an unknown exception";
   try {
     if (error) std::rethrow_exception(error);
@@ -63,7 +67,8 @@ ServiceError internal_error(const char* while_doing, std::exception_ptr error) {
     what = e.what();
   } catch (...) {
   }
-  return {ErrorCode::kInternal, std::string("internal error while ") + while_doing + ": " + what};
+  return {service::ErrorCode::kInternal,
+          std::string("internal error while ") + while_doing + ": " + what};
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

@@ -13,11 +13,12 @@
 #include "primlabel/service/service_environment.hpp"
 #include "primlabel/service/service_error.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 // A draining server, or a caller without a valid token, is turned away before anything is read.
-std::optional<ServiceError> may_start(const ServiceEnvironment& env, const TokenAuth& auth,
-                                      const grpc::ServerContextBase& context);
+std::optional<service::ServiceError> may_start(const service::ServiceEnvironment& env,
+                                               const TokenAuth& auth,
+                                               const grpc::ServerContextBase& context);
 
 // The earlier of the client's deadline and --max-request-seconds from now.
 struct CallDeadline {
@@ -25,17 +26,18 @@ struct CallDeadline {
   bool from_client = false;
   double server_limit_seconds = 0;
 
-  static CallDeadline of(const grpc::ServerContextBase& context, const ServerConfig& config);
+  static CallDeadline of(const grpc::ServerContextBase& context, const ops::ServerConfig& config);
   // DEADLINE_EXCEEDED naming which deadline passed and while doing what.
-  ServiceError passed(const char* while_doing) const;
+  service::ServiceError passed(const char* while_doing) const;
 };
 
 // Why a call the transport cancelled ended: the server shutting down (UNAVAILABLE), the
 // client's deadline (DEADLINE_EXCEEDED) or the client (CANCELLED).
-ServiceError cancel_reason(const ServiceEnvironment& env, const grpc::ServerContextBase& context,
-                           const char* while_doing);
+service::ServiceError cancel_reason(const service::ServiceEnvironment& env,
+                                    const grpc::ServerContextBase& context,
+                                    const char* while_doing);
 
 // INTERNAL for an exception that reached the edge (the last line of defence).
-ServiceError internal_error(const char* while_doing, std::exception_ptr error);
+service::ServiceError internal_error(const char* while_doing, std::exception_ptr error);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

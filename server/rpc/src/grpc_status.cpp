@@ -2,41 +2,41 @@
 
 #include "primlabel/wire/status_names.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 namespace {
 
-grpc::StatusCode grpc_code(ErrorCode code) {
+grpc::StatusCode grpc_code(service::ErrorCode code) {
   switch (code) {
-    case ErrorCode::kCancelled:
+    case service::ErrorCode::kCancelled:
       return grpc::StatusCode::CANCELLED;
-    case ErrorCode::kInvalidArgument:
+    case service::ErrorCode::kInvalidArgument:
       return grpc::StatusCode::INVALID_ARGUMENT;
-    case ErrorCode::kDeadlineExceeded:
+    case service::ErrorCode::kDeadlineExceeded:
       return grpc::StatusCode::DEADLINE_EXCEEDED;
-    case ErrorCode::kNotFound:
+    case service::ErrorCode::kNotFound:
       return grpc::StatusCode::NOT_FOUND;
-    case ErrorCode::kAlreadyExists:
+    case service::ErrorCode::kAlreadyExists:
       return grpc::StatusCode::ALREADY_EXISTS;
-    case ErrorCode::kPermissionDenied:
+    case service::ErrorCode::kPermissionDenied:
       return grpc::StatusCode::PERMISSION_DENIED;
-    case ErrorCode::kResourceExhausted:
+    case service::ErrorCode::kResourceExhausted:
       return grpc::StatusCode::RESOURCE_EXHAUSTED;
-    case ErrorCode::kFailedPrecondition:
+    case service::ErrorCode::kFailedPrecondition:
       return grpc::StatusCode::FAILED_PRECONDITION;
-    case ErrorCode::kAborted:
+    case service::ErrorCode::kAborted:
       return grpc::StatusCode::ABORTED;
-    case ErrorCode::kOutOfRange:
+    case service::ErrorCode::kOutOfRange:
       return grpc::StatusCode::OUT_OF_RANGE;
-    case ErrorCode::kUnimplemented:
+    case service::ErrorCode::kUnimplemented:
       return grpc::StatusCode::UNIMPLEMENTED;
-    case ErrorCode::kInternal:
+    case service::ErrorCode::kInternal:
       return grpc::StatusCode::INTERNAL;
-    case ErrorCode::kUnavailable:
+    case service::ErrorCode::kUnavailable:
       return grpc::StatusCode::UNAVAILABLE;
-    case ErrorCode::kDataLoss:
+    case service::ErrorCode::kDataLoss:
       return grpc::StatusCode::DATA_LOSS;
-    case ErrorCode::kUnauthenticated:
+    case service::ErrorCode::kUnauthenticated:
       return grpc::StatusCode::UNAUTHENTICATED;
   }
   return grpc::StatusCode::INTERNAL;
@@ -44,13 +44,13 @@ grpc::StatusCode grpc_code(ErrorCode code) {
 
 }  // namespace
 
-grpc::Status to_grpc_status(const ServiceError& error) {
+grpc::Status to_grpc_status(const service::ServiceError& error) {
   return {grpc_code(error.code), error.message};
 }
 
-grpc::Status finish_request(RequestRecord& record, const grpc::Status& status) {
+grpc::Status finish_request(service::RequestRecord& record, const grpc::Status& status) {
   record.finish(::primlabel::wire::status_code_name(status.error_code()), status.error_message());
   return status;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

@@ -13,7 +13,7 @@
 #include "primlabel/service/labeling_session.hpp"
 #include "primlabel/service/request_record.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 namespace {
 
@@ -25,7 +25,7 @@ constexpr std::uint64_t kAnswerOverheadBytes = 4096;
 class LabelCloudReactor final : public grpc::ServerUnaryReactor,
                                 public std::enable_shared_from_this<LabelCloudReactor> {
  public:
-  LabelCloudReactor(const ServiceEnvironment& env, const TokenAuth& auth,
+  LabelCloudReactor(const service::ServiceEnvironment& env, const TokenAuth& auth,
                     grpc::CallbackServerContext* context, grpc::ByteBuffer* response)
       : env_(env),
         auth_(auth),
@@ -64,9 +64,10 @@ class LabelCloudReactor final : public grpc::ServerUnaryReactor,
     v1::LabelCloudRequest request;
     grpc::ByteBuffer copy(bytes);  // the reader consumes its buffer
     if (!parse_message(copy, request))
-      return fail({ErrorCode::kInvalidArgument, "the request is not a valid LabelCloudRequest"});
+      return fail(
+          {service::ErrorCode::kInvalidArgument, "the request is not a valid LabelCloudRequest"});
     if (!request.has_header())
-      return fail({ErrorCode::kInvalidArgument, "the request has no header"});
+      return fail({service::ErrorCode::kInvalidArgument, "the request has no header"});
     if (auto refused = session_.start(request.header(), /*streamed=*/false)) return fail(*refused);
     if (auto refused = session_.add(request.points())) return fail(*refused);
     request.Clear();
@@ -74,7 +75,7 @@ class LabelCloudReactor final : public grpc::ServerUnaryReactor,
     const std::uint64_t answer = session_.answer_bytes();
     const auto limit = std::uint64_t(env_.config->max_message_bytes);
     if (answer + kAnswerOverheadBytes > limit)
-      return fail({ErrorCode::kResourceExhausted,
+      return fail({service::ErrorCode::kResourceExhausted,
                    "the response would take " + std::to_string(answer) +
                        " bytes, over the server's message limit of " + std::to_string(limit) +
                        " (--max-message-bytes); use the streaming Label RPC"});
@@ -99,11 +100,12 @@ class LabelCloudReactor final : public grpc::ServerUnaryReactor,
     if (finished_) return session_.free_result();
     try {
       if (auto failed = session_.outcome()) return fail(*failed);
-      const LabelResponder responder(session_.result(), 0, std::uint64_t(-1));
+      const service::LabelResponder responder(session_.result(), 0, std::uint64_t(-1));
       v1::LabelCloudResponse response;
       responder.fill_range(0, session_.result().labels.size(), *response.mutable_result());
       record_.stages.send = 0;
-      fill_summary(record_, session_.plan(), session_.result(), *response.mutable_summary());
+      service::fill_summary(record_, session_.plan(), session_.result(),
+                            *response.mutable_summary());
       session_.free_result();
       *response_ = serialize_message(response);
       record_.stages.send =
@@ -114,7 +116,7 @@ class LabelCloudReactor final : public grpc::ServerUnaryReactor,
     }
   }
 
-  void fail(const ServiceError& error) {
+  void fail(const service::ServiceError& error) {
     if (finished_) return;
     if (job_running_ && session_.stop()) job_running_ = false;
     if (!job_running_) session_.free_result();
@@ -132,7 +134,7 @@ class LabelCloudReactor final : public grpc::ServerUnaryReactor,
     Finish(status);
   }
 
-  const ServiceEnvironment& env_;
+  const service::ServiceEnvironment& env_;
   const TokenAuth& auth_;
   grpc::CallbackServerContext* const context_;
   grpc::ByteBuffer* const response_;
@@ -140,15 +142,15 @@ class LabelCloudReactor final : public grpc::ServerUnaryReactor,
   std::shared_ptr<LabelCloudReactor> self_;
   bool finished_ = false;
   bool job_running_ = false;
-  RequestRecord record_;
-  LabelingSession session_;
+  service::RequestRecord record_;
+  service::LabelingSession session_;
   const CallDeadline deadline_;
-  TimerService::Id timer_ = 0;
+  service::TimerService::Id timer_ = 0;
 };
 
 }  // namespace
 
-grpc::ServerUnaryReactor* start_label_cloud_reactor(const ServiceEnvironment& env,
+grpc::ServerUnaryReactor* start_label_cloud_reactor(const service::ServiceEnvironment& env,
                                                     const TokenAuth& auth,
                                                     grpc::CallbackServerContext* context,
                                                     const grpc::ByteBuffer* request,
@@ -164,4 +166,4 @@ grpc::ServerUnaryReactor* start_label_cloud_reactor(const ServiceEnvironment& en
   }
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

@@ -22,15 +22,16 @@
 #include "primlabel/rpc/auth.hpp"
 #include "primlabel/service/service_environment.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>* start_label_reactor(
-    const ServiceEnvironment& env, const TokenAuth& auth, grpc::CallbackServerContext* context);
+    const service::ServiceEnvironment& env, const TokenAuth& auth,
+    grpc::CallbackServerContext* context);
 
-grpc::ServerUnaryReactor* start_label_cloud_reactor(const ServiceEnvironment& env,
+grpc::ServerUnaryReactor* start_label_cloud_reactor(const service::ServiceEnvironment& env,
                                                     const TokenAuth& auth,
                                                     grpc::CallbackServerContext* context,
                                                     const grpc::ByteBuffer* request,
                                                     grpc::ByteBuffer* response);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

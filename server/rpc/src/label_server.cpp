@@ -10,14 +10,14 @@
 #include "primlabel/rpc/auth.hpp"
 #include "primlabel/service/user_text.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 namespace {
 
 constexpr auto kShutdownGrace = std::chrono::milliseconds(250);
 
-ModelRegistry::Options registry_options(const ServerConfig& config) {
-  ModelRegistry::Options options;
+service::ModelRegistry::Options registry_options(const ops::ServerConfig& config) {
+  service::ModelRegistry::Options options;
   options.root = config.models_dir;
   options.default_model = config.default_model;
   options.pins = config.pins;
@@ -34,14 +34,14 @@ std::string with_port(const std::string& address, int port) {
 
 }  // namespace
 
-LabelServer::LabelServer(ServerConfig config)
+LabelServer::LabelServer(ops::ServerConfig config)
     : config_(std::move(config)),
       registry_(registry_options(config_)),
       auth_(config_.token, config_.token_for_all, config_.insecure_admin) {
-  receiving_ = std::make_unique<SlotBudget>(config_.max_receiving_streams);
-  admission_ =
-      std::make_unique<Admission>(effective_workers(config_), config_.queue,
-                                  [this](int, int queued) { requests_.set_queued(queued); });
+  receiving_ = std::make_unique<service::SlotBudget>(config_.max_receiving_streams);
+  admission_ = std::make_unique<service::Admission>(
+      ops::effective_workers(config_), config_.queue,
+      [this](int, int queued) { requests_.set_queued(queued); });
   env_.config = &config_;
   env_.registry = &registry_;
   env_.admission = admission_.get();
@@ -51,35 +51,35 @@ LabelServer::LabelServer(ServerConfig config)
   env_.trimmer = &trimmer_;
   env_.metrics = &metrics_;
   env_.draining = &draining_;
-  env_.threads_per_job = effective_threads_per_job(config_);
+  env_.threads_per_job = ops::effective_threads_per_job(config_);
   // Every change of the registry, whoever made it (poller, admin RPC), reaches health and the
   // model gauges.
   registry_.set_observer([this] { models_changed(); });
 
   try {
-    const ReloadReport report = registry_.rescan();
+    const service::ReloadReport report = registry_.rescan();
     metrics_.reloads(report.loaded, report.failed);
-  } catch (const RegistryError& error) {
+  } catch (const service::RegistryError& error) {
     throw std::runtime_error(error.what());
   }
   // A default or pin naming nothing loaded is a typo that would otherwise only show as failed
   // requests (or a silently different version) in production.
   if (std::string problem = registry_.configuration_problem(); !problem.empty())
-    throw ConfigError{std::move(problem), kExitUsage};
+    throw ops::ConfigError{std::move(problem), kExitUsage};
   // Requests naming no model go by their cloud's domain; this one takes those no domain decides.
   if (const std::string fallback = registry_.default_model(); fallback.empty())
-    log_info("default_model").kv("model", "").kv("source", "none");
+    ops::log_info("default_model").kv("model", "").kv("source", "none");
   else
-    log_info("default_model")
-        .kv("model", user_text(fallback))
+    ops::log_info("default_model")
+        .kv("model", service::user_text(fallback))
         .kv("source", registry_.default_source())
         .kv("loaded", [&] {
-          for (const ServedModel& served : registry_.list())
+          for (const service::ServedModel& served : registry_.list())
             if (served.name == fallback) return "yes";
           return "no";
         }());
   if (auth_.admin_open())
-    log_warn("insecure_admin")
+    ops::log_warn("insecure_admin")
         .kv("message",
             "admin RPCs (load, unload, reload models) are open to anyone who reaches the port: "
             "--insecure-admin without a token");
@@ -110,12 +110,12 @@ LabelServer::LabelServer(ServerConfig config)
 
   if (!config_.metrics_listen.empty())
     metrics_endpoint_ =
-        std::make_unique<MetricsEndpoint>(config_.metrics_listen, metrics_.collectables());
+        std::make_unique<ops::MetricsEndpoint>(config_.metrics_listen, metrics_.collectables());
   models_changed();
   if (config_.reload_seconds > 0)
     poller_ = std::jthread([this](std::stop_token stop) { poll_models(stop); });
 
-  LogLine line(LogLevel::kInfo, "listening");
+  ops::LogLine line(ops::LogLevel::kInfo, "listening");
   line.kv("address", with_port(config_.listen, port_))
       .kv("port", port_)
       .kv("metrics_port", metrics_port())
@@ -141,9 +141,10 @@ void LabelServer::models_changed() {
   // One at a time, reading the registry under the lock: whichever call comes last publishes the
   // latest state (the constructor's call can race with an early admin RPC's observer call).
   std::lock_guard lock(health_mutex_);
-  const std::vector<ServedModel> models = registry_.list();
+  const std::vector<service::ServedModel> models = registry_.list();
   std::vector<std::pair<std::string, std::string>> served;
-  for (const ServedModel& model : models) served.emplace_back(model.name, model.served->version);
+  for (const service::ServedModel& model : models)
+    served.emplace_back(model.name, model.served->version);
   metrics_.set_models(served, registry_.loaded_versions());
   if (draining_.load() || !server_) return;  // health was shut down for good
   const bool serving = !models.empty();
@@ -163,10 +164,10 @@ void LabelServer::poll_models(std::stop_token stop) {
       if (stop.stop_requested()) return;
     }
     try {
-      const ReloadReport report = registry_.rescan();  // changes reach models_changed()
+      const service::ReloadReport report = registry_.rescan();  // changes reach models_changed()
       metrics_.reloads(report.loaded, report.failed);
     } catch (const std::exception& e) {
-      log_error("model_poll_failed").kv("error", e.what());
+      ops::log_error("model_poll_failed").kv("error", e.what());
     }
   }
 }
@@ -175,7 +176,7 @@ void LabelServer::shutdown(std::chrono::milliseconds drain) {
   std::lock_guard shutdown_lock(shutdown_mutex_);
   if (shut_down_) return;
   shut_down_ = true;
-  log_info("shutting_down")
+  ops::log_info("shutting_down")
       .kv("drain_ms", std::int64_t(drain.count()))
       .kv("in_flight", requests_.in_flight());
   {
@@ -197,7 +198,7 @@ void LabelServer::shutdown(std::chrono::milliseconds drain) {
     server_->Wait();
   }
   metrics_endpoint_.reset();
-  log_info("stopped");
+  ops::log_info("stopped");
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

@@ -18,7 +18,7 @@
 #include "primlabel/service/request_record.hpp"
 #include "primlabel/service/stream_limits.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 namespace {
 
@@ -29,11 +29,13 @@ double seconds_between(Clock::time_point from, Clock::time_point to) {
   return std::chrono::duration<double>(to - from).count();
 }
 
-ServiceError invalid(const std::string& message) { return {ErrorCode::kInvalidArgument, message}; }
+service::ServiceError invalid(const std::string& message) {
+  return {service::ErrorCode::kInvalidArgument, message};
+}
 
 class LabelReactor final : public RawReactor, public std::enable_shared_from_this<LabelReactor> {
  public:
-  LabelReactor(const ServiceEnvironment& env, const TokenAuth& auth,
+  LabelReactor(const service::ServiceEnvironment& env, const TokenAuth& auth,
                grpc::CallbackServerContext* context)
       : env_(env),
         auth_(auth),
@@ -82,8 +84,8 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
   }
 
  private:
-  using Phase = StreamPhase;
-  const char* doing() const { return server::doing(phase_); }
+  using Phase = service::StreamPhase;
+  const char* doing() const { return service::doing(phase_); }
 
   // The exception barrier: whatever a step throws fails this call alone.
   template <typename Step>
@@ -104,7 +106,7 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
     read_buffer_.Clear();
     if (!parsed)
       return fail(invalid("message " + std::to_string(index) + " is not a valid LabelRequest"));
-    if (auto refused = out_of_order(phase_, request, index)) return fail(*refused);
+    if (auto refused = service::out_of_order(phase_, request, index)) return fail(*refused);
     if (phase_ == Phase::kHeader) {
       if (auto refused = session_.start(request.header(), /*streamed=*/true)) return fail(*refused);
       phase_ = Phase::kReceiving;
@@ -138,7 +140,7 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
     job_running_ = false;
     if (phase_ == Phase::kFinished) {
       session_.free_result();
-      log_info("labeling_stopped")
+      ops::log_info("labeling_stopped")
           .kv("request_id", record_.id())
           .kv("stop_ms", 1e3 * seconds_between(stopped_at_, Clock::now()));
       return;
@@ -159,7 +161,8 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
     } else {
       // From the job's end: the hand-over to this thread, packing and writing the chunks.
       record_.stages.send = seconds_between(session_.job_ended(), Clock::now());
-      fill_summary(record_, session_.plan(), session_.result(), *response.mutable_summary());
+      service::fill_summary(record_, session_.plan(), session_.result(),
+                            *response.mutable_summary());
       summary_sent_ = true;
     }
     write_buffer_ = serialize_message(response);
@@ -178,7 +181,7 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
 
   // Ends the call with `error` at once: the job is told to stop, the memory goes, the slots go
   // (the compute slot when the worker has stopped, within a block of points).
-  void fail(const ServiceError& error) {
+  void fail(const service::ServiceError& error) {
     if (phase_ == Phase::kFinished) return;
     const Phase was = phase_;
     phase_ = Phase::kFinished;
@@ -230,29 +233,29 @@ class LabelReactor final : public RawReactor, public std::enable_shared_from_thi
     });
   }
 
-  const ServiceEnvironment& env_;
+  const service::ServiceEnvironment& env_;
   const TokenAuth& auth_;
   grpc::CallbackServerContext* const context_;
   std::mutex mutex_;
   std::shared_ptr<LabelReactor> self_;
   Phase phase_ = Phase::kHeader;
-  RequestRecord record_;
-  LabelingSession session_;
+  service::RequestRecord record_;
+  service::LabelingSession session_;
   const CallDeadline deadline_;
 
-  StreamLimits limits_;
+  service::StreamLimits limits_;
 
   grpc::ByteBuffer read_buffer_;
   std::uint64_t messages_ = 0;
 
   bool job_running_ = false;
-  std::optional<LabelResponder> responder_;
+  std::optional<service::LabelResponder> responder_;
   std::uint64_t next_chunk_ = 0;
   bool summary_sent_ = false;
   grpc::ByteBuffer write_buffer_;
   Clock::time_point stopped_at_;
 
-  TimerService::Id timer_ = 0;
+  service::TimerService::Id timer_ = 0;
   Clock::time_point timer_at_;
 };
 
@@ -265,7 +268,7 @@ class RefusedReactor final : public RawReactor {
 
 }  // namespace
 
-RawReactor* start_label_reactor(const ServiceEnvironment& env, const TokenAuth& auth,
+RawReactor* start_label_reactor(const service::ServiceEnvironment& env, const TokenAuth& auth,
                                 grpc::CallbackServerContext* context) {
   try {
     auto reactor = std::make_shared<LabelReactor>(env, auth, context);
@@ -277,4 +280,4 @@ RawReactor* start_label_reactor(const ServiceEnvironment& env, const TokenAuth& 
   }
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

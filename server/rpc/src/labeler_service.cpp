@@ -6,9 +6,9 @@
 #include "primlabel/service/registry_error.hpp"
 #include "primlabel/service/request_record.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
-LabelerService::LabelerService(const ServiceEnvironment& env, const TokenAuth& auth)
+LabelerService::LabelerService(const service::ServiceEnvironment& env, const TokenAuth& auth)
     : env_(env), auth_(auth) {}
 
 grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>* LabelerService::Label(
@@ -22,8 +22,8 @@ grpc::ServerUnaryReactor* LabelerService::LabelCloud(grpc::CallbackServerContext
   return start_label_cloud_reactor(env_, auth_, context, request, response);
 }
 
-void fill_model_info(const ServedModel& model, v1::ModelInfo& info) {
-  const ModelEntry& entry = *model.served;
+void fill_model_info(const service::ServedModel& model, v1::ModelInfo& info) {
+  const service::ModelEntry& entry = *model.served;
   info.set_name(model.name);
   info.set_version(entry.version);
   for (const std::string& version : model.versions) info.add_loaded_versions(version);
@@ -37,10 +37,10 @@ void fill_model_info(const ServedModel& model, v1::ModelInfo& info) {
 
 grpc::Status LabelerService::ListModels(grpc::ServerContext* context, const v1::ListModelsRequest*,
                                         v1::ListModelsResponse* response) {
-  RequestRecord record("ListModels", *env_.metrics);
+  service::RequestRecord record("ListModels", *env_.metrics);
   if (auto refused = auth_.check(*context, false))
     return finish_request(record, to_grpc_status(*refused));
-  for (const ServedModel& model : env_.registry->list())
+  for (const service::ServedModel& model : env_.registry->list())
     fill_model_info(model, *response->add_models());
   return finish_request(record, grpc::Status::OK);
 }
@@ -48,7 +48,7 @@ grpc::Status LabelerService::ListModels(grpc::ServerContext* context, const v1::
 grpc::Status LabelerService::GetModelMetadata(grpc::ServerContext* context,
                                               const v1::GetModelMetadataRequest* request,
                                               v1::ModelMetadata* response) {
-  RequestRecord record("GetModelMetadata", *env_.metrics);
+  service::RequestRecord record("GetModelMetadata", *env_.metrics);
   record.model = request->model();
   if (auto refused = auth_.check(*context, false))
     return finish_request(record, to_grpc_status(*refused));
@@ -58,10 +58,10 @@ grpc::Status LabelerService::GetModelMetadata(grpc::ServerContext* context,
     record.version = entry->version;
     record.model_resolved = true;
     *response = entry->metadata;
-  } catch (const RegistryError& error) {
-    return finish_request(record, to_grpc_status(registry_error(error)));
+  } catch (const service::RegistryError& error) {
+    return finish_request(record, to_grpc_status(service::registry_error(error)));
   }
   return finish_request(record, grpc::Status::OK);
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

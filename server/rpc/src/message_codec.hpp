@@ -9,7 +9,7 @@
 #include <grpcpp/support/proto_buffer_reader.h>
 #include <grpcpp/support/proto_buffer_writer.h>
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 inline bool parse_message(grpc::ByteBuffer& buffer, google::protobuf::MessageLite& message) {
   grpc::ProtoBufferReader reader(&buffer);
@@ -24,4 +24,4 @@ grpc::ByteBuffer serialize_message(const Message& message) {
   return buffer;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <utility>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 Admission::Admission(int workers, int queue_capacity, Observer observer)
     : capacity_(std::max(1, workers) + std::max(0, queue_capacity)),
@@ -123,4 +123,4 @@ void Admission::notify() {
   observer_(admitted, queued);
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

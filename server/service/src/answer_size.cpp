@@ -5,7 +5,7 @@
 #include "primlabel/tabletop/tabletop.hpp"
 #include "primlabel/wire/packing.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 std::uint64_t array_bytes_per_point(const AnswerArrays& arrays) {
   return wire::kLabelBytesPerPoint + sizeof(float) * arrays.descriptor_dim +
@@ -46,4 +46,4 @@ std::uint64_t answer_summary_bytes(const JobPlan& plan) {
   return bytes;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

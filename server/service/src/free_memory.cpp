@@ -6,7 +6,7 @@
 #include <mutex>
 #include <utility>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 struct IdleMemoryTrimmer::State {
   std::mutex mutex;
@@ -46,4 +46,4 @@ void IdleMemoryTrimmer::released(std::uint64_t points) {
 
 std::uint64_t IdleMemoryTrimmer::trims() const { return state_->trims.load(); }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -9,7 +9,7 @@
 #include "primlabel/service/label_options.hpp"
 #include "primlabel/service/registry_error.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 std::vector<const ModelEntry*> JobPlan::possible_models() const {
   if (entry) return {entry.get()};
@@ -134,4 +134,4 @@ ServiceError server_busy(const Admission& admission) {
 
 ServiceError shutting_down() { return {ErrorCode::kUnavailable, "the server is shutting down"}; }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

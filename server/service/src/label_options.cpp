@@ -2,7 +2,7 @@
 
 #include <string>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 pipeline::LabelingOptions labeling_options(const v1::ScanHeader& header) {
   const v1::LabelOptions& options = header.options();
@@ -66,4 +66,4 @@ std::optional<ServiceError> refuse_options(const pipeline::LabelingOptions& opti
   return std::nullopt;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -12,16 +12,16 @@
 #include "primlabel/service/primitive_messages.hpp"
 #include "primlabel/wire/packing.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 LabelResponder::LabelResponder(const pipeline::LabelingResult& result,
                                std::uint32_t requested_points, std::uint64_t max_bytes)
     : result_(result),
       points_(result.labels.size()),
       classes_(std::uint64_t(result.probabilities.cols())) {
-  const std::uint64_t bytes_per_point = array_bytes_per_point(
-      {result.descriptors.empty() ? 0 : std::uint64_t(result.descriptors.dim), classes_,
-       bool(result.primitives), bool(result.objects)});
+  const std::uint64_t bytes_per_point =
+      array_bytes_per_point({result.descriptors.empty() ? 0 : std::uint64_t(result.descriptors.dim),
+                             classes_, bool(result.primitives), bool(result.objects)});
   const std::uint64_t fitting = std::max<std::uint64_t>(1, max_bytes / bytes_per_point);
   chunk_points_ =
       requested_points > 0 ? std::min<std::uint64_t>(requested_points, fitting) : fitting;
@@ -127,7 +127,7 @@ void fill_summary(const RequestRecord& record, const JobPlan& plan,
     count->set_points(points);
     count->set_name(class_name_of(entry, id));
   }
-  for (const auto& [name, field] : kStages) {
+  for (const auto& [name, field] : ops::kStages) {
     const double seconds = record.stages.*field;
     if (seconds < 0) continue;
     v1::StageTiming* timing = summary.add_timings();
@@ -145,4 +145,4 @@ void fill_summary(const RequestRecord& record, const JobPlan& plan,
   if (result.objects) add_objects(*result.objects, summary);
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

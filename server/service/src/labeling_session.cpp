@@ -2,11 +2,11 @@
 
 #include <algorithm>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 namespace {
 
-ScanLimits limits_of(const ServerConfig& config) {
+ScanLimits limits_of(const ops::ServerConfig& config) {
   return ScanLimits{config.max_points, config.max_request_bytes};
 }
 
@@ -110,7 +110,7 @@ std::optional<ServiceError> LabelingSession::outcome() {
   if (plan_.entry && !record_.model_resolved) note_model();  // chosen in the job
   if (job_error_) return job_error_;
   record_.cascaded = result_.cascaded_points;
-  StageTimes& stages = record_.stages;
+  ops::StageTimes& stages = record_.stages;
   const pipeline::StageSeconds& seconds = result_.seconds;
   // The model choice, when it measured the cloud, counts with the work before the description.
   const double prefilter = seconds.voxels + seconds.tabletop + seconds.duplicates;
@@ -133,4 +133,4 @@ std::optional<ServiceError> LabelingSession::outcome() {
   return std::nullopt;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

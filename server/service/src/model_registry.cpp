@@ -12,7 +12,7 @@
 #include "primlabel/service/user_text.hpp"
 #include "primlabel/v1/model.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 namespace fs = std::filesystem;
 
@@ -141,7 +141,7 @@ void ModelRegistry::read_declared_default() {
     if (size > kMaxDefaultModelFileBytes || !plain || declared.empty() || declared[0] == '.') {
       const std::string raw(text, size);
       if (raw != ignored_default_text_)  // once per content, not at every scan
-        log_warn("default_model_file_ignored")
+        ops::log_warn("default_model_file_ignored")
             .kv("path", user_text(file.string()))
             .kv("reason", "not one line naming a model (letters, digits, - _ .; at most " +
                               std::to_string(kMaxDefaultModelFileBytes) + " bytes)");
@@ -218,7 +218,7 @@ void ModelRegistry::note_refused(const std::vector<Refused>& refused, ReloadRepo
     report.errors.push_back(path.relative + ": resolves to " + path.target.string() +
                             ", outside the model repository");
     if (refused_.count(path.relative)) continue;  // logged when first refused
-    log_warn("model_path_refused")
+    ops::log_warn("model_path_refused")
         .kv("path", user_text(path.relative))
         .kv("resolves_to", user_text(path.target.string()))
         .kv("reason", "outside the model repository");
@@ -239,7 +239,7 @@ std::shared_ptr<const ModelEntry> ModelRegistry::read_entry(const Key& key,
   entry->loaded_unix_ms = unix_ms_now();
   entry->signature = found.signature;
   if (entry->model->name != key.first || entry->model->version != key.second)
-    log_warn("model_name_mismatch")
+    ops::log_warn("model_name_mismatch")
         .kv("path", user_text(relative))
         .kv("file_model", user_text(entry->model->name))
         .kv("file_version", user_text(entry->model->version))
@@ -288,7 +288,7 @@ ReloadReport ModelRegistry::scan_locked() {
       failed_.erase(key);
       changed = true;
       ++report.loaded;
-      log_info("model_loaded")
+      ops::log_info("model_loaded")
           .kv("model", user_text(key.first))
           .kv("version", user_text(key.second))
           .kv("path", user_text(entry->path));
@@ -296,7 +296,7 @@ ReloadReport ModelRegistry::scan_locked() {
       failed_[key] = file.signature;
       ++report.failed;
       report.errors.push_back(e.what());
-      log_error("model_load_failed")
+      ops::log_error("model_load_failed")
           .kv("model", user_text(key.first))
           .kv("version", user_text(key.second))
           .kv("error", user_text(e.what(), 1000));
@@ -317,7 +317,7 @@ ReloadReport ModelRegistry::scan_locked() {
         if (scans < options_.missing_scans_before_unload) {
           still_missing[key] = scans;
           ++report.missing;
-          log_warn("model_missing")
+          ops::log_warn("model_missing")
               .kv("model", user_text(key.first))
               .kv("version", user_text(key.second))
               .kv("missing_scans", scans)
@@ -325,7 +325,7 @@ ReloadReport ModelRegistry::scan_locked() {
           ++version;
           continue;
         }
-        log_info("model_removed")
+        ops::log_info("model_removed")
             .kv("model", user_text(key.first))
             .kv("version", user_text(key.second))
             .kv("missing_scans", scans);
@@ -381,7 +381,7 @@ std::shared_ptr<const ModelEntry> ModelRegistry::load(const std::string& model,
   failed_.erase(key);
   unloaded_.erase(key);
   unloaded_.erase({model, ""});
-  log_info("model_loaded")
+  ops::log_info("model_loaded")
       .kv("model", user_text(model))
       .kv("version", user_text(chosen))
       .kv("path", user_text(entry->path));
@@ -413,7 +413,7 @@ unsigned ModelRegistry::unload(const std::string& model, const std::string& vers
     settle_default_locked();
   }
   unloaded_.insert({model, version});
-  log_info("model_unloaded")
+  ops::log_info("model_unloaded")
       .kv("model", user_text(model))
       .kv("version", user_text(version))
       .kv("versions", removed);
@@ -541,4 +541,4 @@ std::string ModelRegistry::configuration_problem() const {
   return {};
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

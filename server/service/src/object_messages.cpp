@@ -1,6 +1,6 @@
 #include "primlabel/service/object_messages.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 namespace {
 
@@ -41,4 +41,4 @@ void add_objects(const tabletop::TabletopObjects& objects, v1::LabelSummary& sum
     to_message(object, *summary.add_objects());
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

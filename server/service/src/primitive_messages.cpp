@@ -2,7 +2,7 @@
 
 #include <variant>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 namespace {
 
@@ -84,4 +84,4 @@ void add_primitives(std::span<const primitives::Primitive> primitives, v1::Label
     to_message(primitives[s], static_cast<std::uint32_t>(s), *summary.add_primitives());
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

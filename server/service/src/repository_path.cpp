@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 bool is_within(const std::filesystem::path& root, const std::filesystem::path& path) {
   auto root_end = root.end();
@@ -10,4 +10,4 @@ bool is_within(const std::filesystem::path& root, const std::filesystem::path& p
   return std::mismatch(root.begin(), root_end, path.begin(), path.end()).first == root_end;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -7,7 +7,7 @@
 #include "primlabel/ops/logging.hpp"
 #include "primlabel/service/user_text.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 std::string next_request_id() {
   static const unsigned prefix = std::random_device{}();
@@ -18,7 +18,7 @@ std::string next_request_id() {
   return id;
 }
 
-RequestRecord::RequestRecord(std::string method, ServerMetrics& metrics)
+RequestRecord::RequestRecord(std::string method, ops::ServerMetrics& metrics)
     : method_(std::move(method)),
       metrics_(metrics),
       id_(next_request_id()),
@@ -39,7 +39,7 @@ void RequestRecord::finish(std::string_view code_name, std::string_view message)
   if (ok && points > 0) metrics_.points_labeled(metric_model, double(points));
   if (ok && !model_choice.empty()) metrics_.model_chosen(metric_model, model_choice);
   if (dropped_non_finite > 0) metrics_.points_dropped("non_finite", double(dropped_non_finite));
-  LogLine line(ok ? LogLevel::kInfo : LogLevel::kWarn, "request");
+  ops::LogLine line(ok ? ops::LogLevel::kInfo : ops::LogLevel::kWarn, "request");
   line.kv("method", method_)
       .kv("request_id", id_)
       .kv("scan_id", user_text(scan_id))
@@ -51,7 +51,7 @@ void RequestRecord::finish(std::string_view code_name, std::string_view message)
       .kv("status", code);
   if (!model_choice.empty()) line.kv("model_choice", model_choice);
   if (ok) line.kv("cascaded", cascaded);
-  for (const auto& [name, field] : kStages) {
+  for (const auto& [name, field] : ops::kStages) {
     const double value = stages.*field;
     if (value < 0) continue;
     metrics_.stage(name, value);
@@ -60,4 +60,4 @@ void RequestRecord::finish(std::string_view code_name, std::string_view message)
   if (!ok) line.kv("message", user_text(std::string(message), 2000));
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -7,7 +7,7 @@
 
 #include "primlabel/wire/packing.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 namespace {
 
@@ -156,4 +156,4 @@ std::optional<ServiceError> ScanAssembler::finish() const {
   return std::nullopt;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

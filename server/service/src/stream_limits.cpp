@@ -4,7 +4,7 @@
 #include <cstdio>
 #include <string>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 namespace {
 
@@ -70,7 +70,7 @@ std::optional<ServiceError> out_of_order(StreamPhase phase, const v1::LabelReque
                                                        "; expected a PointChunk or EndOfScan"};
 }
 
-StreamLimits::StreamLimits(const ServerConfig& config, Clock::time_point now)
+StreamLimits::StreamLimits(const ops::ServerConfig& config, Clock::time_point now)
     : config_(config), last_message_(now) {}
 
 void StreamLimits::message_arrived(std::uint64_t bytes, Clock::time_point now) {
@@ -126,4 +126,4 @@ std::optional<ServiceError> StreamLimits::check(StreamPhase phase, Clock::time_p
   return std::nullopt;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

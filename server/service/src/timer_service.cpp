@@ -2,7 +2,7 @@
 
 #include "primlabel/ops/logging.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 TimerService::TimerService() : thread_([this](std::stop_token stop) { run(stop); }) {}
 
@@ -61,13 +61,13 @@ void TimerService::run(std::stop_token stop) {
     try {
       callback();
     } catch (const std::exception& e) {  // a timer must never take the thread down
-      log_error("timer_failed").kv("error", e.what());
+      ops::log_error("timer_failed").kv("error", e.what());
     } catch (...) {
-      log_error("timer_failed").kv("error", "unknown exception");
+      ops::log_error("timer_failed").kv("error", "unknown exception");
     }
     callback = nullptr;  // its captures go outside the lock, too
     lock.lock();
   }
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

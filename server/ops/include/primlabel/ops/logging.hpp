@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 enum class LogLevel { kDebug, kInfo, kWarn, kError };
 
@@ -47,4 +47,4 @@ inline LogLine log_warn(std::string_view event) { return LogLine(LogLevel::kWarn
 inline LogLine log_error(std::string_view event) { return LogLine(LogLevel::kError, event); }
 inline LogLine log_debug(std::string_view event) { return LogLine(LogLevel::kDebug, event); }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

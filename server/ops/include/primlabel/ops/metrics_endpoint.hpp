@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 class MetricsEndpoint {
  public:
@@ -37,4 +37,4 @@ class MetricsEndpoint {
 // refused here, with a reason. This build's civetweb has no IPv6, so "[...]" is refused too.
 std::string civetweb_listening_port(const std::string& address);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string_view>
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 // The fields of /proc/<pid>/stat we use (proc(5): utime, stime, starttime in clock ticks,
 // vsize in bytes, rss in pages).
@@ -25,4 +25,4 @@ std::optional<ProcStat> parse_proc_stat(std::string_view text);
 // The "btime" line of /proc/stat: boot time, seconds since the epoch; nullopt without one.
 std::optional<std::uint64_t> parse_boot_time(std::string_view proc_stat_text);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 class ProcessCollector : public prometheus::Collectable {
  public:
@@ -31,4 +31,4 @@ class ProcessCollector : public prometheus::Collectable {
   std::string proc_stat_;
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

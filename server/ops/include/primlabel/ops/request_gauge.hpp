@@ -7,7 +7,7 @@
 
 #include "primlabel/ops/server_metrics.hpp"
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 class RequestGauge {
  public:
@@ -34,4 +34,4 @@ class RequestGauge {
   int in_flight_ = 0, queued_ = 0;
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -11,7 +11,7 @@
 
 #include "primlabel/cli/exit_codes.hpp"
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 struct ServerConfig {
   std::string models_dir;                         // <dir>/<model>/<version>/<file>.plm
@@ -62,4 +62,4 @@ ServerConfig parse_server_config(int argc, const char* const* argv);
 int effective_workers(const ServerConfig& config);
 int effective_threads_per_job(const ServerConfig& config);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

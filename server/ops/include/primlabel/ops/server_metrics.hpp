@@ -34,7 +34,7 @@
 #include <utility>
 #include <vector>
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 inline constexpr const char* kUnknownModelLabel = "unknown";
 
@@ -85,4 +85,4 @@ class ServerMetrics {
   std::set<std::string, std::less<>> loaded_models_;
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

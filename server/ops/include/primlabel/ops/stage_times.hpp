@@ -5,7 +5,7 @@
 
 #include <array>
 
-namespace primlabel::server {
+namespace primlabel::ops {
 
 // Seconds per stage; negative = the stage did not run.
 struct StageTimes {
@@ -28,4 +28,4 @@ inline constexpr std::array<StageField, 7> kStages = {{
     {"send", &StageTimes::send},
 }};
 
-}  // namespace primlabel::server
+}  // namespace primlabel::ops

@@ -8,11 +8,12 @@
 #include "primlabel/service/service_environment.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 class AdminService final : public v1::ModelAdmin::Service {
  public:
-  AdminService(const ServiceEnvironment& env, const TokenAuth& auth) : env_(env), auth_(auth) {}
+  AdminService(const service::ServiceEnvironment& env, const TokenAuth& auth)
+      : env_(env), auth_(auth) {}
 
   grpc::Status LoadModel(grpc::ServerContext* context, const v1::LoadModelRequest* request,
                          v1::LoadModelResponse* response) override;
@@ -22,8 +23,8 @@ class AdminService final : public v1::ModelAdmin::Service {
                             v1::ReloadModelsResponse* response) override;
 
  private:
-  const ServiceEnvironment& env_;
+  const service::ServiceEnvironment& env_;
   const TokenAuth& auth_;
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

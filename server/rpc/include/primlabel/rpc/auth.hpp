@@ -11,7 +11,7 @@
 
 #include "primlabel/service/service_error.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 class TokenAuth {
  public:
@@ -22,7 +22,8 @@ class TokenAuth {
   // Nothing, or UNAUTHENTICATED saying what is missing, or PERMISSION_DENIED naming the flags
   // that enable admin RPCs. `admin` RPCs need the token whenever one is configured; the others
   // only with required_for_all. Any kind of server context.
-  std::optional<ServiceError> check(const grpc::ServerContextBase& context, bool admin) const;
+  std::optional<service::ServiceError> check(const grpc::ServerContextBase& context,
+                                             bool admin) const;
 
   bool enabled() const { return !token_.empty(); }
   bool admin_open() const { return token_.empty() && insecure_admin_; }
@@ -41,4 +42,4 @@ struct TlsFiles {
 // Insecure credentials without a certificate; throws std::runtime_error for unreadable files.
 std::shared_ptr<grpc::ServerCredentials> server_credentials(const TlsFiles& files);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

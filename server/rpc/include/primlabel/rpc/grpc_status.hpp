@@ -6,11 +6,11 @@
 #include "primlabel/service/request_record.hpp"
 #include "primlabel/service/service_error.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
-grpc::Status to_grpc_status(const ServiceError& error);
+grpc::Status to_grpc_status(const service::ServiceError& error);
 
 // Finishes the request's record with `status`; returns it, for `return finish_request(...)`.
-grpc::Status finish_request(RequestRecord& record, const grpc::Status& status);
+grpc::Status finish_request(service::RequestRecord& record, const grpc::Status& status);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

@@ -20,7 +20,7 @@
 #include "primlabel/rpc/labeler_service.hpp"
 #include "primlabel/service/service_environment.hpp"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 inline constexpr const char* kLabelerServiceName = "primlabel.v1.Labeler";
 
@@ -30,7 +30,7 @@ class LabelServer {
   // binds both ports, the gRPC one exclusively (no SO_REUSEPORT). Throws ConfigError (exit code
   // 2) when --default-model or a --pin names no loaded model or version, std::runtime_error
   // when the repository is not a directory or an address cannot be bound.
-  explicit LabelServer(ServerConfig config);
+  explicit LabelServer(ops::ServerConfig config);
   ~LabelServer();  // shutdown(0) if still running
   LabelServer(const LabelServer&) = delete;
   LabelServer& operator=(const LabelServer&) = delete;
@@ -42,30 +42,30 @@ class LabelServer {
   // cancelled; returns when every handler has returned. Idempotent.
   void shutdown(std::chrono::milliseconds drain);
 
-  ModelRegistry& registry() { return registry_; }
-  ServerMetrics& metrics() { return metrics_; }
-  const ServerConfig& config() const { return config_; }
+  service::ModelRegistry& registry() { return registry_; }
+  ops::ServerMetrics& metrics() { return metrics_; }
+  const ops::ServerConfig& config() const { return config_; }
 
  private:
   void models_changed();
   void poll_models(std::stop_token stop);
 
-  ServerConfig config_;
-  ServerMetrics metrics_;
-  ModelRegistry registry_;
+  ops::ServerConfig config_;
+  ops::ServerMetrics metrics_;
+  service::ModelRegistry registry_;
   TokenAuth auth_;
   std::atomic<bool> draining_{false};
   // Before admission_: jobs still stopping when the workers are joined may touch them.
-  TimerService timers_;
-  IdleMemoryTrimmer trimmer_{timers_};
-  std::unique_ptr<SlotBudget> receiving_;
-  RequestGauge requests_{metrics_};
-  std::unique_ptr<Admission> admission_;
-  ServiceEnvironment env_;
+  service::TimerService timers_;
+  service::IdleMemoryTrimmer trimmer_{timers_};
+  std::unique_ptr<service::SlotBudget> receiving_;
+  ops::RequestGauge requests_{metrics_};
+  std::unique_ptr<service::Admission> admission_;
+  service::ServiceEnvironment env_;
   std::unique_ptr<LabelerService> labeler_;
   std::unique_ptr<AdminService> admin_;
   std::unique_ptr<grpc::Server> server_;
-  std::unique_ptr<MetricsEndpoint> metrics_endpoint_;
+  std::unique_ptr<ops::MetricsEndpoint> metrics_endpoint_;
   int port_ = 0;
   std::mutex health_mutex_;
   std::mutex shutdown_mutex_;
@@ -73,4 +73,4 @@ class LabelServer {
   std::jthread poller_;
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

@@ -6,14 +6,14 @@
 #include "primlabel/service/service_environment.hpp"
 #include "primlabel/v1/labeling.grpc.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::rpc {
 
 using LabelerBase = v1::Labeler::WithRawCallbackMethod_Label<
     v1::Labeler::WithRawCallbackMethod_LabelCloud<v1::Labeler::Service>>;
 
 class LabelerService final : public LabelerBase {
  public:
-  LabelerService(const ServiceEnvironment& env, const TokenAuth& auth);
+  LabelerService(const service::ServiceEnvironment& env, const TokenAuth& auth);
 
   grpc::ServerBidiReactor<grpc::ByteBuffer, grpc::ByteBuffer>* Label(
       grpc::CallbackServerContext* context) override;
@@ -28,10 +28,10 @@ class LabelerService final : public LabelerBase {
                                 v1::ModelMetadata* response) override;
 
  private:
-  const ServiceEnvironment& env_;
+  const service::ServiceEnvironment& env_;
   const TokenAuth& auth_;
 };
 
-void fill_model_info(const ServedModel& model, v1::ModelInfo& info);
+void fill_model_info(const service::ServedModel& model, v1::ModelInfo& info);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::rpc

@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 class Admission {
  public:
@@ -89,4 +89,4 @@ class Admission {
   std::vector<std::thread> threads_;
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

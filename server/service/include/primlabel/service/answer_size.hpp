@@ -7,7 +7,7 @@
 
 #include "primlabel/service/job_plan.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 // The answer's per-point arrays: a label, and as asked the descriptor, the class
 // probabilities, a segment id (primitives) and an object id (objects).
@@ -37,4 +37,4 @@ inline constexpr std::uint64_t kMaxTableMessageBytes = 64 + 1024 * 31;
 // primitive ids (the objects themselves are counted per point in answer_bytes_per_point).
 std::uint64_t answer_summary_bytes(const JobPlan& plan);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -12,7 +12,7 @@
 
 #include "primlabel/service/timer_service.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 // Requests below this many points free too little to be worth a trim (a few ms).
 inline constexpr std::uint64_t kTrimAfterPoints = 100'000;
@@ -40,4 +40,4 @@ class IdleMemoryTrimmer {
   std::shared_ptr<State> state_;  // shared with a pending timer, which may outlive this object
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

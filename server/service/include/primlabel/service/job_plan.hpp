@@ -17,7 +17,7 @@
 #include "primlabel/service/service_error.hpp"
 #include "primlabel/v1/labeling.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 struct JobPlan {
   // The model, held for the whole request: reloads cannot touch it. Empty until the job when
@@ -61,4 +61,4 @@ ServiceError server_busy(const Admission& admission);
 // UNAVAILABLE, for requests arriving while the server drains.
 ServiceError shutting_down();
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

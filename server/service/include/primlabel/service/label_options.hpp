@@ -10,7 +10,7 @@
 #include "primlabel/service/service_error.hpp"
 #include "primlabel/v1/labeling.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 pipeline::LabelingOptions labeling_options(const v1::ScanHeader& header);
 
@@ -20,4 +20,4 @@ std::optional<ServiceError> refuse_options(const pipeline::LabelingOptions& opti
 std::optional<ServiceError> refuse_options(const pipeline::LabelingOptions& options,
                                            const ModelEntry& model, bool chosen);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

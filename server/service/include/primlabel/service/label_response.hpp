@@ -10,7 +10,7 @@
 #include "primlabel/service/request_record.hpp"
 #include "primlabel/v1/labeling.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 class LabelResponder {
  public:
@@ -36,4 +36,4 @@ class LabelResponder {
 void fill_summary(const RequestRecord& record, const JobPlan& plan,
                   const pipeline::LabelingResult& result, v1::LabelSummary& summary);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

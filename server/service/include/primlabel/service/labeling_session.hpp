@@ -20,7 +20,7 @@
 #include "primlabel/service/scan_assembler.hpp"
 #include "primlabel/service/service_environment.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 class LabelingSession {
  public:
@@ -62,7 +62,7 @@ class LabelingSession {
   void note_model();  // the plan's model into the record
 
   const ServiceEnvironment& env_;
-  RequestGauge* const requests_;  // copied: the session may outlive the environment's owner
+  ops::RequestGauge* const requests_;  // copied: the session may outlive the environment's owner
   IdleMemoryTrimmer* const trimmer_;
   RequestRecord& record_;
   v1::ScanHeader header_;
@@ -81,4 +81,4 @@ class LabelingSession {
 // A streamed scan with no room among the receiving streams.
 ServiceError receiving_busy(const SlotBudget& budget);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

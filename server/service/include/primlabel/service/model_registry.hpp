@@ -32,7 +32,7 @@
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/v1/labeling.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 // Size and modification time: a version is reloaded when its file's signature changes.
 struct FileSignature {
@@ -182,4 +182,4 @@ class ModelRegistry {
   std::set<std::string> refused_;        // refused at the last scan (logged once)
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -5,7 +5,7 @@
 #include "primlabel/tabletop/tabletop_objects.hpp"
 #include "primlabel/v1/labeling.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 void to_message(const tabletop::TabletopTable& table, v1::TabletopTable& message);
 void to_message(const tabletop::TabletopObject& object, v1::TabletopObject& message);
@@ -13,4 +13,4 @@ void to_message(const tabletop::TabletopObject& object, v1::TabletopObject& mess
 // Sets the summary's table (or no_table_reason) and appends every object in id order.
 void add_objects(const tabletop::TabletopObjects& objects, v1::LabelSummary& summary);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -8,7 +8,7 @@
 #include "primlabel/primitives/primitive.hpp"
 #include "primlabel/v1/labeling.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 void to_message(const primitives::Primitive& primitive, std::uint32_t segment_id,
                 v1::Primitive& message);
@@ -16,4 +16,4 @@ void to_message(const primitives::Primitive& primitive, std::uint32_t segment_id
 // Appends primitives[s] as segment s.
 void add_primitives(std::span<const primitives::Primitive> primitives, v1::LabelSummary& summary);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

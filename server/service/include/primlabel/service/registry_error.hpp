@@ -4,7 +4,7 @@
 #include "primlabel/service/model_registry.hpp"
 #include "primlabel/service/service_error.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 inline ServiceError registry_error(const RegistryError& error) {
   switch (error.kind()) {
@@ -18,4 +18,4 @@ inline ServiceError registry_error(const RegistryError& error) {
   return {ErrorCode::kInternal, error.what()};
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

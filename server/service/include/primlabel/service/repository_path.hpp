@@ -5,10 +5,10 @@
 
 #include <filesystem>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 // True when `path` is `root` or lies below it; both canonical. Compared component by component,
 // so "/models-evil" does not lie within "/models".
 bool is_within(const std::filesystem::path& root, const std::filesystem::path& path);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -10,11 +10,11 @@
 #include "primlabel/ops/server_metrics.hpp"
 #include "primlabel/ops/stage_times.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 class RequestRecord {
  public:
-  RequestRecord(std::string method, ServerMetrics& metrics);
+  RequestRecord(std::string method, ops::ServerMetrics& metrics);
   RequestRecord(const RequestRecord&) = delete;
   RequestRecord& operator=(const RequestRecord&) = delete;
 
@@ -35,7 +35,7 @@ class RequestRecord {
   std::uint64_t points = 0, dropped_non_finite = 0;
   // Of the described points, those the plane cascade labeled plane (LabelSummary.cascaded_points).
   std::uint64_t cascaded = 0;
-  StageTimes stages;
+  ops::StageTimes stages;
 
   // Logs and counts the request once, with its outcome: the status code's name ("OK",
   // "INVALID_ARGUMENT", ...) and, when it failed, the message. The RPC edge calls it
@@ -44,7 +44,7 @@ class RequestRecord {
 
  private:
   std::string method_;
-  ServerMetrics& metrics_;
+  ops::ServerMetrics& metrics_;
   std::string id_;
   std::chrono::steady_clock::time_point start_;
   bool finished_ = false;
@@ -53,4 +53,4 @@ class RequestRecord {
 // A process-unique id: a random per-process prefix and a counter, e.g. "5f3a9c01-000042".
 std::string next_request_id();
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -13,7 +13,7 @@
 #include "primlabel/service/service_error.hpp"
 #include "primlabel/v1/labeling.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 struct ScanLimits {
   std::uint64_t max_points = 0;
@@ -50,4 +50,4 @@ class ScanAssembler {
 // Checks a header before any point arrives: limits against expected_points and option values.
 std::optional<ServiceError> check_header(const v1::ScanHeader& header, const ScanLimits& limits);
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -14,19 +14,19 @@
 #include "primlabel/service/slot_budget.hpp"
 #include "primlabel/service/timer_service.hpp"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 struct ServiceEnvironment {
-  const ServerConfig* config = nullptr;
+  const ops::ServerConfig* config = nullptr;
   ModelRegistry* registry = nullptr;
   Admission* admission = nullptr;
   SlotBudget* receiving = nullptr;
-  RequestGauge* requests = nullptr;
+  ops::RequestGauge* requests = nullptr;
   TimerService* timers = nullptr;
   IdleMemoryTrimmer* trimmer = nullptr;
-  ServerMetrics* metrics = nullptr;
+  ops::ServerMetrics* metrics = nullptr;
   const std::atomic<bool>* draining = nullptr;
   int threads_per_job = 1;
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

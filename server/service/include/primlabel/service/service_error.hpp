@@ -5,7 +5,7 @@
 
 #include <string>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 enum class ErrorCode {
   kCancelled,
@@ -30,4 +30,4 @@ struct ServiceError {
   std::string message;
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -5,7 +5,7 @@
 #include <optional>
 #include <utility>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 class SlotBudget {
  public:
@@ -51,4 +51,4 @@ class SlotBudget {
   std::atomic<int> used_{0};
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

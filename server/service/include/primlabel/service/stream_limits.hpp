@@ -14,7 +14,7 @@
 #include "primlabel/service/service_error.hpp"
 #include "primlabel/v1/labeling.pb.h"
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 enum class StreamPhase { kHeader, kReceiving, kLabeling, kSending, kFinished };
 
@@ -29,7 +29,7 @@ class StreamLimits {
  public:
   using Clock = std::chrono::steady_clock;
 
-  StreamLimits(const ServerConfig& config, Clock::time_point now);
+  StreamLimits(const ops::ServerConfig& config, Clock::time_point now);
 
   void message_arrived(std::uint64_t bytes, Clock::time_point now);
   // The header was accepted: the first rate window begins after a grace period of one window.
@@ -44,7 +44,7 @@ class StreamLimits {
   std::optional<ServiceError> check(StreamPhase phase, Clock::time_point now);
 
  private:
-  const ServerConfig& config_;
+  const ops::ServerConfig& config_;
   Clock::time_point last_message_;
   Clock::time_point window_start_, rate_check_at_;
   std::uint64_t window_bytes_ = 0;
@@ -52,4 +52,4 @@ class StreamLimits {
   Clock::time_point write_started_;
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -12,7 +12,7 @@
 #include <thread>
 #include <utility>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 class TimerService {
  public:
@@ -40,4 +40,4 @@ class TimerService {
   std::jthread thread_;  // last: stops and joins before the maps go
 };
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-namespace primlabel::server {
+namespace primlabel::service {
 
 inline constexpr std::size_t kMaxUserText = 200;
 
@@ -23,4 +23,4 @@ inline std::string user_text(std::string_view text, std::size_t max_bytes = kMax
   return out;
 }
 
-}  // namespace primlabel::server
+}  // namespace primlabel::service

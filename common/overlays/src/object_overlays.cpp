@@ -1,10 +1,10 @@
-#include "object_overlays.hpp"
+#include "primlabel/overlays/object_overlays.hpp"
 
 #include <string>
 
 #include "primlabel/render/box_outlines.hpp"
 
-namespace primlabel::client::tools {
+namespace primlabel {
 
 std::vector<Overlay> object_overlays(const tabletop::TabletopObjects& objects) {
   std::vector<LabeledBox> boxes;
@@ -15,4 +15,4 @@ std::vector<Overlay> object_overlays(const tabletop::TabletopObjects& objects) {
   return table_top_outlines(objects.table ? objects.table->hull : std::vector<Vec3f>{}, boxes);
 }
 
-}  // namespace primlabel::client::tools
+}  // namespace primlabel
