@@ -322,6 +322,30 @@ void explain_misses(const char* what, std::uint64_t seed, const primitives::Prim
       std::printf("\n");
     }
   }
+  // The detections no true primitive took (what precision counts against).
+  std::vector<bool> taken(set.primitives.size(), false);
+  for (const auto& pair : m.pairs) taken[pair.detection] = true;
+  for (std::size_t d = 0; d < set.primitives.size(); ++d) {
+    const primitives::Primitive& p = set.primitives[d];
+    const PrimitiveKind kind = p.kind();
+    if (taken[d] || p.points < options.min_detection_points ||
+        !(kind == PrimitiveKind::kPlane || kind == PrimitiveKind::kCylinder ||
+          kind == PrimitiveKind::kSphere || kind == PrimitiveKind::kTorus))
+      continue;
+    std::printf(
+        "extra %s seed %llu: detection %zu: %s class %u, %zu points (%zu inliers), rms "
+        "%.2f mm, confidence %.2f",
+        what, static_cast<unsigned long long>(seed), d,
+        std::string(primitives::kind_name(kind)).c_str(), p.class_id, p.points, p.inliers,
+        1000 * p.rms, p.confidence);
+    if (const auto* t = std::get_if<primitives::TorusModel>(&p.model))
+      std::printf(", R %.1f r %.1f mm", 1000 * t->major_radius, 1000 * t->minor_radius);
+    if (const auto* c = std::get_if<primitives::CylinderModel>(&p.model))
+      std::printf(", r %.1f mm", 1000 * c->radius);
+    if (const auto* sp = std::get_if<primitives::SphereModel>(&p.model))
+      std::printf(", r %.1f mm", 1000 * sp->radius);
+    std::printf("\n");
+  }
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -474,7 +498,8 @@ BenchCommand add_primitives_command(CLI::App& parent) {
       ->check(CLI::Range(0.5, 100.0))
       ->capture_default_str();
   cmd->add_flag("--explain-misses", args->explain_misses,
-                "print, per unmatched true primitive, the detections with points on it");
+                "print, per unmatched true primitive, the detections with points on it, and the "
+                "detections no true primitive took");
   return {cmd, [args] { return run_primitives_bench(*args); }};
 }
 

@@ -163,6 +163,81 @@ TEST(PrimitiveFit, EdgeIsTheCreaseOfItsTwoFaces) {
   EXPECT_GT(f->confidence, 0.95);
 }
 
+// Model selection (FitSettings::prefer_simpler): a curved fit is reported only when it describes
+// its points better than the simpler surfaces do. Each case first shows the curved fitter does
+// return a model on those points, so the check can fail.
+std::optional<Fit> fit_with(PrimitiveKind kind, const Samples& s, bool prefer_simpler,
+                            double max_radius = FitSettings{}.max_radius) {
+  const std::vector<std::uint32_t> idx = s.indices();
+  FitSettings settings;
+  settings.prefer_simpler = prefer_simpler;
+  settings.max_radius = max_radius;
+  return fit_model(kind, SegmentPoints{s.xyz, s.normals, idx}, settings, 1);
+}
+std::optional<Fit> fit_without_selection(PrimitiveKind kind, const Samples& s) {
+  return fit_with(kind, s, false);
+}
+
+TEST(PrimitiveFit, FlatPatchIsNotReportedAsSphereOrTorus) {
+  SampleMaker m(11);
+  Samples s;
+  // A 12 x 8 cm patch of a table top, 0.5 mm noise, normals tilted a few degrees. With radii up
+  // to 50 m the sphere and torus fitters find one (a large, flat one) on it.
+  for (int i = 0; i < 1000; ++i)
+    m.add(s, V(m.uniform(0, 0.12), m.uniform(0, 0.08), 0.7), V::UnitZ());
+  for (PrimitiveKind kind : {PrimitiveKind::kSphere, PrimitiveKind::kTorus}) {
+    SCOPED_TRACE(std::string(kind_name(kind)));
+    ASSERT_TRUE(fit_with(kind, s, false, 50.0));
+    EXPECT_FALSE(fit_with(kind, s, true, 50.0));
+  }
+  EXPECT_TRUE(fit(PrimitiveKind::kPlane, s));
+}
+
+TEST(PrimitiveFit, NearPlanarSpherePatchIsNotReportedAsTorus) {
+  SampleMaker m(11);
+  Samples s;
+  // A 6 x 4 cm patch of a sphere of radius 1.5 m (0.2 mm from its tangent plane at the corners,
+  // under the 0.5 mm noise): the torus fitter finds a torus on it; a plane or a sphere says as
+  // much with fewer parameters.
+  const V center(0, 0, -0.8);
+  for (int i = 0; i < 2000; ++i) {
+    const V d = V(m.uniform(-0.03, 0.03), m.uniform(-0.02, 0.02), 1.5).normalized();
+    m.add(s, center + 1.5 * d, d);
+  }
+  const auto torus = fit_without_selection(PrimitiveKind::kTorus, s);
+  ASSERT_TRUE(torus);
+  const std::vector<std::uint32_t> idx = s.indices();
+  EXPECT_FALSE(explains_better_than_simpler(
+      PrimitiveKind::kTorus, *torus, SegmentPoints{s.xyz, s.normals, idx}, FitSettings{}, 1));
+  EXPECT_FALSE(fit(PrimitiveKind::kTorus, s));
+}
+
+TEST(PrimitiveFit, CylinderPatchIsNotReportedAsTorus) {
+  SampleMaker m(12);
+  Samples s;
+  // 400 points on 2 cm of a torus with a 0.5 m major radius: its centre circle 0.1 mm off
+  // straight, under the 0.5 mm noise.
+  for (int i = 0; i < 400; ++i) {
+    const double phi = m.uniform(-0.02, 0.02), theta = m.uniform(-M_PI / 2, M_PI / 2);
+    const V radial(std::cos(phi), std::sin(phi), 0);
+    const V n = std::cos(theta) * radial + std::sin(theta) * V::UnitZ();
+    m.add(s, V(-0.5, 0, 0) + 0.5 * radial + 0.04 * n, n);
+  }
+  ASSERT_TRUE(fit_without_selection(PrimitiveKind::kTorus, s));
+  EXPECT_FALSE(fit(PrimitiveKind::kTorus, s));
+  EXPECT_TRUE(fit(PrimitiveKind::kCylinder, s));  // and the cylinder beats the plane
+}
+
+TEST(PrimitiveFit, TrueTorusBeatsPlaneCylinderAndSphere) {
+  SampleMaker m(13);
+  Samples s;
+  // A mug's handle-sized torus seen from one side: half the tube all round the axis.
+  test::add_torus(s, m, V(0, 0, 0.1), V::UnitX(), 0.03, 0.006, -M_PI / 2, M_PI / 2, 2000);
+  const auto f = fit(PrimitiveKind::kTorus, s);
+  ASSERT_TRUE(f);
+  EXPECT_NEAR(std::get<TorusModel>(f->model).major_radius, 0.03, 0.001);
+}
+
 // The bounds above bite: the same cylinder fitted as a sphere is far off any of them.
 TEST(PrimitiveFit, WrongModelFitsBadly) {
   SampleMaker m(8);

@@ -25,6 +25,10 @@ struct FitSettings {
   std::size_t max_refine_points = 20000;  // least squares runs on at most this many inliers
   int refine_iterations = 20;
   double min_radius = 0.002, max_radius = 2.0;  // cylinders, spheres, tori (major radius)
+  // fit_model reports a cylinder, sphere or torus only when its description length (BIC on the
+  // band-truncated residuals, explains_better_than_simpler) beats every simpler surface fitted
+  // to the same points: a plane; for a torus also a cylinder and a sphere.
+  bool prefer_simpler = true;
 
   void validate() const;  // throws std::invalid_argument naming the bad setting
 };
@@ -60,7 +64,18 @@ std::optional<Fit> fit_torus(const SegmentPoints& points, const FitSettings& set
 std::optional<Fit> fit_line(const SegmentPoints& points, const FitSettings& settings,
                             std::uint64_t seed);
 
-// Dispatches on `kind` (kSegment: nothing).
+// Whether `fit` (of `kind`: cylinder, sphere or torus; any other kind is always true) has a
+// lower description length on `points` than each simpler surface fitted to them with the same
+// seed: n ln(S / n) + k ln n (BIC with the noise variance unknown), S the squared distances
+// truncated at the inlier band (MSAC's cost: a point outside it, or with a disagreeing normal,
+// costs the band's square), k the surface's parameters (plane 3, sphere 4, cylinder 5, torus
+// 7). No constant to tune: the band is the fit's own and the penalty is BIC's (residuals under a
+// thousandth of the band count as that, so noise-free points do not give ln 0).
+bool explains_better_than_simpler(PrimitiveKind kind, const Fit& fit, const SegmentPoints& points,
+                                  const FitSettings& settings, std::uint64_t seed);
+
+// Dispatches on `kind` (kSegment: nothing); with settings.prefer_simpler, nothing for a curved
+// fit a simpler surface describes as well (explains_better_than_simpler).
 std::optional<Fit> fit_model(PrimitiveKind kind, const SegmentPoints& points,
                              const FitSettings& settings, std::uint64_t seed);
 
