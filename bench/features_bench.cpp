@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "bench_timing.hpp"
 #include "pcl_availability.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
@@ -51,18 +52,6 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Runs `work` `repeat` times and returns the fastest wall time: the least disturbed by the other
-// processes sharing the machine.
-double best_seconds(int repeat, const std::function<void()>& work) {
-  double best = std::numeric_limits<double>::infinity();
-  for (int r = 0; r < std::max(1, repeat); ++r) {
-    const auto start = Clock::now();
-    work();
-    best = std::min(best, seconds_since(start));
-  }
-  return best;
-}
-
 double peak_rss_mb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
@@ -84,19 +73,6 @@ class JsonLine {
  private:
   json::Json line_ = json::Json::object();
 };
-
-// The finite points of `cloud` as a new unorganised cloud (xyz and viewpoint only): both
-// primlabel and PCL then work on exactly the same points, with no NaN handling in the way.
-PointCloud finite_points(const PointCloud& cloud) {
-  PointCloud out;
-  out.viewpoint = cloud.viewpoint;
-  out.xyz.reserve(cloud.size());
-  for (const Vec3f& p : cloud.xyz)
-    if (is_finite(p)) out.xyz.push_back(p);
-  out.width = static_cast<std::uint32_t>(out.xyz.size());
-  out.height = 1;
-  return out;
-}
 
 // Evenly spaced indices 0, n/m, 2n/m, ... : at most `m` of them, the same on every run.
 std::vector<std::size_t> stride_sample(std::size_t n, std::size_t m) {

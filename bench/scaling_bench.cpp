@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "bench_commands.hpp"
+#include "bench_timing.hpp"
 #include "pcl_availability.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
@@ -35,8 +36,6 @@
 namespace primlabel::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 struct Arguments {
   std::string input;  // empty: the synthetic LMS400 test scene 0
   std::vector<int> threads = {1, 2, 4, 8, 16};
@@ -50,29 +49,6 @@ struct Row {
   double normals_pts_s = 0, fpfh_pts_s = 0;
   std::optional<double> pcl_normals_pts_s, pcl_fpfh_pts_s;
 };
-
-// The fastest of `repeat` runs: the least disturbed by other processes.
-template <typename Work>
-double best_seconds(int repeat, Work&& work) {
-  double best = std::numeric_limits<double>::infinity();
-  for (int r = 0; r < repeat; ++r) {
-    const auto start = Clock::now();
-    work();
-    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
-  }
-  return best;
-}
-
-// The finite points only, unorganised: both libraries see exactly the same points.
-PointCloud finite_points(const PointCloud& cloud) {
-  PointCloud out;
-  out.viewpoint = cloud.viewpoint;
-  for (const Vec3f& p : cloud.xyz)
-    if (is_finite(p)) out.xyz.push_back(p);
-  out.width = static_cast<std::uint32_t>(out.xyz.size());
-  out.height = 1;
-  return out;
-}
 
 int run(const Arguments& args) {
   PointCloud cloud =
