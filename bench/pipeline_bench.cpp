@@ -58,6 +58,7 @@ struct Arguments {
   bool compare_unshared = false;  // also each case without the shared neighbour lists
   bool compare_cascade = false;   // also each case with the plane cascade
   bool compare_crease = false;    // also each case with crease_points the other way
+  bool tabletop = false;          // only the table and its objects, as `label --tabletop`
   int stop_latency = 0;           // > 0: stops per input
 };
 
@@ -128,7 +129,7 @@ LabelModel quick_model(synth::SensorKind sensor) {
 }
 
 Row measure(const LabelModel& model, const PointCloud& scene, int threads, int repeat, float voxel,
-            bool share_lists, bool cascade, bool crease) {
+            bool share_lists, bool cascade, bool crease, bool tabletop) {
   Row best;
   best.total_s = std::numeric_limits<double>::infinity();
   pipeline::LabelingOptions options;
@@ -136,6 +137,7 @@ Row measure(const LabelModel& model, const PointCloud& scene, int threads, int r
   options.share_neighbor_lists = share_lists;
   options.plane_cascade = cascade;
   options.crease_points = crease;
+  options.tabletop_only = options.want_objects = tabletop;
   std::vector<double> totals, cpu;
   std::vector<pipeline::StageSeconds> runs;
   for (int r = 0; r < repeat; ++r) {
@@ -315,8 +317,8 @@ int run_pipeline_bench(const Arguments& args) {
       for (float voxel : args.voxel_sizes)
         for (int threads : args.threads)
           for (const Variant& v : variants) {
-            Row row =
-                measure(model, scene, threads, args.repeat, voxel, v.share, v.cascade, v.crease);
+            Row row = measure(model, scene, threads, args.repeat, voxel, v.share, v.cascade,
+                              v.crease, args.tabletop);
             row.sensor = name;
             row.model = model_name + (v.share ? "" : "-unshared") + (v.cascade ? "-cascade" : "") +
                         (v.crease == crease ? ""
@@ -397,6 +399,9 @@ BenchCommand add_pipeline_command(CLI::App& parent) {
   cmd->add_flag("--compare-crease", args->compare_crease,
                 "also run every case with LabelingOptions::crease_points the other way (the "
                 "per-point labels near creases)");
+  cmd->add_flag("--tabletop", args->tabletop,
+                "label only the table and the objects on it, with the objects (as the service's "
+                "label --tabletop --objects)");
   cmd->add_option("--repeat", args->repeat, "runs per case, the fastest counts (default 1)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--stop-latency", args->stop_latency,

@@ -12,7 +12,9 @@
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/cloud_signature.hpp"
 #include "primlabel/geometry/features.hpp"
+#include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/research/mosd_report.hpp"
+#include "primlabel/tabletop/tabletop_objects.hpp"
 #include "random_label_model.hpp"
 #include "test_util.hpp"
 
@@ -94,6 +96,39 @@ TEST(PipelineMosd, TablePointsNearAnObjectAreTheContactBand) {
   EXPECT_DOUBLE_EQ(report.mean_away_plane_share(), scene.away_plane_share());
   EXPECT_NE(research::mosd_report_json(report).find("\"mean_away_plane_share\":"),
             std::string::npos);
+}
+
+// One answer: the service's table-top objects (label_cloud with voxels, as a Kinect model labels)
+// are primlabel-tabletop's for the same frame, point for point and largest first. learn25 holds a
+// stack the crease split and the stacked split cut, learn33 five objects.
+TEST(PipelineMosd, ObjectsThroughVoxelsAreTheTabletopStagesOnTheFrame) {
+  for (const char* name : {"learn25", "learn33"}) {
+    SCOPED_TRACE(name);
+    const std::string path = mosd(name);
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "shared data absent: " << path;
+    const PointCloud cloud = read_cloud(path);
+    const tabletop::TabletopResult stage =
+        tabletop::segment_tabletop(cloud, tabletop::TabletopOptions{}, RunContext{2});
+    tabletop::TabletopObjects expected = tabletop::object_ids(stage, cloud.size());
+    tabletop::describe_objects(cloud.xyz, expected);
+
+    pipeline::LabelingOptions options;
+    options.tabletop_only = true;
+    options.want_objects = true;
+    options.voxel_size = 0.007f;
+    PointCloud labeled = cloud;
+    const pipeline::LabelingResult result =
+        pipeline::label_cloud(zero_model(), labeled, options, RunContext{2});
+    ASSERT_TRUE(result.objects);
+    const tabletop::TabletopObjects& objects = *result.objects;
+    EXPECT_TRUE(objects.point_object == expected.point_object);
+    ASSERT_EQ(objects.objects.size(), expected.objects.size());
+    ASSERT_GE(objects.objects.size(), 2u);
+    for (std::size_t k = 0; k < objects.objects.size(); ++k) {
+      EXPECT_EQ(objects.objects[k].points, expected.objects[k].points) << k;
+      EXPECT_EQ(objects.objects[k].points, stage.clusters[k].size()) << k;  // largest first
+    }
+  }
 }
 
 TEST(PipelineMosd, SceneWithoutLabelsIsAClearError) {

@@ -74,18 +74,6 @@ Kept kept_points(const std::vector<std::uint8_t>& mask) {
   return kept;
 }
 
-// The object ids of the table-top stage's points carried to the input points they stand for
-// (`voxel_of_point`: per input point its voxel; null when the stage saw the input itself).
-tabletop::TabletopObjects objects_of_input(tabletop::TabletopObjects objects,
-                                           const std::vector<std::uint32_t>* voxel_of_point) {
-  if (!voxel_of_point) return objects;
-  std::vector<std::uint32_t> ids(voxel_of_point->size(), tabletop::kNoObject);
-  for (std::size_t i = 0; i < ids.size(); ++i)
-    if ((*voxel_of_point)[i] != kNoSlot) ids[i] = objects.point_object[(*voxel_of_point)[i]];
-  objects.point_object = std::move(ids);
-  return objects;
-}
-
 // Sends every slot through the next map (kNoSlot stays).
 void compose(std::vector<std::uint32_t>& slot_of, const std::vector<std::uint32_t>& next) {
   for (std::uint32_t& slot : slot_of)
@@ -104,41 +92,43 @@ LabelingPlan plan_labeling(const PointCloud& cloud, float voxel_size,
                            const LabelingOptions& options, const RunContext& context) {
   LabelingPlan plan;
   const bool with_normals = options.use_cloud_normals;
-  const auto voxels_start = std::chrono::steady_clock::now();
 
-  // 1. Voxels: a centroid stands for its voxel's members (non-finite points are in none).
+  // 1. The table-top stage on the input itself, as primlabel-tabletop runs it, so both give the
+  // same objects (its image steps need the organised frame, not voxels): only its table and
+  // objects are kept.
+  std::optional<Kept> kept;
+  if (options.tabletop_only) {
+    const auto tabletop_start = std::chrono::steady_clock::now();
+    const tabletop::TabletopResult segmented =
+        tabletop::segment_tabletop(cloud, tabletop::TabletopOptions{}, context);
+    kept = kept_points(tabletop::tabletop_mask(segmented, cloud.size()));
+    if (options.want_objects) plan.objects = tabletop::object_ids(segmented, cloud.size());
+    plan.seconds.tabletop = seconds_since(tabletop_start);
+    context.throw_if_stopped("labeling");
+  }
+
+  // 2. Voxels of the kept points: a centroid stands for its voxel's members (non-finite points
+  // are in none).
+  const auto voxels_start = std::chrono::steady_clock::now();
   std::optional<PointCloud> voxels;
   std::vector<std::uint32_t> voxel_of_point;
   if (voxel_size > 0.0f) {
     tabletop::VoxelGrid grid = tabletop::voxel_downsample(
-        cloud.xyz, tabletop::finite_indices(cloud.xyz), voxel_size, context);
+        cloud.xyz, kept ? kept->points : tabletop::finite_indices(cloud.xyz), voxel_size, context);
     voxels = voxel_cloud(cloud, grid, with_normals);
     voxel_of_point = std::move(grid.voxel_of_point);
     plan.voxel_size = voxel_size;
     plan.seconds.voxels = seconds_since(voxels_start);
     context.throw_if_stopped("labeling");
   }
-  const PointCloud& base = voxels ? *voxels : cloud;
 
-  // 2. The table-top stage, on the voxels when there are: only its table and objects are kept.
-  std::optional<Kept> kept;
-  const auto tabletop_start = std::chrono::steady_clock::now();
-  if (options.tabletop_only) {
-    const tabletop::TabletopResult segmented =
-        tabletop::segment_tabletop(base, tabletop::TabletopOptions{}, context);
-    kept = kept_points(tabletop::tabletop_mask(segmented, base.size()));
-    if (options.want_objects)
-      plan.objects = objects_of_input(tabletop::object_ids(segmented, base.size()),
-                                      voxels ? &voxel_of_point : nullptr);
-  }
-  if (options.tabletop_only) plan.seconds.tabletop = seconds_since(tabletop_start);
-  context.throw_if_stopped("labeling");
-
-  // 3. Exact duplicates among the kept points: one slot per position. Its time includes the slot
+  // 3. Exact duplicates among what is left: one slot per position. Its time includes the slot
   // map and the gather below.
   const auto duplicates_start = std::chrono::steady_clock::now();
-  const DuplicateMap duplicates = kept ? find_duplicates(base.xyz, kept->points, context.stop)
-                                       : find_duplicates(base.xyz, context.stop);
+  const PointCloud& base = voxels ? *voxels : cloud;
+  const bool kept_input = kept && !voxels;  // the voxels hold only kept points already
+  const DuplicateMap duplicates = kept_input ? find_duplicates(base.xyz, kept->points, context.stop)
+                                             : find_duplicates(base.xyz, context.stop);
   plan.merges_points = voxels || duplicates.any();
   if (!voxels && !kept && !duplicates.any()) {
     plan.in_place = true;
@@ -146,19 +136,19 @@ LabelingPlan plan_labeling(const PointCloud& cloud, float voxel_size,
     return plan;
   }
 
-  // 4. Per input point its slot: input -> voxel -> kept point -> distinct position.
+  // 4. Per input point its slot: input -> voxel or kept point -> distinct position.
   plan.slot_of = voxels ? std::move(voxel_of_point) : identity(cloud.size());
-  if (kept) compose(plan.slot_of, kept->position_of);
+  if (kept_input) compose(plan.slot_of, kept->position_of);
   compose(plan.slot_of, duplicates.slot_of);
 
   // 5. The one cloud to describe: every slot's representative.
-  if (voxels && !kept && !duplicates.any()) {
+  if (voxels && !duplicates.any()) {
     plan.described = std::move(*voxels);  // every voxel is its own slot
     plan.seconds.duplicates = seconds_since(duplicates_start);
     return plan;
   }
   std::vector<std::uint32_t> representatives = duplicates.representatives;
-  if (kept) compose(representatives, kept->points);
+  if (kept_input) compose(representatives, kept->points);
   plan.described = gather(base, representatives, with_normals);
   plan.seconds.duplicates = seconds_since(duplicates_start);
   return plan;

@@ -1,8 +1,9 @@
 #pragma once
 // Where every input point of label_cloud takes its answer from. Three maps are composed once:
-// voxel downsampling (a voxel's centroid stands for its members), the table-top stage (only the
-// table and its objects are labeled) and exact duplicates (duplicates.hpp: one representative per
-// position, the lowest index), in that order, each on what the one before kept. The described
+// the table-top stage on the input (only the table and its objects are labeled), voxel
+// downsampling (a voxel's centroid stands for its members) and exact duplicates (duplicates.hpp:
+// one representative per position, the lowest index), in that order, each on what the one before
+// kept. The described
 // cloud holds one point per slot; every input point has a slot, or none and stays unknown.
 
 #include <cstdint>
