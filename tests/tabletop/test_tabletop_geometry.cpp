@@ -237,6 +237,34 @@ TEST(TabletopConvexHull, SquareWithInteriorAndEdgePoints) {
   EXPECT_EQ(convex_hull({{0, 0}, {1, 1}, {2, 2}}).size(), 2u);  // collinear: a segment
 }
 
+// The cached squares answer as hull_contains does, near the boundary and far from it, with a
+// margin either way; a point at infinity, NaN or far away is answered by the plain test.
+TEST(TabletopConvexHull, MembershipBySquaresAnswersAsTheEdgeTest) {
+  std::vector<Vec2f> ring;
+  for (int k = 0; k < 40; ++k) {
+    const float a = 2.0f * float(M_PI) * float(k) / 40.0f;
+    ring.emplace_back(0.3f + 0.8f * std::cos(a), -0.2f + 0.5f * std::sin(a));
+  }
+  const std::vector<Vec2f> hull = convex_hull(ring);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> x(-0.7f, 1.3f), y(-0.9f, 0.5f);
+  for (const float margin : {0.0f, 0.01f, -0.02f}) {
+    HullMembership membership(hull, margin, 0.02f);
+    std::size_t inside = 0;
+    for (int i = 0; i < 20000; ++i) {
+      const Vec2f p(x(rng), y(rng));
+      const bool expected = hull_contains(hull, p, margin);
+      ASSERT_EQ(membership.contains(p), expected) << p.transpose() << " margin " << margin;
+      inside += expected;
+    }
+    EXPECT_GT(inside, 5000u);
+    EXPECT_LT(inside, 18000u);
+    for (const Vec2f& odd : {Vec2f(std::numeric_limits<float>::infinity(), 0.0f),
+                             Vec2f(std::nanf(""), 0.0f), Vec2f(3e38f, -3e38f)})
+      EXPECT_EQ(membership.contains(odd), hull_contains(hull, odd, margin));
+  }
+}
+
 TEST(TabletopConvexHull, PlaneBasisIsRightHanded) {
   for (const Vec3f& n : {Vec3f(0, 0, 1), Vec3f(0, -0.8f, -0.6f), Vec3f(1, 0, 0)}) {
     Vec3f u, v;

@@ -30,6 +30,29 @@ bool hull_contains(const std::vector<Vec2f>& hull, const Vec2f& p, float margin)
   return true;
 }
 
+HullMembership::HullMembership(const std::vector<Vec2f>& hull, float margin, float cell)
+    : hull_(hull), margin_(margin), cell_(cell) {}
+
+bool HullMembership::contains(const Vec2f& p) {
+  constexpr float kRoundingGuard = 1e-4f;
+  const float sx = std::floor(p.x() / cell_), sy = std::floor(p.y() / cell_);
+  if (std::isfinite(sx) && std::isfinite(sy) && std::abs(sx) < 2e9f && std::abs(sy) < 2e9f) {
+    const auto x = static_cast<std::int32_t>(sx), y = static_cast<std::int32_t>(sy);
+    const std::uint64_t key = std::uint64_t(std::uint32_t(x)) << 32 | std::uint32_t(y);
+    auto [it, fresh] = square_inside_.try_emplace(key, false);
+    if (fresh) {
+      bool inside = true;
+      for (int corner = 0; corner < 4 && inside; ++corner)
+        inside = hull_contains(
+            hull_, Vec2f((sx + float(corner & 1)) * cell_, (sy + float(corner >> 1)) * cell_),
+            margin_ - kRoundingGuard);
+      it->second = inside;
+    }
+    if (it->second) return true;
+  }
+  return hull_contains(hull_, p, margin_);
+}
+
 void plane_basis(const Eigen::Vector3f& normal, Eigen::Vector3f& u, Eigen::Vector3f& v) {
   const Eigen::Vector3f n = normal.normalized();
   // Start from the coordinate axis least aligned with n, for a well-conditioned cross product.

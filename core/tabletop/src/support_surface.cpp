@@ -62,12 +62,12 @@ std::size_t support_count(const std::vector<Vec3f>& points, const std::vector<st
                           const SupportOptions& options) {
   if (surface.not_a_table) return 0;
   std::size_t held = 0;
+  HullMembership inside_hull(surface.hull, 0.0f, surface.band_grid->cell());
   for (std::size_t k = 0; k < valid.size(); k += std::size_t(options.count_stride)) {
     const std::uint32_t i = valid[k];
     const float h = surface.height[i];
-    held +=
-        surface.is_table[i] || (h >= rules.min_height && h <= rules.max_height &&
-                                hull_contains(surface.hull, surface.band_grid->project(points[i])));
+    held += surface.is_table[i] || (h >= rules.min_height && h <= rules.max_height &&
+                                    inside_hull.contains(surface.band_grid->project(points[i])));
   }
   return held;
 }

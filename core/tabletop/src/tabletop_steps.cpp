@@ -158,6 +158,7 @@ ObjectCandidates object_candidates(const PointCloud& cloud, const std::vector<st
   const std::vector<Vec3f>& xyz = cloud.xyz;
   const std::vector<float>& height = surface.height;
   ObjectCandidates candidates;
+  HullMembership inside_hull(surface.hull, options.hull_margin, surface.band_grid->cell());
   for (std::uint32_t i : valid) {
     if (surface.is_table[i] || height[i] > options.max_object_height) continue;
     // Below the table inside its boundary is only the table seen through depth noise.
@@ -166,7 +167,7 @@ ObjectCandidates object_candidates(const PointCloud& cloud, const std::vector<st
                   -height[i] > table_noise_band(options.table_noise, options.table_band,
                                                 (xyz[i] - cloud.viewpoint.origin).norm())))
       continue;
-    if (hull_contains(surface.hull, surface.band_grid->project(xyz[i]), options.hull_margin))
+    if (inside_hull.contains(surface.band_grid->project(xyz[i])))
       (below ? candidates.below_table : candidates.above).push_back(i);
   }
   return candidates;
