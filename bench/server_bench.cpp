@@ -35,6 +35,7 @@
 
 #include "bench_commands.hpp"
 #include "label_stages.hpp"
+#include "loopback_server_config.hpp"
 #include "primlabel/cli/exit_codes.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
@@ -331,12 +332,8 @@ int run_server_bench(const Arguments& args) {
     fs::copy_file(file, repo / frame.name / "1" / "model.plm");
     frame_cases.push_back(std::move(frame));
   }
-  ops::ServerConfig config;
-  config.models_dir = repo.string();
-  config.listen = "127.0.0.1:0";
+  ops::ServerConfig config = test::loopback_server_config(repo.string());
   config.metrics_listen = "";
-  config.reload_seconds = 0;
-  config.workers = 1;
   config.threads_per_job = args.threads;
   config.max_points = std::max<std::uint64_t>(config.max_points, args.cancel_points);
   rpc::LabelServer server(config);

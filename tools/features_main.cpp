@@ -49,6 +49,22 @@ int print_signature(const Arguments& args) {
   return cli::kExitOk;
 }
 
+// The K of --normal-k and --feature-k when neither that nor the radius is given.
+constexpr int kDefaultNeighbors = 10;
+
+// --NAME-k and --NAME-radius: `what` from the K nearest points or from those within R, not both.
+// 0 stands for "not given"; --help shows what is used then.
+void add_neighborhood_options(CLI::App& app, const std::string& name, const std::string& what,
+                              int& k, float& radius) {
+  CLI::Option* k_option = app.add_option("--" + name + "-k", k, what + " from the K nearest points")
+                              ->check(CLI::PositiveNumber)
+                              ->default_str(std::to_string(kDefaultNeighbors));
+  app.add_option("--" + name + "-radius", radius, what + " from points within R")
+      ->check(CLI::PositiveNumber)
+      ->default_str("")
+      ->excludes(k_option);
+}
+
 Neighborhood neighborhood_of(int k, float radius, int max_neighbors, int default_k) {
   if (radius > 0)
     return max_neighbors > 0 ? Neighborhood::Hybrid(radius, max_neighbors)
@@ -84,7 +100,7 @@ int run(const Arguments& args) {
   } else {
     NormalOptions options;
     options.neighborhood =
-        neighborhood_of(args.normal_k, args.normal_radius, args.max_neighbors, 10);
+        neighborhood_of(args.normal_k, args.normal_radius, args.max_neighbors, kDefaultNeighbors);
     if (!args.viewpoint.empty()) options.viewpoint = cli::parse_vec3(args.viewpoint);
     const NormalStats stats = estimate_normals(
         cloud, options, RunContext{args.threads, {}, progress.stage("normals")}, &search);
@@ -96,7 +112,7 @@ int run(const Arguments& args) {
 
   FeatureOptions options;
   options.neighborhood =
-      neighborhood_of(args.feature_k, args.feature_radius, args.max_neighbors, 10);
+      neighborhood_of(args.feature_k, args.feature_radius, args.max_neighbors, kDefaultNeighbors);
   options.fpfh_variant = args.variant == "paper" ? FpfhVariant::kWithOwnSpfh : FpfhVariant::kPcl;
   const RunContext context{args.threads, {}, progress.stage(args.descriptor)};
   const auto features_start = std::chrono::steady_clock::now();
@@ -137,21 +153,8 @@ int main(int argc, char** argv) {
                "print the cloud's signature (point spacing, roughness, noise growth with range: "
                "what a server picks a model by) as one JSON line instead")
       ->excludes(output);
-  // 0 stands for "not given"; --help shows what is used then.
-  auto* nk = app.add_option("--normal-k", args.normal_k, "normals from the K nearest points")
-                 ->check(CLI::PositiveNumber)
-                 ->default_str("10");
-  app.add_option("--normal-radius", args.normal_radius, "normals from points within R")
-      ->check(CLI::PositiveNumber)
-      ->default_str("")
-      ->excludes(nk);
-  auto* fk = app.add_option("--feature-k", args.feature_k, "descriptors from the K nearest points")
-                 ->check(CLI::PositiveNumber)
-                 ->default_str("10");
-  app.add_option("--feature-radius", args.feature_radius, "descriptors from points within R")
-      ->check(CLI::PositiveNumber)
-      ->default_str("")
-      ->excludes(fk);
+  add_neighborhood_options(app, "normal", "normals", args.normal_k, args.normal_radius);
+  add_neighborhood_options(app, "feature", "descriptors", args.feature_k, args.feature_radius);
   app.add_option("--max-neighbors", args.max_neighbors,
                  "cap radius neighbourhoods at the M nearest points")
       ->check(CLI::PositiveNumber)

@@ -26,16 +26,20 @@ class FeaturesCli : public ::testing::Test {
     bunny_ = test::shared_data("pcl/bun0.pcd");
     if (!std::filesystem::exists(bunny_)) GTEST_SKIP() << bunny_ << " not present";
   }
+  // primlabel-features on the bunny, writing `out` (in the test's folder).
+  Result describe_bunny(const std::string& out, const std::string& flags) {
+    return run(features_tool() + " " + bunny_ + " -o " + dir_.file(out) + " " + flags);
+  }
+
   std::string bunny_;
   test::TempDir dir_;
 };
 
 TEST_F(FeaturesCli, WritesNormalsCurvatureAndFpfh) {
-  const std::string out = dir_.file("bunny_fpfh.pcd");
-  const Result r = run(features_tool() + " " + bunny_ + " -o " + out +
-                       " --normal-k 10 --feature-radius 0.02 --threads 2");
+  const Result r =
+      describe_bunny("bunny_fpfh.pcd", "--normal-k 10 --feature-radius 0.02 --threads 2");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const PointCloud cloud = read_pcd(out);
+  const PointCloud cloud = read_pcd(dir_.file("bunny_fpfh.pcd"));
   EXPECT_EQ(cloud.size(), 397u);
   EXPECT_TRUE(cloud.has_normals());
   EXPECT_TRUE(cloud.has_curvature());
@@ -46,11 +50,10 @@ TEST_F(FeaturesCli, WritesNormalsCurvatureAndFpfh) {
 }
 
 TEST_F(FeaturesCli, ThePapersVariantIsNamedAsSuch) {
-  const std::string out = dir_.file("bunny_fpfh_paper.pcd");
-  const Result r = run(features_tool() + " " + bunny_ + " -o " + out +
-                       " --normal-k 10 --feature-radius 0.02 --fpfh-variant paper");
+  const Result r = describe_bunny("bunny_fpfh_paper.pcd",
+                                  "--normal-k 10 --feature-radius 0.02 --fpfh-variant paper");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const PointCloud cloud = read_pcd(out);
+  const PointCloud cloud = read_pcd(dir_.file("bunny_fpfh_paper.pcd"));
   EXPECT_EQ(cloud.find_field("fpfh"), nullptr);
   const FloatField* paper = cloud.find_field("fpfh_paper");
   ASSERT_NE(paper, nullptr);
@@ -61,12 +64,11 @@ TEST_F(FeaturesCli, ThePapersVariantIsNamedAsSuch) {
 }
 
 TEST_F(FeaturesCli, PfhToPlyWithInputNormals) {
-  const std::string out = dir_.file("bunny_pfh.ply");
-  const Result r = run(features_tool() + " " + bunny_ + " -o " + out +
-                       " --use-input-normals --feature-k 10 --descriptor pfh -q");
+  const Result r =
+      describe_bunny("bunny_pfh.ply", "--use-input-normals --feature-k 10 --descriptor pfh -q");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output, "");  // quiet
-  const PointCloud cloud = read_ply(out);
+  const PointCloud cloud = read_ply(dir_.file("bunny_pfh.ply"));
   const FloatField* pfh = cloud.find_field("pfh");
   ASSERT_NE(pfh, nullptr);
   EXPECT_EQ(pfh->count, kPfhSize);

@@ -344,12 +344,22 @@ TEST(ClientCli, TheSummaryLineSeparatesNanPointsFromUnknownOnesAsThePictureDoes)
   EXPECT_EQ(std::count(line.begin(), line.end(), '%'), 3) << line;
 }
 
-TEST(ClientCli, PngViewIsChosenByView) {
+// A scan the fake server labels into pictures.
+class ClientCliPng : public ::testing::Test {
+ protected:
+  void SetUp() override { write_scan(dir.file("scan.pcd")); }
+  // `primlabel label SCAN --png -o`: the output path and further flags follow.
+  std::string png_label_command() const {
+    return cli() + " -q --server " + server.address() + " label " + dir.file("scan.pcd") +
+           " --png -o ";
+  }
+
   FakeServer server;
   test::TempDir dir;
-  write_scan(dir.file("scan.pcd"));
-  const std::string base =
-      cli() + " -q --server " + server.address() + " label " + dir.file("scan.pcd") + " --png -o ";
+};
+
+TEST_F(ClientCliPng, PngViewIsChosenByView) {
+  const std::string base = png_label_command();
   ASSERT_EQ(test::run_command(base + dir.file("auto.pcd")).exit_code, 0);
   auto r = test::run_command(base + dir.file("top.pcd") + " --view top");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -363,21 +373,15 @@ TEST(ClientCli, PngViewIsChosenByView) {
 
 // --tabletop --png draws the table's hull and each object's box with its id over the points,
 // without --objects too (which alone adds the JSON and the `object` field).
-TEST(ClientCli, TabletopPngDrawsTheObjects) {
-  FakeServer server;
-  test::TempDir dir;
-  write_scan(dir.file("scan.pcd"));
-  const std::string base =
-      cli() + " -q --server " + server.address() + " label " + dir.file("scan.pcd") + " --png -o ";
+TEST_F(ClientCliPng, TabletopPngDrawsTheObjects) {
+  const std::string base = png_label_command();
   ASSERT_EQ(test::run_command(base + dir.file("plain.pcd")).exit_code, 0);
   const auto r = test::run_command(base + dir.file("table.pcd") + " --tabletop");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const test::Decoded plain = test::decode_png(dir.file("plain.png"));
   const test::Decoded table = test::decode_png(dir.file("table.png"));
   ASSERT_EQ(plain.rgb.size(), table.rgb.size());
-  std::size_t changed = 0;
-  for (std::size_t i = 0; i < plain.rgb.size(); ++i) changed += plain.rgb[i] != table.rgb[i];
-  EXPECT_GT(changed, 1000u);
+  EXPECT_GT(table.pixels_differing_from(plain), 1000u);
   const auto black = [](const test::Decoded& png) {
     return png.count(0x000000, 0, 0, png.width, png.height);
   };

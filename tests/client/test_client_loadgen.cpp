@@ -101,14 +101,24 @@ client::ClientOptions options_for(const FakeServer& server) {
   return options;
 }
 
+// One step over the small clouds against `server`, from a client of its own.
+StepResult run_small_step(const FakeServer& server, const LoadSpec& spec) {
+  client::Client client(options_for(server));
+  return run_step(client, small_clouds(), spec);
+}
+
+// `concurrency` callers, each calling again on an answer, until `requests` calls are answered.
+LoadSpec closed_loop(int concurrency, std::uint64_t requests) {
+  LoadSpec spec;
+  spec.concurrency = concurrency;
+  spec.requests = requests;
+  spec.duration_s = 0;
+  return spec;
+}
+
 TEST(LoadgenRunner, ClosedLoopSendsExactlyTheRequestCount) {
   FakeServer server;
-  client::Client client(options_for(server));
-  LoadSpec spec;
-  spec.concurrency = 3;
-  spec.requests = 20;
-  spec.duration_s = 0;
-  const StepResult r = run_step(client, small_clouds(), spec);
+  const StepResult r = run_small_step(server, closed_loop(3, 20));
   EXPECT_EQ(r.stats.ok(), 20u);
   EXPECT_EQ(r.stats.errors(), 0u);
   EXPECT_EQ(r.stats.points(), 10u * 300 + 10u * 400);
@@ -119,14 +129,13 @@ TEST(LoadgenRunner, ClosedLoopSendsExactlyTheRequestCount) {
 TEST(LoadgenRunner, OpenLoopIssuesAtItsRateAndCountsErrorsByStatus) {
   FakeServer server;
   server.service.unavailable_calls = 2;
-  client::Client client(options_for(server));
   LoadSpec spec;
   spec.mode = LoadMode::kOpen;
   spec.rate = 200;
   spec.requests = 12;
   spec.duration_s = 0;
   spec.unary = true;
-  const StepResult r = run_step(client, small_clouds(), spec);
+  const StepResult r = run_small_step(server, spec);
   EXPECT_EQ(r.stats.ok() + r.stats.errors(), 12u);
   EXPECT_EQ(r.stats.errors_by_status().at("UNAVAILABLE"), 2u);
   EXPECT_EQ(server.service.label_calls, 12);
@@ -139,11 +148,10 @@ TEST(LoadgenRunner, OpenLoopIssuesAtItsRateAndCountsErrorsByStatus) {
 TEST(LoadgenRunner, ClosedLoopBacksOffWhenTheServerRejectsAtAdmission) {
   FakeServer server;
   server.service.exhausted_calls = 1'000'000;
-  client::Client client(options_for(server));
   LoadSpec spec;
   spec.concurrency = 2;
   spec.duration_s = 1.5;
-  const StepResult r = run_step(client, small_clouds(), spec);
+  const StepResult r = run_small_step(server, spec);
   EXPECT_EQ(r.stats.ok(), 0u);
   EXPECT_EQ(r.stats.rejected(), static_cast<std::uint64_t>(server.service.label_calls.load()));
   EXPECT_EQ(r.stats.failed(), 0u);
@@ -154,11 +162,7 @@ TEST(LoadgenRunner, ClosedLoopBacksOffWhenTheServerRejectsAtAdmission) {
 TEST(LoadgenRunner, ARejectedCallerResumesOnceTheServerAdmitsAgain) {
   FakeServer server;
   server.service.exhausted_calls = 3;
-  client::Client client(options_for(server));
-  LoadSpec spec;
-  spec.requests = 10;
-  spec.duration_s = 0;
-  const StepResult r = run_step(client, small_clouds(), spec);
+  const StepResult r = run_small_step(server, closed_loop(1, 10));
   EXPECT_EQ(r.stats.ok(), 7u);
   EXPECT_EQ(r.stats.rejected(), 3u);
   EXPECT_EQ(r.stats.errors(), 3u);
@@ -167,10 +171,9 @@ TEST(LoadgenRunner, ARejectedCallerResumesOnceTheServerAdmitsAgain) {
 
 TEST(LoadgenRunner, DurationBoundsAStep) {
   FakeServer server;
-  client::Client client(options_for(server));
   LoadSpec spec;
   spec.duration_s = 0.3;
-  const StepResult r = run_step(client, small_clouds(), spec);
+  const StepResult r = run_small_step(server, spec);
   EXPECT_GT(r.stats.ok(), 0u);
   EXPECT_LT(r.elapsed_s, 30.0);  // bounded, not a timing assertion on the server
 }

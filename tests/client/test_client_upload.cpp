@@ -6,6 +6,7 @@
 
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "common/labeled_output.hpp"
@@ -265,12 +266,27 @@ TEST(UploadFraming, FramesRoundTripAndBadStreamsAreErrors) {
 // ---------------------------------------------------------------------------------------------
 // The uploader against the fake server
 
-TEST(Uploader, LabelsEachScanOnceIntoItsOwnOutput) {
+// A fresh spool and output folder, and a client of the fake server.
+class UploaderWithFakeServer : public ::testing::Test {
+ protected:
+  // The uploader over `options`, started; it stops before the client and server go.
+  Uploader& started_uploader(const client::upload::UploaderOptions& options) {
+    uploader_.emplace(client, options);
+    uploader_->start();
+    return *uploader_;
+  }
+  Uploader& started_uploader() { return started_uploader(uploader_options(dir)); }
+
   FakeServer server;
   test::TempDir dir;
-  client::Client client(fast_client(server.address()));
-  Uploader uploader(client, uploader_options(dir));
-  uploader.start();
+  client::Client client{fast_client(server.address())};
+
+ private:
+  std::optional<Uploader> uploader_;
+};
+
+TEST_F(UploaderWithFakeServer, LabelsEachScanOnceIntoItsOwnOutput) {
+  Uploader& uploader = started_uploader();
   std::string id;
   EXPECT_EQ(uploader.submit(scan_bytes(1), ".pcd", &id), Uploader::Submitted::kAccepted);
   uploader.submit(scan_bytes(2), ".pcd");
@@ -288,13 +304,9 @@ TEST(Uploader, LabelsEachScanOnceIntoItsOwnOutput) {
   EXPECT_EQ(server.service.scan_ids.front().size(), 32u);  // the content hash travels as scan_id
 }
 
-TEST(Uploader, RetriesWithBackoffWhileTheServerIsUnavailable) {
-  FakeServer server;
+TEST_F(UploaderWithFakeServer, RetriesWithBackoffWhileTheServerIsUnavailable) {
   server.service.unavailable_calls = 4;
-  test::TempDir dir;
-  client::Client client(fast_client(server.address()));
-  Uploader uploader(client, uploader_options(dir));
-  uploader.start();
+  Uploader& uploader = started_uploader();
   std::string id;
   uploader.submit(scan_bytes(3), ".pcd", &id);
   ASSERT_TRUE(wait_idle(uploader));
@@ -304,9 +316,7 @@ TEST(Uploader, RetriesWithBackoffWhileTheServerIsUnavailable) {
   EXPECT_NE(uploader.status_line().find("retries 4"), std::string::npos) << uploader.status_line();
 }
 
-TEST(Uploader, StartupResumesTheSpoolAndSkipsScansAlreadyWritten) {
-  FakeServer server;
-  test::TempDir dir;
+TEST_F(UploaderWithFakeServer, StartupResumesTheSpoolAndSkipsScansAlreadyWritten) {
   const auto options = uploader_options(dir);
   // A previous run accepted two scans and crashed after writing the first one's output.
   const std::string done_id = client::upload::scan_id(scan_bytes(4));
@@ -321,7 +331,6 @@ TEST(Uploader, StartupResumesTheSpoolAndSkipsScansAlreadyWritten) {
                 scan_bytes(4));
     write_bytes((options.output_dir / ("." + todo_id + ".pcd.tmp.1.0")).string(), "partial");
   }
-  client::Client client(fast_client(server.address()));
   Uploader uploader(client, options);
   EXPECT_EQ(uploader.queued(), 1u);
   uploader.start();
@@ -335,12 +344,8 @@ TEST(Uploader, StartupResumesTheSpoolAndSkipsScansAlreadyWritten) {
                          client::upload::output_name(todo_id, options.label, "scan_5")));
 }
 
-TEST(Uploader, ARefusedScanMovesToFailedAndTheRestGoOn) {
-  FakeServer server;
-  test::TempDir dir;
-  client::Client client(fast_client(server.address()));
-  Uploader uploader(client, uploader_options(dir));
-  uploader.start();
+TEST_F(UploaderWithFakeServer, ARefusedScanMovesToFailedAndTheRestGoOn) {
+  Uploader& uploader = started_uploader();
   std::string empty_id;
   uploader.submit(scan_bytes(6, 0), ".pcd", &empty_id);  // the server refuses zero points
   uploader.submit(scan_bytes(7), ".pcd");
@@ -352,14 +357,10 @@ TEST(Uploader, ARefusedScanMovesToFailedAndTheRestGoOn) {
 
 // A model the server does not serve (a typo) fails the scan for good with the server's reason,
 // instead of retrying it forever and wedging the spool.
-TEST(Uploader, AModelTheServerDoesNotHaveFailsTheScanForGood) {
-  FakeServer server;
-  test::TempDir dir;
-  client::Client client(fast_client(server.address()));
+TEST_F(UploaderWithFakeServer, AModelTheServerDoesNotHaveFailsTheScanForGood) {
   client::upload::UploaderOptions options = uploader_options(dir);
   options.label.model = "faek";
-  Uploader uploader(client, options);
-  uploader.start();
+  Uploader& uploader = started_uploader(options);
   std::string id;
   uploader.submit(scan_bytes(8), ".pcd", &id);
   ASSERT_TRUE(wait_idle(uploader));
@@ -371,9 +372,7 @@ TEST(Uploader, AModelTheServerDoesNotHaveFailsTheScanForGood) {
             std::string::npos);
 }
 
-TEST(Uploader, ACorruptSpoolEntryIsNeverUploaded) {
-  FakeServer server;
-  test::TempDir dir;
+TEST_F(UploaderWithFakeServer, ACorruptSpoolEntryIsNeverUploaded) {
   const auto options = uploader_options(dir);
   client::upload::SpooledScan stored;
   {
@@ -382,7 +381,6 @@ TEST(Uploader, ACorruptSpoolEntryIsNeverUploaded) {
     spool.accept(client::upload::scan_id(scan_bytes(53)), scan_bytes(53), ".pcd");
   }
   flip_a_bit(stored.path);
-  client::Client client(fast_client(server.address()));
   Uploader uploader(client, options);
   EXPECT_EQ(uploader.queued(), 1u);
   uploader.start();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <random>
 #include <sstream>
 #include <string>
@@ -30,6 +31,17 @@ Eigen::VectorXd random_parameters(Eigen::Index size, std::uint32_t seed, double 
   Eigen::VectorXd x(size);
   for (Eigen::Index i = 0; i < size; ++i) x(i) = u(rng);
   return x;
+}
+
+// The Bethe objective on one thread, its BP run to a 1e-7 tolerance (or `max_iterations`): close
+// enough to a fixed point to compare with exact values and finite differences.
+std::unique_ptr<detail::Objective> converged_bethe(const std::vector<detail::PreparedScene>& scenes,
+                                                   const detail::ParameterShape& shape,
+                                                   int max_iterations) {
+  detail::BpSettings bp;
+  bp.max_iterations = max_iterations;
+  bp.tolerance = 1e-7f;
+  return detail::make_bethe(scenes, shape, bp, RunContext{1});
 }
 
 // Largest |analytic - central difference| over every coordinate.
@@ -226,10 +238,7 @@ TEST(CrfTraining, BetheObjectiveIsExactOnATree) {
     const CrfModel like = CrfModel::zeros(ids(3), 3, 0.01f, knots);
     const auto prepared = detail::prepare_scenes(scenes, like, true);
     const detail::ParameterShape shape = shape_of(like, true);
-    detail::BpSettings bp;
-    bp.max_iterations = 300;
-    bp.tolerance = 1e-7f;
-    auto objective = detail::make_bethe(prepared, shape, bp, RunContext{1});
+    auto objective = converged_bethe(prepared, shape, 300);
     const Eigen::VectorXd x = random_parameters(shape.size(), 11, 1.5);
     Eigen::VectorXd grad(x.size());
     const double value_bethe = objective->evaluate(x, grad);
@@ -256,10 +265,7 @@ TEST(CrfTraining, BetheGradientMatchesFiniteDifferencesOnALoopyGraph) {
   prepared[0].graph = &restricted;
   ASSERT_GT(restricted.num_edges(), restricted.num_active());  // loops
   const detail::ParameterShape shape = shape_of(like, true);
-  detail::BpSettings bp;
-  bp.max_iterations = 500;
-  bp.tolerance = 1e-7f;
-  auto objective = detail::make_bethe(prepared, shape, bp, RunContext{1});
+  auto objective = converged_bethe(prepared, shape, 500);
   const Eigen::VectorXd x = random_parameters(shape.size(), 13, 0.5);
   EXPECT_LT(gradient_error(*objective, x, 1e-4), 2e-3);
 }

@@ -2,12 +2,9 @@
 // labels, exit codes 0 / 1 / 2 and one-line errors (primlabel-research: tests/research).
 
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <utility>
 #include <vector>
@@ -27,21 +24,15 @@
 namespace primlabel {
 namespace {
 
-namespace fs = std::filesystem;
-
 using Result = test::CommandResult;
 
 Result run(const std::string& command) { return test::run_command(command); }
-
-int lines(const std::string& text) { return test::count_lines(text); }
 
 class PipelineCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     // One folder per process: ctest runs the cases in parallel processes.
-    dir_ = new fs::path(fs::temp_directory_path() /
-                        ("primlabel_pipeline_cli_" + std::to_string(::getpid())));
-    fs::create_directories(*dir_);
+    dir_ = new test::TempDir;
     // An all-zero node-only model: loads and labels instantly (the trained one is tested below).
     save_model(zero_model_path(), testing::zero_node_model());
     synth::GenerateOptions options;
@@ -49,30 +40,29 @@ class PipelineCli : public ::testing::Test {
     const synth::Generated scene = synth::generate(options);
     write_tagged_cloud(scene_path(), scene.cloud, scene.tags);
   }
-  static void TearDownTestSuite() {
-    fs::remove_all(*dir_);
-    delete dir_;
-  }
-  static std::string model_path() { return (*dir_ / "model.plm").string(); }
-  static std::string zero_model_path() { return (*dir_ / "zero.plm").string(); }
-  static std::string scene_path() { return (*dir_ / "scene.pcd").string(); }
+  static void TearDownTestSuite() { delete dir_; }
+  static std::string model_path() { return dir_->file("model.plm"); }
+  static std::string zero_model_path() { return dir_->file("zero.plm"); }
+  static std::string scene_path() { return dir_->file("scene.pcd"); }
   static std::string eval() { return test::binary("primlabel-eval"); }
+  // primlabel-train on one synthetic scene without validation: fast enough for every case.
+  static Result train_on_one_scene(const std::string& flags, const std::string& out) {
+    return run(test::binary("primlabel-train") + " --synth-train 1 --synth-val 0 --threads 2 -q " +
+               flags + " -o " + out);
+  }
 
-  static inline fs::path* dir_ = nullptr;
+  static inline test::TempDir* dir_ = nullptr;
 };
 
 // A node-only model from one training scene: fast, and enough to check the tools.
 TEST_F(PipelineCli, TrainedModelLoadsAndLabelsWithJsonScores) {
-  const Result trained = run(test::binary("primlabel-train") +
-                             " --synth-train 1 --synth-val 0 --kind node --iterations 30 "
-                             "--threads 2 -q -o " +
-                             model_path());
+  const Result trained = train_on_one_scene("--kind node --iterations 30", model_path());
   ASSERT_EQ(trained.exit_code, 0) << trained.output;
   const Result r = run(eval() + " --model " + model_path() + " --json -q " + scene_path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("\"accuracy\":0."), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("\"plane\":{\"precision\""), std::string::npos) << r.output;
-  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
   const LabelModel model = load_model(model_path());
   EXPECT_EQ(model.kind, ModelKind::kNodeOnly);
   EXPECT_EQ(model.training.scenes, 1u);
@@ -80,11 +70,8 @@ TEST_F(PipelineCli, TrainedModelLoadsAndLabelsWithJsonScores) {
 }
 
 TEST_F(PipelineCli, SvmModelTrainsAndEvaluates) {
-  const std::string svm = (*dir_ / "svm.plm").string();
-  const Result trained = run(test::binary("primlabel-train") +
-                             " --synth-train 1 --synth-val 0 --kind svm --svm-max-points 1000 "
-                             "--threads 2 -q -o " +
-                             svm);
+  const std::string svm = dir_->file("svm.plm");
+  const Result trained = train_on_one_scene("--kind svm --svm-max-points 1000", svm);
   ASSERT_EQ(trained.exit_code, 0) << trained.output;
   EXPECT_EQ(load_model(svm).kind, ModelKind::kSvm);
   const Result r = run(eval() + " --model " + svm + " --json -q --threads 2 " + scene_path());
@@ -93,7 +80,7 @@ TEST_F(PipelineCli, SvmModelTrainsAndEvaluates) {
 }
 
 TEST_F(PipelineCli, WritesPredictedLabelsAndHistogramWithoutTruth) {
-  const std::string out = (*dir_ / "labeled.pcd").string();
+  const std::string out = dir_->file("labeled.pcd");
   const Result r = run(eval() + " --model " + zero_model_path() + " --no-truth -q --out " + out +
                        " " + scene_path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -105,7 +92,7 @@ TEST_F(PipelineCli, WritesPredictedLabelsAndHistogramWithoutTruth) {
 // The all-zero model labels every point plane, so the largest instance is the table top, the
 // plane z = 0 of the synthetic scene.
 TEST_F(PipelineCli, WritesPrimitivesAsJson) {
-  const std::string out = (*dir_ / "primitives.json").string();
+  const std::string out = dir_->file("primitives.json");
   const Result r = run(eval() + " --model " + zero_model_path() + " --no-truth -q --primitives " +
                        out + " " + scene_path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -132,12 +119,12 @@ TEST_F(PipelineCli, WritesPrimitivesAsJson) {
 // --objects with --tabletop-only: the table and the two boxes and the can of the synthetic
 // table, as the JSON the CLI writes too (read back by the core's parser).
 TEST_F(PipelineCli, WritesTableTopObjectsAsJson) {
-  const std::string scene = (*dir_ / "objects_scene.pcd").string();
+  const std::string scene = dir_->file("objects_scene.pcd");
   write_cloud(scene, testing::objects_scene(0.005f).cloud);
-  const std::string out = (*dir_ / "objects.json").string();
-  const Result r = run(
-      eval() + " --model " + zero_model_path() + " --no-truth -q --tabletop-only --primitives " +
-      (*dir_ / "objects_primitives.json").string() + " --objects " + out + " " + scene);
+  const std::string out = dir_->file("objects.json");
+  const Result r = run(eval() + " --model " + zero_model_path() +
+                       " --no-truth -q --tabletop-only --primitives " +
+                       dir_->file("objects_primitives.json") + " --objects " + out + " " + scene);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(out);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -158,7 +145,7 @@ TEST_F(PipelineCli, WritesTableTopObjectsAsJson) {
 }
 
 TEST_F(PipelineCli, WritesTheConfusionMatrixAsPng) {
-  const std::string png = (*dir_ / "confusion.png").string();
+  const std::string png = dir_->file("confusion.png");
   const Result r = run(eval() + " --model " + zero_model_path() + " -q --confusion-png " + png +
                        " " + scene_path());
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -170,17 +157,17 @@ TEST_F(PipelineCli, WritesTheConfusionMatrixAsPng) {
 TEST_F(PipelineCli, MissingFileFailsWithOneLine) {
   const Result r = run(eval() + " --model " + zero_model_path() + " -q /nonexistent/scene.pcd");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("primlabel-eval: error:"), std::string::npos) << r.output;
 }
 
 TEST_F(PipelineCli, CorruptModelFailsWithOneLine) {
-  const std::string corrupt = (*dir_ / "corrupt.plm").string();
+  const std::string corrupt = dir_->file("corrupt.plm");
   std::ofstream(corrupt) << "PRIMLABEL-MODEL\nnot a protobuf at all";
   const Result r = run(eval() + " --model " + corrupt + " -q " + scene_path());
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(lines(r.output), 1) << r.output;
-  const std::string missing = (*dir_ / "missing.plm").string();
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
+  const std::string missing = dir_->file("missing.plm");
   EXPECT_EQ(run(eval() + " --model " + missing + " -q " + scene_path()).exit_code, 1);
 }
 
@@ -208,7 +195,7 @@ TEST_F(PipelineCli, BadUsageExitsTwo) {
         test::binary("primlabel-train") + " --extra-radii 0.01,-0.02 -o m.plm"}) {
     const Result r = run(command);
     EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
-    EXPECT_EQ(lines(r.output), 1) << command << "\n" << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << command << "\n" << r.output;
   }
 }
 
@@ -217,7 +204,7 @@ TEST_F(PipelineCli, TrainAugmentsTheTrainingScenes) {
   const std::string command = test::binary("primlabel-train") +
                               " --synth-train 1 --synth-val 0 --kind node --iterations 5 "
                               "--threads 2 --augment noise=2,density=0.5 -o " +
-                              (*dir_ / "augmented.plm").string();
+                              dir_->file("augmented.plm");
   const Result r = run(command);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("training: synth:lms400:train:seed1000, "), std::string::npos)
@@ -226,14 +213,14 @@ TEST_F(PipelineCli, TrainAugmentsTheTrainingScenes) {
                           "range 1.00, elevation +0.0)"),
             std::string::npos)
       << r.output;
-  const LabelModel model = load_model((*dir_ / "augmented.plm").string());
+  const LabelModel model = load_model(dir_->file("augmented.plm"));
   EXPECT_EQ(model.training.scenes, 2u);
 }
 
 // --train files beside --synth-train scenes: one training set (real scans with the simulator's),
 // validated on --val files and --synth-val scenes; the model records both and the attribution.
 TEST_F(PipelineCli, TrainOnFilesBesideSyntheticScenes) {
-  const std::string path = (*dir_ / "mixed.plm").string();
+  const std::string path = dir_->file("mixed.plm");
   const Result r =
       run(test::binary("primlabel-train") + " --train " + scene_path() + " --val " + scene_path() +
           " --synth-train 1 --synth-val 1 --kind node --iterations 5 --threads 2 "
@@ -257,11 +244,10 @@ TEST_F(PipelineCli, TrainOnFilesBesideSyntheticScenes) {
 // --voxel-size trains on voxel centroids and records the size, so label_cloud (and the server)
 // serves the model at the density it was trained at.
 TEST_F(PipelineCli, TrainAtAVoxelSizeRecordsItAndEvalAppliesIt) {
-  const std::string path = (*dir_ / "voxel.plm").string();
-  const Result r = run(test::binary("primlabel-train") +
-                       " --synth-train 1 --synth-val 0 --kind node --iterations 30 --threads 2 "
-                       "--normal-radius 0.02 --feature-radius 0.04 --voxel-size 0.008 -o " +
-                       path);
+  const std::string path = dir_->file("voxel.plm");
+  const Result r = train_on_one_scene(
+      "--kind node --iterations 30 --normal-radius 0.02 --feature-radius 0.04 --voxel-size 0.008",
+      path);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const LabelModel model = load_model(path);
   EXPECT_FLOAT_EQ(model.features.voxel_size, 0.008f);
@@ -292,7 +278,7 @@ TEST_F(PipelineCli, EvalRefusesTheResearchModesNamingTheirSubcommand) {
            {" --node-knots 0,0.5,1 --table1", "table1"}}) {
     const Result r = run(eval() + arguments);
     EXPECT_EQ(r.exit_code, 2) << arguments << "\n" << r.output;
-    EXPECT_EQ(lines(r.output), 1) << arguments << "\n" << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << arguments << "\n" << r.output;
     EXPECT_NE(r.output.find("primlabel-eval: usage error: "), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("`primlabel-research " + subcommand + "`"), std::string::npos)
         << arguments << "\n"
@@ -305,9 +291,9 @@ TEST_F(PipelineCli, EvalRefusesTheResearchModesNamingTheirSubcommand) {
 
 TEST_F(PipelineCli, TrainMissingFileFails) {
   const Result r = run(test::binary("primlabel-train") + " --train /nonexistent/a.pcd -q -o " +
-                       (*dir_ / "x.plm").string());
+                       dir_->file("x.plm"));
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
 }
 
 }  // namespace

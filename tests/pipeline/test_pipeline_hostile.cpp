@@ -12,6 +12,7 @@
 #include <string>
 #include <thread>
 
+#include "one_and_two_threads.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/pipeline/duplicates.hpp"
 #include "primlabel/pipeline/labeling.hpp"
@@ -53,6 +54,23 @@ PointCloud packed_cube_cloud(std::size_t points) {
   std::vector<Vec3f> cube(points);
   for (Vec3f& p : cube) p = Vec3f(0.2f + mm(rng), 0.2f + mm(rng), mm(rng));
   return with_points(distinct_table(), cube);
+}
+
+// A labeling's result with its wall time and how much it raised the peak RSS.
+struct MeasuredLabeling {
+  LabelingResult result;
+  double seconds = 0;
+  std::size_t peak_growth_bytes = 0;
+};
+MeasuredLabeling label_measured(const LabelModel& model, PointCloud& cloud,
+                                const LabelingOptions& options) {
+  const std::size_t before = peak_rss_bytes();
+  const auto start = std::chrono::steady_clock::now();
+  MeasuredLabeling measured{pipeline::label_cloud(model, cloud, options, RunContext{2})};
+  measured.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  measured.peak_growth_bytes = peak_rss_bytes() - before;
+  return measured;
 }
 
 LabelingOptions all_outputs() {
@@ -123,12 +141,7 @@ TEST(PipelineHostile, CoincidentPointsLabelInBoundedMemoryAndFanOut) {
   const LabelModel model = testing::random_label_model("dup", "1", 7, 0.25f);
   PointCloud cloud = coincident_cloud(100000);
   const std::size_t first_copy = cloud.size() - 100000;
-  const std::size_t before = peak_rss_bytes();
-  const auto start = std::chrono::steady_clock::now();
-  const LabelingResult result = pipeline::label_cloud(model, cloud, all_outputs(), RunContext{2});
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const std::size_t growth = peak_rss_bytes() - before;
+  const auto [result, seconds, growth] = label_measured(model, cloud, all_outputs());
   std::printf("100k coincident points: %.2f s, peak RSS +%.0f MB\n", seconds, growth / 1e6);
   EXPECT_LT(growth, std::size_t(400) << 20);  // 1.1 GB before the caps
   // Described once: every copy is labeled (it lies on the table) exactly as the first one.
@@ -143,12 +156,7 @@ TEST(PipelineHostile, CoincidentPointsLabelInBoundedMemoryAndFanOut) {
 TEST(PipelineHostile, PointsPackedInAMillimetreCubeLabelInBoundedMemory) {
   const LabelModel model = testing::random_label_model("cube", "1", 7, 0.25f);
   PointCloud cloud = packed_cube_cloud(20000);
-  const std::size_t before = peak_rss_bytes();
-  const auto start = std::chrono::steady_clock::now();
-  const LabelingResult result = pipeline::label_cloud(model, cloud, all_outputs(), RunContext{2});
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const std::size_t growth = peak_rss_bytes() - before;
+  const auto [result, seconds, growth] = label_measured(model, cloud, all_outputs());
   std::printf(
       "20k points in a 1 mm cube: %.2f s (normals %.2f, descriptors %.2f, inference %.2f), peak "
       "RSS +%.0f MB\n",
@@ -219,9 +227,7 @@ TEST(PipelineHostile, HostileMixIsTheSameForOneAndTwoThreads) {
   PointCloud base = packed_cube_cloud(3000);
   base = with_points(base, std::vector<Vec3f>(2000, Vec3f(-0.2f, 0.25f, 0.0f)));
   base = with_points(base, {Vec3f(1e30f, 0, 0), Vec3f(FLT_MAX, FLT_MAX, FLT_MAX)});
-  PointCloud one = base, two = base;
-  const LabelingResult r1 = pipeline::label_cloud(model, one, all_outputs(), RunContext{1});
-  const LabelingResult r2 = pipeline::label_cloud(model, two, all_outputs(), RunContext{2});
+  const auto [r1, r2] = testing::label_with_one_and_two_threads(model, base, all_outputs());
   ASSERT_EQ(r1.labels, r2.labels);
   ASSERT_EQ(r1.descriptors.values.size(), r2.descriptors.values.size());
   for (std::size_t k = 0; k < r1.descriptors.values.size(); ++k)

@@ -11,6 +11,7 @@
 #include <random>
 
 #include "crf_scenes.hpp"
+#include "one_and_two_threads.hpp"
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "primlabel/pipeline/training.hpp"
@@ -124,10 +125,9 @@ TEST(PipelineLabeling, TrainedModelLabelsHeldOutSceneDeterministicallyAndAfterRo
 
   // CRF: same labels for 1 and 2 threads.
   const LabelModel crf = with_coupling(model, 0.5f);
-  PointCloud one = trained.test_scene, two = trained.test_scene;
   options = {};
-  const auto with_one = pipeline::label_cloud(crf, one, options, RunContext{1});
-  const auto with_two = pipeline::label_cloud(crf, two, options, RunContext{2});
+  const auto [with_one, with_two] =
+      testing::label_with_one_and_two_threads(crf, trained.test_scene, options);
   EXPECT_EQ(with_one.labels, with_two.labels);
   EXPECT_GT(accuracy(crf, trained.test_scene, with_two.labels), 0.80);
 

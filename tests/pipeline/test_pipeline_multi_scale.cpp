@@ -7,6 +7,7 @@
 
 #include <cmath>
 
+#include "one_and_two_threads.hpp"
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/geometry/features.hpp"
 #include "primlabel/geometry/normals.hpp"
@@ -105,11 +106,9 @@ TEST(PipelineMultiScale, TrainedModelLabelsGivesThePlainDescriptorAndRoundTrips)
   model.weights.edge_weights.col(model.weights.edge_feature_dim() - 1).setConstant(0.5f);
 
   const PointCloud truth = test_scene();
-  PointCloud one = truth, two = truth;
   pipeline::LabelingOptions labeling;
   labeling.want_descriptors = true;
-  const auto with_one = pipeline::label_cloud(model, one, labeling, RunContext{1});
-  const auto with_two = pipeline::label_cloud(model, two, labeling, RunContext{2});
+  const auto [with_one, with_two] = testing::label_with_one_and_two_threads(model, truth, labeling);
   EXPECT_EQ(with_one.labels, with_two.labels);
   crf::ConfusionMatrix confusion(model.class_ids());
   confusion.add(truth.labels, with_two.labels, 0u);

@@ -7,6 +7,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "one_and_two_threads.hpp"
 #include "primlabel/pipeline/labeling.hpp"
 #include "random_label_model.hpp"
 #include "tabletop_objects_scene.hpp"
@@ -72,9 +73,7 @@ TEST(PipelineObjects, RefusedWithoutTheTabletopStage) {
 TEST(PipelineObjects, SameObjectsAtOneAndTwoThreadsEachWithItsPrimitive) {
   const LabelModel model = all_planes_model();
   const testing::ObjectsScene scene = testing::objects_scene(0.005f, 0.02f);
-  PointCloud one = scene.cloud, two = scene.cloud;
-  const LabelingResult a = label_cloud(model, one, object_options(), RunContext{1});
-  const LabelingResult b = label_cloud(model, two, object_options(), RunContext{2});
+  const auto [a, b] = testing::label_with_one_and_two_threads(model, scene.cloud, object_options());
   ASSERT_TRUE(a.objects && b.objects && a.primitives);
   expect_same(*a.objects, *b.objects);
   const TabletopObjects& objects = *a.objects;

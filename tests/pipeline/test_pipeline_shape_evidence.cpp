@@ -11,6 +11,7 @@
 #include <cmath>
 #include <random>
 
+#include "one_and_two_threads.hpp"
 #include "primlabel/crf/metrics.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 #include "primlabel/pipeline/labeled_voxels.hpp"
@@ -120,11 +121,9 @@ TEST(PipelineShapeEvidence, ModelTrainedWithItLabelsAndRoundTrips) {
 
   const PointCloud frame =
       synth::synthetic_scene(synth::SceneSet::kTest, 0, synth::SensorKind::kKinect);
-  PointCloud one = frame, two = frame;
   pipeline::LabelingOptions labeling;
   labeling.want_descriptors = true;
-  const auto with_one = pipeline::label_cloud(model, one, labeling, RunContext{1});
-  const auto with_two = pipeline::label_cloud(model, two, labeling, RunContext{2});
+  const auto [with_one, with_two] = testing::label_with_one_and_two_threads(model, frame, labeling);
   EXPECT_EQ(with_one.labels, with_two.labels);
   EXPECT_EQ(with_two.descriptors.dim, kFpfhSize) << "clients get the descriptor alone";
   crf::ConfusionMatrix confusion(model.class_ids());

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <utility>
 
 #include "png_decode.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
@@ -25,8 +26,6 @@ using Result = test::CommandResult;
 Result run(const std::string& command) { return test::run_command(command); }
 
 std::string render_tool() { return test::binary("primlabel-render"); }
-int lines(const std::string& text) { return test::count_lines(text); }
-
 bool png_size(const std::string& path, int& width, int& height) {
   png_image image{};
   image.version = PNG_IMAGE_VERSION;
@@ -48,6 +47,19 @@ class RenderCli : public ::testing::Test {
   }
   static void TearDownTestSuite() { delete dir_; }
   static std::string scene() { return dir_->file("prims.pcd"); }
+  // The scene's picture, small and without a legend, so overlays show as changed pixels; the
+  // output file follows.
+  static std::string small_picture_command() {
+    return render_tool() + " " + scene() + " --no-legend --width 320 --height 240 -o ";
+  }
+  // Least and greatest corner of the scene's finite points.
+  static std::pair<Vec3f, Vec3f> scene_bounds() {
+    const PointCloud cloud = read_cloud(scene());
+    Vec3f lo = Vec3f::Constant(INFINITY), hi = -lo;
+    for (const Vec3f& p : cloud.xyz)
+      if (is_finite(p)) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    return {lo, hi};
+  }
   static test::TempDir* dir_;
 };
 test::TempDir* RenderCli::dir_ = nullptr;
@@ -88,7 +100,7 @@ TEST_F(RenderCli, UsageErrorsExitWith2AndOneLine) {
        {" -o x.png --view side", "", " -o x.png --width 10", " -o x.png --palette rainbow"}) {
     const Result r = run(render_tool() + " " + scene() + args);
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.output;
-    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find("primlabel-render: usage error"), std::string::npos) << r.output;
   }
 }
@@ -99,7 +111,7 @@ TEST_F(RenderCli, ANonPngOutputNameIsAUsageErrorAndWritesNothing) {
     const std::string out = dir_->file(name);
     const Result r = run(render_tool() + " " + scene() + " -o " + out);
     EXPECT_EQ(r.exit_code, 2) << name << ": " << r.output;
-    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find("writes PNG only"), std::string::npos) << r.output;
     EXPECT_FALSE(std::filesystem::exists(out)) << out;
   }
@@ -115,7 +127,7 @@ TEST_F(RenderCli, RuntimeErrorsExitWith1AndNameTheFile) {
   EXPECT_NE(r.output.find("/nonexistent/scan.pcd"), std::string::npos) << r.output;
   r = run(render_tool() + " " + scene() + " -o /nonexistent/dir/x.png");
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("/nonexistent/dir/x.png"), std::string::npos) << r.output;
   r = run(render_tool() + " " + scene() + " -o " + dir_->file("x.png") + " --field fpfh");
   EXPECT_EQ(r.exit_code, 1);
@@ -126,10 +138,7 @@ TEST_F(RenderCli, RuntimeErrorsExitWith1AndNameTheFile) {
 
 TEST_F(RenderCli, DrawsTheFittedPrimitivesOfAJsonFile) {
   // A cylinder standing in the scene's middle, as primlabel label --primitives writes it.
-  const PointCloud cloud = read_cloud(scene());
-  Vec3f lo = Vec3f::Constant(INFINITY), hi = -lo;
-  for (const Vec3f& p : cloud.xyz)
-    if (is_finite(p)) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const auto [lo, hi] = scene_bounds();
   primitives::Primitive can;
   can.class_id = class_id(PrimitiveClass::kCylinderConvex);
   can.model = primitives::CylinderModel{((lo + hi) / 2).cast<double>(), primitives::Vec3d::UnitZ(),
@@ -138,15 +147,12 @@ TEST_F(RenderCli, DrawsTheFittedPrimitivesOfAJsonFile) {
   can.points = 100;
   const std::string json = dir_->file("prims.json");
   { std::ofstream(json) << primitives::primitives_json(std::vector{can}); }
-  const std::string base =
-      render_tool() + " " + scene() + " --no-legend --width 320 --height 240 -o ";
+  const std::string base = small_picture_command();
   ASSERT_EQ(run(base + dir_->file("plain.png")).exit_code, 0);
   Result r = run(base + dir_->file("fits.png") + " --primitives " + json);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const test::Decoded plain = test::decode_png(dir_->file("plain.png"));
-  const test::Decoded fits = test::decode_png(dir_->file("fits.png"));
-  std::size_t changed = 0;
-  for (std::size_t i = 0; i < plain.rgb.size(); ++i) changed += plain.rgb[i] != fits.rgb[i];
+  const std::size_t changed = test::decode_png(dir_->file("fits.png")).pixels_differing_from(plain);
   EXPECT_GT(changed, 400u) << changed;  // two circles, four sides and an axis
   // Below --min-confidence it is left out: the same picture as without.
   r = run(base + dir_->file("none.png") + " --primitives " + json + " --min-confidence 0.9");
@@ -157,17 +163,14 @@ TEST_F(RenderCli, DrawsTheFittedPrimitivesOfAJsonFile) {
   for (const std::string& bad : {dir_->file("absent.json"), scene()}) {
     r = run(base + dir_->file("bad.png") + " --primitives " + bad);
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find(bad), std::string::npos) << r.output;
   }
 }
 
 TEST_F(RenderCli, DrawsTheTableTopObjectsOfAJsonFile) {
   // One box around the scene's middle, as primlabel label --objects writes it.
-  const PointCloud cloud = read_cloud(scene());
-  Vec3f lo = Vec3f::Constant(INFINITY), hi = -lo;
-  for (const Vec3f& p : cloud.xyz)
-    if (is_finite(p)) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const auto [lo, hi] = scene_bounds();
   tabletop::TabletopObjects objects;
   objects.table = tabletop::TabletopTable{};
   tabletop::TabletopObject box;
@@ -178,15 +181,13 @@ TEST_F(RenderCli, DrawsTheTableTopObjectsOfAJsonFile) {
   objects.objects.push_back(box);
   const std::string json = dir_->file("objects.json");
   { std::ofstream(json) << tabletop::objects_json(objects); }
-  const std::string base =
-      render_tool() + " " + scene() + " --no-legend --width 320 --height 240 -o ";
+  const std::string base = small_picture_command();
   ASSERT_EQ(run(base + dir_->file("plain_objects.png")).exit_code, 0);
   Result r = run(base + dir_->file("boxes.png") + " --objects " + json);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const test::Decoded plain = test::decode_png(dir_->file("plain_objects.png"));
-  const test::Decoded boxes = test::decode_png(dir_->file("boxes.png"));
-  std::size_t changed = 0;
-  for (std::size_t i = 0; i < plain.rgb.size(); ++i) changed += plain.rgb[i] != boxes.rgb[i];
+  const std::size_t changed =
+      test::decode_png(dir_->file("boxes.png"))
+          .pixels_differing_from(test::decode_png(dir_->file("plain_objects.png")));
   EXPECT_GT(changed, 300u) << changed;  // twelve edges
   r = run(base + dir_->file("bad.png") + " --objects " + scene());
   EXPECT_EQ(r.exit_code, 1) << r.output;

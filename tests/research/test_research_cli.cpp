@@ -4,7 +4,6 @@
 // --segment-labels), so they run without ../shared.
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <sstream>
@@ -28,26 +27,19 @@ using Result = test::CommandResult;
 
 Result run(const std::string& command) { return test::run_command(command); }
 
-int lines(const std::string& text) { return test::count_lines(text); }
-
 std::string research() { return test::binary("primlabel-research"); }
 
 class ResearchCli : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     // One folder per process: ctest runs the cases in parallel processes.
-    dir_ = new fs::path(fs::temp_directory_path() /
-                        ("primlabel_research_cli_" + std::to_string(::getpid())));
-    fs::create_directories(*dir_);
+    dir_ = new test::TempDir;
     // An all-zero node-only model with small radii: fast on a 640x480 frame, labels all plane.
     save_model(model_path(), testing::zero_node_model(0.008f, 0.012f));
   }
-  static void TearDownTestSuite() {
-    fs::remove_all(*dir_);
-    delete dir_;
-  }
-  static std::string model_path() { return (*dir_ / "zero.plm").string(); }
-  static std::string file(const std::string& name) { return (*dir_ / name).string(); }
+  static void TearDownTestSuite() { delete dir_; }
+  static std::string model_path() { return dir_->file("zero.plm"); }
+  static std::string file(const std::string& name) { return dir_->file(name); }
 
   // A held-out synthetic Kinect frame labeled as mOSD labels its scenes (1 table, 10 (k + 1)
   // object k), alone in its folder (calibrate-kinect takes a folder). Made on first use.
@@ -62,7 +54,7 @@ class ResearchCli : public ::testing::Test {
     return path;
   }
 
-  static inline fs::path* dir_ = nullptr;
+  static inline test::TempDir* dir_ = nullptr;
 };
 
 TEST_F(ResearchCli, NeedsAKnownSubcommand) {
@@ -70,7 +62,7 @@ TEST_F(ResearchCli, NeedsAKnownSubcommand) {
        {research(), research() + " table2", research() + " --table1"}) {
     const Result r = run(command);
     EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
-    EXPECT_EQ(lines(r.output), 1) << command << "\n" << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << command << "\n" << r.output;
   }
 }
 
@@ -92,7 +84,7 @@ TEST_F(ResearchCli, Table1RefusesBadKnotsBeforeAnyScene) {
         research() + " table1 --train-scenes 0", research() + " table1 --table1-train 2"}) {
     const Result r = run(command);
     EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.output;
-    EXPECT_EQ(lines(r.output), 1) << command << "\n" << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << command << "\n" << r.output;
     EXPECT_EQ(r.output.rfind("primlabel-research table1: usage error: ", 0), 0u) << r.output;
   }
 }
@@ -103,7 +95,7 @@ TEST_F(ResearchCli, Table1OnOneSceneEachPrintsAJsonLinePerRow) {
                        " table1 --train-scenes 1 --test-scenes 1 --no-pfh --no-svm --json -q "
                        "--threads 2");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  ASSERT_EQ(lines(r.output), 2) << r.output;
+  ASSERT_EQ(test::count_lines(r.output), 2) << r.output;
   std::istringstream rows(r.output);
   for (const char* method : {"crf", "node"}) {
     std::string text;
@@ -119,7 +111,7 @@ TEST_F(ResearchCli, Fig4WritesItsFilesAndOneJsonLine) {
   const std::string out = file("fig4");
   const Result r = run(research() + " fig4 " + out + " --scenes 1 --json -q --threads 2");
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
   const json::Json line = json::Json::parse(r.output);
   ASSERT_TRUE(line.contains("hik")) << r.output;
   EXPECT_EQ(line["hik"].size(), line["classes"].size());
@@ -148,7 +140,7 @@ TEST_F(ResearchCli, MosdReportScoresASceneAndWritesItsTruth) {
                                      research() + " mosd-report " + out + " --model m.plm"}) {
     const Result bad = run(command);
     EXPECT_EQ(bad.exit_code, 2) << command << "\n" << bad.output;
-    EXPECT_EQ(lines(bad.output), 1) << command << "\n" << bad.output;
+    EXPECT_EQ(test::count_lines(bad.output), 1) << command << "\n" << bad.output;
   }
 }
 
@@ -164,7 +156,7 @@ TEST_F(ResearchCli, WriteTruthWritesTheTruthOfAScene) {
   EXPECT_TRUE(fs::exists(fs::path(truth) / "truth_fits.json"));
   const Result no_scenes = run(research() + " write-truth " + truth);
   EXPECT_EQ(no_scenes.exit_code, 2) << no_scenes.output;
-  EXPECT_EQ(lines(no_scenes.output), 1) << no_scenes.output;
+  EXPECT_EQ(test::count_lines(no_scenes.output), 1) << no_scenes.output;
 }
 
 TEST_F(ResearchCli, TruthCheckOnOneScenePrintsItsScores) {
@@ -190,7 +182,7 @@ TEST_F(ResearchCli, CalibrateKinectMeasuresTheScenesOfAFolder) {
 TEST_F(ResearchCli, CalibrateKinectWithoutScenesFailsWithOneLine) {
   const Result r = run(research() + " calibrate-kinect -q /nonexistent/mosd");
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
   EXPECT_EQ(r.output.rfind("primlabel-research calibrate-kinect: error: ", 0), 0u) << r.output;
 }
 

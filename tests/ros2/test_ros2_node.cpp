@@ -412,16 +412,18 @@ class Ros2Node : public ::testing::Test {
         dir_->file(log));
   }
 
-  // primlabel-ros2 named `name` (topics /<name>/in, /<name>/out, /<name>/summary), in ROS 2's
-  // command-line style.
-  static std::unique_ptr<Process> start_node(const std::string& name, const std::string& server,
-                                             std::vector<std::string> extra = {}) {
+  // The command line of primlabel-ros2 named `node` in namespace /`ns` (topics /<ns>/in,
+  // /<ns>/out, /<ns>/summary) on `domain`, labeling with `server`, in ROS 2's style; `extra`
+  // follows.
+  static std::vector<std::string> node_command(const std::string& node, const std::string& ns,
+                                               std::uint32_t domain, const std::string& server,
+                                               const std::vector<std::string>& extra) {
     std::vector<std::string> args{test::binary("primlabel-ros2"),
                                   "--ros-args",
                                   "-r",
-                                  "__node:=" + name,
+                                  "__node:=" + node,
                                   "-r",
-                                  "__ns:=/" + name,
+                                  "__ns:=/" + ns,
                                   "-p",
                                   "input_topic:=in",
                                   "-p",
@@ -429,17 +431,23 @@ class Ros2Node : public ::testing::Test {
                                   "-p",
                                   "summary_topic:=summary",
                                   "-p",
-                                  "domain_id:=" + std::to_string(domain_),
+                                  "domain_id:=" + std::to_string(domain),
                                   "-p",
                                   "server:=" + server,
                                   "-p",
-                                  "deadline:=120",
-                                  "-p",
-                                  "voxel_size:=" + std::to_string(kVoxel),
-                                  "-p",
-                                  "probabilities:=true"};
+                                  "deadline:=120"};
     args.insert(args.end(), extra.begin(), extra.end());
-    return std::make_unique<Process>(args, dir_->file(name + ".log"));
+    return args;
+  }
+
+  // primlabel-ros2 named `name` in namespace /`name`, with probabilities.
+  static std::unique_ptr<Process> start_node(const std::string& name, const std::string& server,
+                                             const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> flags{"-p", "voxel_size:=" + std::to_string(kVoxel), "-p",
+                                   "probabilities:=true"};
+    flags.insert(flags.end(), extra.begin(), extra.end());
+    return std::make_unique<Process>(node_command(name, name, domain_, server, flags),
+                                     dir_->file(name + ".log"));
   }
 
   // A participant of a robot whose ROS 2 runs with ROS_LOCALHOST_ONLY=1: rmw_cyclonedds then
@@ -676,27 +684,9 @@ TEST_F(Ros2Node, StartsFromAParamsFileAndIsInTheRosGraph) {
 TEST_F(Ros2Node, FoundWithRosLocalhostOnlyAndNoCycloneddsUri) {
   const dds_entity_t participant = localhost_participant();
   ASSERT_GT(participant, 0) << dds_strretcode(participant);
-  auto node = start_localhost_only_node({test::binary("primlabel-ros2"),
-                                         "--ros-args",
-                                         "-r",
-                                         "__node:=local_labeler",
-                                         "-r",
-                                         "__ns:=/local",
-                                         "-p",
-                                         "input_topic:=in",
-                                         "-p",
-                                         "output_topic:=out",
-                                         "-p",
-                                         "summary_topic:=summary",
-                                         "-p",
-                                         "domain_id:=" + std::to_string(domain_ + 1),
-                                         "-p",
-                                         "server:=" + server_address_,
-                                         "-p",
-                                         "deadline:=120",
-                                         "-p",
-                                         "model:=random"},
-                                        "local.log");
+  auto node = start_localhost_only_node(
+      node_command("local_labeler", "local", domain_ + 1, server_address_, {"-p", "model:=random"}),
+      "local.log");
   Robot robot(participant, "local");
   ASSERT_TRUE(robot.connected()) << node->log();
   Cloud got;
@@ -720,31 +710,11 @@ TEST_F(Ros2Node, LabelsEveryFrameOfAReliablePublisher) {
                       << "        subscription:\n          reliability: reliable\n"
                       << "          depth: 10\n      /reliable/out:\n        publisher:\n"
                       << "          depth: 10\n";
-  auto node = start_localhost_only_node({test::binary("primlabel-ros2"),
-                                         "--ros-args",
-                                         "-r",
-                                         "__node:=reliable",
-                                         "-r",
-                                         "__ns:=/reliable",
-                                         "-p",
-                                         "input_topic:=in",
-                                         "-p",
-                                         "output_topic:=out",
-                                         "-p",
-                                         "summary_topic:=summary",
-                                         "-p",
-                                         "domain_id:=" + std::to_string(domain_ + 1),
-                                         "-p",
-                                         "server:=" + server_address_,
-                                         "-p",
-                                         "deadline:=120",
-                                         "-p",
-                                         "model:=random",
-                                         "-p",
-                                         "voxel_size:=" + std::to_string(kVoxel),
-                                         "--params-file",
-                                         file},
-                                        "reliable.log");
+  auto node = start_localhost_only_node(
+      node_command("reliable", "reliable", domain_ + 1, server_address_,
+                   {"-p", "model:=random", "-p", "voxel_size:=" + std::to_string(kVoxel),
+                    "--params-file", file}),
+      "reliable.log");
   Robot robot(participant, "reliable", /*reliable_input=*/true);
   ASSERT_TRUE(robot.connected()) << node->log();
   {  // Both sides matched before the frames that count.

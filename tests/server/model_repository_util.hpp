@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <string>
 
+#include "loopback_server_config.hpp"
 #include "primlabel/model/label_model.hpp"
 #include "primlabel/ops/server_config.hpp"
 
@@ -45,12 +46,8 @@ inline fs::path write_model(const fs::path& root, const LabelModel& model) {
 }
 
 inline ops::ServerConfig test_config(const fs::path& models) {
-  ops::ServerConfig config;
-  config.models_dir = models.string();
-  config.listen = "127.0.0.1:0";
+  ops::ServerConfig config = test::loopback_server_config(models.string());
   config.metrics_listen = "127.0.0.1:0";
-  config.reload_seconds = 0;
-  config.workers = 1;
   config.queue = 2;
   config.threads_per_job = 2;
   return config;

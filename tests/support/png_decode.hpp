@@ -3,6 +3,7 @@
 
 #include <png.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <set>
 #include <string>
@@ -33,6 +34,13 @@ struct Decoded {
             strongest = int(c >> other & 0xFF);
         n += int(c >> channel & 0xFF) > 100 && strongest < 60;
       }
+    return n;
+  }
+  // Pixels whose colour differs from the same pixel of `other` (one missing there counts too).
+  std::size_t pixels_differing_from(const Decoded& other) const {
+    const std::size_t common = std::min(rgb.size(), other.rgb.size());
+    std::size_t n = std::max(rgb.size(), other.rgb.size()) - common;
+    for (std::size_t i = 0; i < common; ++i) n += rgb[i] != other.rgb[i];
     return n;
   }
   std::size_t distinct_colors() const {

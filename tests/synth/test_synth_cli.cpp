@@ -25,8 +25,6 @@ Result run(const std::string& arguments) {
   return test::run_command(test::binary("primlabel-synth") + " " + arguments);
 }
 
-int lines(const std::string& text) { return test::count_lines(text); }
-
 TEST(SynthCli, ListsTheClassesAsAClassMap) {
   const Result r = run("--list-classes");
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -39,7 +37,7 @@ TEST(SynthCli, WritesALabeledScene) {
   const std::string out = dir.file("scene.pcd");
   const Result r = run("--scene table --sensor lms400 --seed 7 -o " + out);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("wrote " + out), std::string::npos);
   const PointCloud cloud = read_pcd(out);
   ASSERT_TRUE(cloud.has_labels());
@@ -141,7 +139,7 @@ TEST(SynthCli, UsageErrorsExitWith2AndOneLine) {
         "--seed x -o x.pcd"}) {
     const Result r = run(args);
     EXPECT_EQ(r.exit_code, 2) << args << ": " << r.output;
-    EXPECT_EQ(lines(r.output), 1) << args << ": " << r.output;
+    EXPECT_EQ(test::count_lines(r.output), 1) << args << ": " << r.output;
     EXPECT_NE(r.output.find("primlabel-synth: usage error"), std::string::npos) << r.output;
   }
 }
@@ -149,7 +147,7 @@ TEST(SynthCli, UsageErrorsExitWith2AndOneLine) {
 TEST(SynthCli, UnwritableOutputExitsWith1NamingThePath) {
   const Result r = run("--scene primitives --seed 1 -o /nonexistent/dir/out.pcd");
   EXPECT_EQ(r.exit_code, 1) << r.output;
-  EXPECT_EQ(lines(r.output), 1) << r.output;
+  EXPECT_EQ(test::count_lines(r.output), 1) << r.output;
   EXPECT_NE(r.output.find("/nonexistent/dir/out.pcd"), std::string::npos) << r.output;
 }
 

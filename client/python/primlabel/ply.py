@@ -243,6 +243,21 @@ def _ascii_vertices(path: str, elements: list, vertex_index: int, data: bytes) -
                            "non-negative integer")
         return length
 
+    def record_scalars(element: _Element, record: int) -> list:
+        """Walks one record of a list-bearing element: its scalar tokens, the lists passed over."""
+        nonlocal pos
+        scalars = []
+        for p in element.properties:
+            need(1, element, record)
+            if p.is_list:
+                length = list_length(tokens[pos], element, p, record)
+                need(1 + length, element, record)
+                pos += 1 + length
+            else:
+                scalars.append(tokens[pos])
+                pos += 1
+        return scalars
+
     for element in elements[:vertex_index]:
         if not element.properties:
             continue
@@ -251,14 +266,7 @@ def _ascii_vertices(path: str, elements: list, vertex_index: int, data: bytes) -
             pos += element.count * len(element.properties)
             continue
         for record in range(element.count):
-            for p in element.properties:
-                need(1, element, record)
-                if p.is_list:
-                    length = list_length(tokens[pos], element, p, record)
-                    need(1 + length, element, record)
-                    pos += 1 + length
-                else:
-                    pos += 1
+            record_scalars(element, record)
 
     vertex = elements[vertex_index]
     scalars = vertex.scalars()
@@ -267,19 +275,7 @@ def _ascii_vertices(path: str, elements: list, vertex_index: int, data: bytes) -
         table = np.array(tokens[pos : pos + vertex.count * len(scalars)], dtype=bytes)
         table = table.reshape(vertex.count, len(scalars))
     else:
-        rows = []
-        for record in range(vertex.count):
-            row = []
-            for p in vertex.properties:
-                need(1, vertex, record)
-                if p.is_list:
-                    length = list_length(tokens[pos], vertex, p, record)
-                    need(1 + length, vertex, record)
-                    pos += 1 + length
-                else:
-                    row.append(tokens[pos])
-                    pos += 1
-            rows.append(row)
+        rows = [record_scalars(vertex, record) for record in range(vertex.count)]
         table = np.array(rows, dtype=bytes).reshape(vertex.count, len(scalars))
     columns = []
     for i, p in enumerate(scalars):

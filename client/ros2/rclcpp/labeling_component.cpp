@@ -11,52 +11,32 @@
 #include <rclcpp_components/register_node_macro.hpp>
 #include <sensor_msgs/msg/point_cloud2.hpp>
 #include <std_msgs/msg/string.hpp>
+#include <string>
 #include <utility>
 
 #include "primlabel/ros_common/cloud_labeler.hpp"
+#include "primlabel/ros_common/pointcloud2_body.hpp"
 
 namespace primlabel::ros2node {
 
 namespace {
 
 roscommon::PointCloud2View view_of(const sensor_msgs::msg::PointCloud2& m) {
-  roscommon::PointCloud2View view;
+  roscommon::PointCloud2View view = roscommon::view_of_body(m);
   view.frame_id = m.header.frame_id;
   view.stamp_ns = m.header.stamp.sec < 0
                       ? 0
                       : std::uint64_t(m.header.stamp.sec) * 1'000'000'000u + m.header.stamp.nanosec;
-  view.height = m.height;
-  view.width = m.width;
-  for (const auto& f : m.fields) view.fields.push_back({f.name, f.offset, f.datatype, f.count});
-  view.is_bigendian = m.is_bigendian;
-  view.point_step = m.point_step;
-  view.row_step = m.row_step;
-  view.is_dense = m.is_dense;
-  view.data = m.data.data();
-  view.data_size = m.data.size();
   return view;
 }
 
 sensor_msgs::msg::PointCloud2 to_message(roscommon::PointCloud2Data&& cloud) {
-  sensor_msgs::msg::PointCloud2 m;
-  m.header.frame_id = cloud.frame_id;
-  m.header.stamp.sec = static_cast<std::int32_t>(cloud.stamp_ns / 1'000'000'000u);
-  m.header.stamp.nanosec = static_cast<std::uint32_t>(cloud.stamp_ns % 1'000'000'000u);
-  m.height = cloud.height;
-  m.width = cloud.width;
-  for (const auto& f : cloud.fields) {
-    sensor_msgs::msg::PointField field;
-    field.name = f.name;
-    field.offset = f.offset;
-    field.datatype = f.datatype;
-    field.count = f.count;
-    m.fields.push_back(field);
-  }
-  m.is_bigendian = cloud.is_bigendian;
-  m.point_step = cloud.point_step;
-  m.row_step = cloud.row_step;
-  m.is_dense = cloud.is_dense;
-  m.data = std::move(cloud.data);
+  std::string frame_id = std::move(cloud.frame_id);
+  const std::uint64_t stamp_ns = cloud.stamp_ns;
+  auto m = roscommon::message_body<sensor_msgs::msg::PointCloud2>(std::move(cloud));
+  m.header.frame_id = std::move(frame_id);
+  m.header.stamp.sec = static_cast<std::int32_t>(stamp_ns / 1'000'000'000u);
+  m.header.stamp.nanosec = static_cast<std::uint32_t>(stamp_ns % 1'000'000'000u);
   return m;
 }
 
