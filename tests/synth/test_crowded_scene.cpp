@@ -180,7 +180,7 @@ TEST(CrowdedScene, ObjectsInContact) {
     pairs += here;
   }
   EXPECT_GE(frames, 15) << pairs << " pairs in contact";
-  EXPECT_GE(pairs, 30);
+  EXPECT_GE(pairs, 45);
 }
 
 // A box on a box (or a can on a can) whose footprint differs from the one below by < 15%.

@@ -1,7 +1,7 @@
 // The crowded table's hard cases: groups of objects composed in a frame of their own (a box or
 // book leaning on a box, a stack of nearly one footprint, a can beside a box of its height and
 // colour, two boxes face to face), placed first, then single objects around them, half of those
-// within contact distance of their neighbours.
+// slid against a neighbour.
 
 #include "crowded_scene.hpp"
 
@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "primlabel/synth/random.hpp"
@@ -190,13 +191,13 @@ bool everything_in_view(const Scene& scene) {
   return true;
 }
 
-// Places the group at the first free spot of `attempts` draws where it leaves everything in
-// view; false when there was none.
-bool place_group(const Group& group, double gap, int attempts, Rng& rng, StandingArea& area,
-                 Scene& scene) {
+// Places the group at the first free spot of `attempts` draws of `spot` (a footprint radius to
+// a pose on the table) where it leaves everything in view; false when there was none.
+template <typename Spot>
+bool place_group(const Group& group, Spot&& spot, int attempts, StandingArea& area, Scene& scene) {
   const Circle circle = enclosing_circle(group);
   for (int attempt = 0; attempt < attempts; ++attempt) {
-    const auto pose = area.place(rng, circle.radius, gap);
+    const std::optional<Eigen::Isometry3d> pose = spot(circle.radius);
     if (!pose) continue;
     const Eigen::Isometry3d world_from_group =
         *pose * Eigen::Translation3d(-circle.center.x(), -circle.center.y(), 0.0);
@@ -227,17 +228,23 @@ Scene crowded_scene(std::uint64_t seed) {
     if (!rng.chance(0.85)) continue;
     const Group group = make(rng);
     if (objects() + static_cast<int>(group.size()) > wanted) continue;
-    place_group(group, rng.uniform(kContactGap, 0.01), 300, rng, area, scene);
+    const double gap = rng.uniform(kContactGap, 0.01);
+    place_group(
+        group, [&](double r) { return area.place(rng, r, gap); }, 300, area, scene);
   }
   for (int attempt = 0; attempt < 2000 && objects() < wanted; ++attempt) {
     Candidate candidate =
         rng.chance(0.33)  // a book lying flat, as on clutter's tables
             ? Candidate{box(draw(rng, {0.14, 0.10, 0.015}, {0.24, 0.17, 0.05})), book_color(rng)}
             : random_object(rng);
-    const double gap =
-        rng.chance(0.5) ? rng.uniform(0.0, kContactGap) : rng.uniform(kContactGap, 0.01);
-    place_group({{candidate.shape, Eigen::Isometry3d::Identity(), candidate.rgb}}, gap, 1, rng,
-                area, scene);
+    // Half of them against a neighbour: drawn spots alone seldom land within contact distance.
+    const bool touching = rng.chance(0.5);
+    const double gap = touching ? rng.uniform(0.0, kContactGap) : rng.uniform(kContactGap, 0.01);
+    const auto spot = [&](double r) {
+      return touching ? area.place_against(rng, r, gap) : area.place(rng, r, gap);
+    };
+    place_group({{candidate.shape, Eigen::Isometry3d::Identity(), candidate.rgb}}, spot, 1, area,
+                scene);
   }
   return scene;
 }

@@ -83,4 +83,27 @@ std::optional<Eigen::Isometry3d> StandingArea::place(Rng& rng, double r, double 
   return pose_on_table(x, y, yaw);
 }
 
+std::optional<Eigen::Isometry3d> StandingArea::place_against(Rng& rng, double r, double gap) {
+  const double x = rng.uniform(-half_x + r, half_x - r);
+  const double y = rng.uniform(y_lo + r, y_hi - r);
+  const double yaw = rng.uniform(0.0, 2.0 * M_PI);
+  if (placed.empty() || 2 * r > 2 * half_x || 2 * r > y_hi - y_lo) return std::nullopt;
+  const Footprint* nearest = &placed.front();
+  for (const Footprint& other : placed)
+    if (std::hypot(x - other.x, y - other.y) - other.r <
+        std::hypot(x - nearest->x, y - nearest->y) - nearest->r)
+      nearest = &other;
+  const double away = std::hypot(x - nearest->x, y - nearest->y);
+  if (away == 0.0) return std::nullopt;
+  const double reach = (r + nearest->r + gap) / away;
+  const double nx = nearest->x + reach * (x - nearest->x);
+  const double ny = nearest->y + reach * (y - nearest->y);
+  if (std::abs(nx) > half_x - r || ny < y_lo + r || ny > y_hi - r) return std::nullopt;
+  for (const Footprint& other : placed)
+    if (&other != nearest && std::hypot(nx - other.x, ny - other.y) < r + other.r)
+      return std::nullopt;
+  placed.push_back({nx, ny, r});
+  return pose_on_table(nx, ny, yaw);
+}
+
 }  // namespace primlabel::synth::detail

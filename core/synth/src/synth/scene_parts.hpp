@@ -42,6 +42,10 @@ struct StandingArea {
   // A random spot and turn for a footprint of radius r, at least `gap` from every placed one; it
   // is then placed. Nothing when the draw lands too close or r does not fit.
   std::optional<Eigen::Isometry3d> place(Rng& rng, double r, double gap);
+  // As place, but the footprint then slides along the line to the nearest placed one until it is
+  // `gap` from it (objects in contact); nothing when that spot is off the area or overlaps
+  // another.
+  std::optional<Eigen::Isometry3d> place_against(Rng& rng, double r, double gap);
 };
 
 }  // namespace primlabel::synth::detail
