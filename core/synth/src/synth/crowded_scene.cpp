@@ -139,7 +139,8 @@ Circle enclosing_circle(const Group& group) {
   Eigen::Vector2d hi = -lo;
   for (const Member& member : group) {
     const double r = member.shape->footprint_radius();
-    const double height = 2.0 * member.shape->bound_center().z();  // every shape is centred so
+    // Every shape's bounding sphere is centred at half its height.
+    const double height = 2.0 * member.shape->bound_center().z();
     for (const double z : {0.0, height}) {
       const Eigen::Vector2d end = (member.pose * Vec3d(0, 0, z)).head<2>();
       discs.push_back({end, r});
