@@ -201,9 +201,11 @@ int main(int argc, char** argv) {
   Arguments args;
   app.add_option("--scene", args.scene,
                  "table (random kitchen objects), primitives (one of each "
-                 "shape), empty (bare table) or clutter (8-14 objects close together, books, "
-                 "stacked boxes: for the table-top stage)")
-      ->check(CLI::IsMember({"table", "primitives", "empty", "clutter"}));
+                 "shape), empty (bare table), clutter (8-14 objects close together, books, "
+                 "stacked boxes: for the table-top stage) or crowded (clutter's hard cases: "
+                 "objects in contact, stacks of one footprint, leaning boxes, a can beside a box "
+                 "of its height and colour)")
+      ->check(CLI::IsMember({"table", "primitives", "empty", "clutter", "crowded"}));
   app.add_flag("--segment-labels", args.segment_labels,
                "write instances, not classes, in `label`: 1 the table, 10 (k + 1) object k, as "
                "mOSD scenes do (primlabel-bench tabletop and primlabel-tabletop score them)");

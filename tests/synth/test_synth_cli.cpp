@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "primlabel/geometry/cloud_io.hpp"
@@ -78,6 +79,31 @@ TEST(SynthCli, ClutterSceneWithSegmentLabels) {
   const CloudTags tags = read_cloud_tags(out);
   EXPECT_EQ(tags.at("scene"), "clutter");
   EXPECT_NE(tags.at("labels").find("segments"), std::string::npos);
+}
+
+// The crowded scene's instances: every object, leaning and stacked ones included, its own label.
+TEST(SynthCli, CrowdedSceneWithSegmentLabels) {
+  test::TempDir dir;
+  const std::string out = dir.file("crowded.pcd");
+  const Result r = run("--scene crowded --sensor kinect --seed 3 --segment-labels -q -o " + out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const PointCloud cloud = read_pcd(out);
+  const FloatField* object = cloud.find_field("object");
+  ASSERT_NE(object, nullptr);
+  std::set<std::uint32_t> labels;
+  int objects = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (!is_finite(cloud.xyz[i])) continue;
+    const int k = static_cast<int>(object->values[i]);
+    objects = std::max(objects, k);
+    if (k > 0) ASSERT_EQ(cloud.labels[i], 10u * std::uint32_t(k + 1)) << i;
+    labels.insert(cloud.labels[i]);
+  }
+  EXPECT_TRUE(labels.count(1u)) << "the table top";
+  EXPECT_GE(objects, 8);
+  EXPECT_LE(objects, 14);
+  for (int k = 1; k <= objects; ++k) EXPECT_TRUE(labels.count(10u * (k + 1))) << k;
+  EXPECT_EQ(read_cloud_tags(out).at("scene"), "crowded");
 }
 
 TEST(SynthCli, KinectPrimitivesWithRadiusToPly) {

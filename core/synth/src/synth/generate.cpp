@@ -119,13 +119,15 @@ std::string_view scene_name(SceneKind scene) {
       return "empty";
     case SceneKind::kClutter:
       return "clutter";
+    case SceneKind::kCrowded:
+      return "crowded";
   }
   return "table";
 }
 
 std::optional<SceneKind> scene_from_name(std::string_view name) {
-  for (SceneKind kind :
-       {SceneKind::kTable, SceneKind::kPrimitives, SceneKind::kEmptyTable, SceneKind::kClutter})
+  for (SceneKind kind : {SceneKind::kTable, SceneKind::kPrimitives, SceneKind::kEmptyTable,
+                         SceneKind::kClutter, SceneKind::kCrowded})
     if (name == scene_name(kind)) return kind;
   return std::nullopt;
 }

@@ -1,6 +1,7 @@
 #pragma once
 // A synthetic table scene: a table slab whose top face is the plane z = 0 of the world frame,
-// and objects standing on it, each a shape with a pose (a position on the table and a yaw).
+// and objects on it, each a shape with a pose (a position on the table and a yaw; objects leaning
+// on others are also tilted).
 // Generation is deterministic for a seed.
 
 #include <Eigen/Geometry>
@@ -52,6 +53,11 @@ enum class SceneKind {
   // creases the truth rule does not model): 8-14 objects a few millimetres apart, books lying
   // flat and boxes stacked on boxes. Each object, stacked ones included, is its own instance.
   kClutter,
+  // The crowded table's hard cases on top of clutter's: 8-14 objects (stacked and leaning ones
+  // included), some in contact (0-3 mm apart), a box on a box of nearly its footprint or a can on
+  // a can, a book or flat box leaning against a box (tilted, resting on its edge), a can beside a
+  // box of its height and colour. Each object is its own instance; for the table-top stage.
+  kCrowded,
 };
 
 struct TableSceneOptions {
