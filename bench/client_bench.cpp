@@ -82,7 +82,8 @@ struct FrameRun {
   double beyond_server() const { return end_to_end - server_total(); }
 };
 
-FrameRun run_frame(client::Client& client, const std::string& input, const std::string& output) {
+FrameRun run_frame(client::Client& client, const std::string& model, const std::string& input,
+                   const std::string& output) {
   FrameRun run;
   auto start = Clock::now();
   PointCloud cloud = read_cloud(input);
@@ -90,7 +91,7 @@ FrameRun run_frame(client::Client& client, const std::string& input, const std::
   run.client["read"] = ms_since(start);
 
   client::LabelOptions options;
-  options.model = "bench";
+  options.model = model;
   options.scan_id = fs::path(input).stem().string();
   start = Clock::now();
   const client::LabelResult result = client.label(cloud, options);
@@ -126,7 +127,7 @@ int run_client_bench(const Arguments& args) {
   ops::set_log_level(ops::LogLevel::kWarn);
   const fs::path scratch =
       fs::temp_directory_path() / ("primlabel_client_bench_" + std::to_string(getpid()));
-  fs::create_directories(scratch / "models" / "bench" / "1");
+  fs::create_directories(scratch);
   struct Cleanup {
     fs::path dir;
     ~Cleanup() {
@@ -140,11 +141,14 @@ int run_client_bench(const Arguments& args) {
     input = (scratch / "kinect_frame.pcd").string();
     write_pcd(input, synthetic_kinect_frame(), PcdEncoding::kBinaryCompressed);
   }
-  const fs::path model_file = scratch / "models" / "bench" / "1" / "model.plm";
+  // Served under its own name and version, as a model repository holds it.
+  const LabelModel model = args.model.empty() ? random_voxel_model() : load_model(args.model);
+  const fs::path model_dir = scratch / "models" / model.name / model.version;
+  fs::create_directories(model_dir);
   if (args.model.empty())
-    save_model(model_file.string(), random_voxel_model());
+    save_model((model_dir / "model.plm").string(), model);
   else
-    fs::copy_file(args.model, model_file);
+    fs::copy_file(args.model, model_dir / "model.plm");
 
   ops::ServerConfig config;
   config.models_dir = (scratch / "models").string();
@@ -154,12 +158,14 @@ int run_client_bench(const Arguments& args) {
   config.workers = 1;
   config.threads_per_job = args.threads;
   rpc::LabelServer server(config);
-  client::Client client({.address = "127.0.0.1:" + std::to_string(server.port())});
+  client::ClientOptions client_options;
+  client_options.address = "127.0.0.1:" + std::to_string(server.port());
+  client::Client client(client_options);
 
   const std::string output = (scratch / "frame_labeled.pcd").string();
   std::vector<FrameRun> runs;
   for (int rep = -1; rep < args.reps; ++rep) {  // rep -1 warms up the server, the caches and files
-    FrameRun run = run_frame(client, input, output);
+    FrameRun run = run_frame(client, model.name, input, output);
     if (rep >= 0) runs.push_back(std::move(run));
   }
   server.shutdown(std::chrono::milliseconds(0));

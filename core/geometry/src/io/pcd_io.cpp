@@ -19,7 +19,9 @@
 #include <vector>
 
 #include "io_util.hpp"
+#include "lzf_decode.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::io_detail {
 namespace {
@@ -466,14 +468,13 @@ std::unique_ptr<unsigned char[]> decompress_planes(const std::string& path, cons
                              uncompressed_size, " bytes (corrupt size header)"));
 
   auto planes = std::make_unique_for_overwrite<unsigned char[]>(uncompressed_size);
-  errno = 0;
-  const unsigned int produced =
-      lzf_decompress(bytes + 8, compressed_size, planes.get(), uncompressed_size);
-  if (produced != uncompressed_size) {
-    const std::string reason = produced == 0 && errno == E2BIG ? "output exceeds the declared size"
-                               : produced == 0 && errno == EINVAL
+  const LzfDecoded decoded = lzf_decode(bytes + 8, compressed_size, planes.get(), uncompressed_size);
+  if (decoded.status != LzfStatus::kOk || decoded.produced != uncompressed_size) {
+    const std::string reason = decoded.status == LzfStatus::kOutputOverflow
+                                   ? "output exceeds the declared size"
+                               : decoded.status == LzfStatus::kInvalid
                                    ? "invalid compressed stream"
-                                   : cat("produced ", produced, " bytes");
+                                   : cat("produced ", decoded.produced, " bytes");
     throw_io_error(path, cat("LZF decompression failed: ", reason, " (expected ", uncompressed_size,
                              " bytes)"));
   }
@@ -694,6 +695,15 @@ std::uint64_t record_bytes_of(const std::vector<OutputField>& fields) {
   return bytes;
 }
 
+// Copies one value of `bytes` bytes; the common 4-byte case with a constant size, which the
+// compiler turns into one load and store instead of a memcpy call per value.
+inline void copy_value(unsigned char* out, const unsigned char* in, std::size_t bytes) {
+  if (bytes == 4)
+    std::memcpy(out, in, 4);
+  else
+    std::memcpy(out, in, bytes);
+}
+
 void append_binary_body(std::string& out, std::size_t points,
                         const std::vector<OutputField>& fields) {
   const std::size_t start = out.size();
@@ -702,44 +712,108 @@ void append_binary_body(std::string& out, std::size_t points,
   for (std::size_t i = 0; i < points; ++i) {
     for (const OutputField& field : fields) {
       const std::size_t bytes = 4 * std::size_t{field.count};
-      std::memcpy(record, field.point(i), bytes);
+      copy_value(record, field.point(i), bytes);
       record += bytes;
     }
   }
 }
 
-void append_compressed_body(const std::string& path, std::string& out, std::size_t points,
-                            const std::vector<OutputField>& fields) {
+// One field's values of every point, one after another (a binary_compressed plane).
+void gather_plane(const OutputField& field, std::size_t points, unsigned char* plane) {
+  const std::size_t bytes = 4 * std::size_t{field.count};
+  if (points == 0) return;
+  if (field.point_stride == bytes) {  // already contiguous: labels, rgba, scalar fields
+    std::memcpy(plane, field.point(0), points * bytes);
+    return;
+  }
+  const unsigned char* in = field.point(0);
+  for (std::size_t i = 0; i < points; ++i, in += field.point_stride, plane += bytes)
+    copy_value(plane, in, bytes);
+}
+
+// Room for LZF's worst-case expansion of `bytes` input bytes.
+std::uint64_t lzf_capacity(std::uint64_t bytes) { return bytes + bytes / 16 + 64; }
+
+// Compresses `size` bytes to `out` (room for lzf_capacity(size) bytes); returns the bytes written.
+std::size_t compress_lzf(const std::string& path, const unsigned char* in, std::size_t size,
+                         unsigned char* out) {
+  if (size == 0) return 0;
+  const unsigned written = lzf_compress(in, static_cast<unsigned>(size), out,
+                                        static_cast<unsigned>(lzf_capacity(size)));
+  if (written == 0) throw_io_error(path, "LZF compression failed");
+  return written;
+}
+
+// Compresses the planes as independent LZF streams of `segment_bytes` each, in parallel, and
+// concatenates them at `out` (CloudWriteOptions); returns the bytes written.
+std::size_t compress_lzf_segments(const std::string& path, const unsigned char* planes,
+                                  std::size_t size, std::size_t segment_bytes, int threads,
+                                  unsigned char* out) {
+  const std::size_t segments = (size + segment_bytes - 1) / segment_bytes;
+  std::vector<std::unique_ptr<unsigned char[]>> compressed(segments);
+  std::vector<std::size_t> compressed_size(segments, 0);
+  detail::parallel_for(std::ptrdiff_t(segments), threads, detail::Schedule::Dynamic(1),
+                       [&](std::ptrdiff_t s) {
+                         const std::size_t first = std::size_t(s) * segment_bytes;
+                         const std::size_t bytes = std::min(segment_bytes, size - first);
+                         compressed[s] =
+                             std::make_unique_for_overwrite<unsigned char[]>(lzf_capacity(bytes));
+                         compressed_size[s] =
+                             compress_lzf(path, planes + first, bytes, compressed[s].get());
+                       });
+  std::size_t written = 0;
+  for (std::size_t s = 0; s < segments; ++s) {
+    std::memcpy(out + written, compressed[s].get(), compressed_size[s]);
+    written += compressed_size[s];
+  }
+  return written;
+}
+
+// A whole binary_compressed file: the header, uint32 compressed and uncompressed sizes, the LZF
+// data of the planes. Built in one buffer that is neither zero-filled nor copied again: the LZF
+// data is compressed straight into place after the header.
+void write_compressed_file(const std::string& path, const std::string& header, std::size_t points,
+                           const std::vector<OutputField>& fields,
+                           const CloudWriteOptions& options) {
   const std::uint64_t plane_bytes = points * record_bytes_of(fields);
-  // Both sizes are stored as uint32; leave room for LZF's worst-case expansion.
-  const std::uint64_t capacity = plane_bytes + plane_bytes / 16 + 64;
-  if (capacity > 0xffffffffu)
+  // Both sizes are stored as uint32 (segments only add their per-segment slack below this).
+  const std::uint64_t segments =
+      options.lzf_segment_bytes > 0
+          ? (plane_bytes + options.lzf_segment_bytes - 1) / options.lzf_segment_bytes
+          : 1;
+  const std::uint64_t capacity = lzf_capacity(plane_bytes) + 64 * segments;
+  if (lzf_capacity(plane_bytes) > 0xffffffffu)
     throw_io_error(path, cat("cannot write binary_compressed: ", plane_bytes,
                              " bytes of point data exceed the format's 32-bit size fields"));
 
-  std::vector<unsigned char> planes(plane_bytes);
-  unsigned char* plane = planes.data();
+  auto planes = std::make_unique_for_overwrite<unsigned char[]>(plane_bytes);
+  unsigned char* plane = planes.get();
   for (const OutputField& field : fields) {
-    const std::size_t bytes = 4 * std::size_t{field.count};
-    for (std::size_t i = 0; i < points; ++i, plane += bytes)
-      std::memcpy(plane, field.point(i), bytes);
+    gather_plane(field, points, plane);
+    plane += points * 4 * std::size_t{field.count};
   }
 
-  std::uint32_t compressed_size = 0;
-  std::vector<unsigned char> compressed(capacity);
-  if (plane_bytes > 0) {
-    compressed_size = lzf_compress(planes.data(), static_cast<unsigned>(plane_bytes),
-                                   compressed.data(), static_cast<unsigned>(capacity));
-    if (compressed_size == 0) throw_io_error(path, "LZF compression failed");
-  }
+  const std::size_t data_offset = header.size() + 8;
+  auto file = std::make_unique_for_overwrite<unsigned char[]>(data_offset + capacity);
+  std::memcpy(file.get(), header.data(), header.size());
+  const std::size_t compressed =
+      options.lzf_segment_bytes > 0 && plane_bytes > options.lzf_segment_bytes
+          ? compress_lzf_segments(path, planes.get(), plane_bytes, options.lzf_segment_bytes,
+                                  options.threads, file.get() + data_offset)
+          : compress_lzf(path, planes.get(), plane_bytes, file.get() + data_offset);
+  if (compressed > 0xffffffffu)
+    throw_io_error(path, cat("cannot write binary_compressed: ", compressed,
+                             " compressed bytes exceed the format's 32-bit size field"));
+  const auto compressed_size = static_cast<std::uint32_t>(compressed);
   const auto uncompressed_size = static_cast<std::uint32_t>(plane_bytes);
-  out.append(reinterpret_cast<const char*>(&compressed_size), 4);
-  out.append(reinterpret_cast<const char*>(&uncompressed_size), 4);
-  out.append(reinterpret_cast<const char*>(compressed.data()), compressed_size);
+  std::memcpy(file.get() + header.size(), &compressed_size, 4);
+  std::memcpy(file.get() + header.size() + 4, &uncompressed_size, 4);
+  write_file_atomically(path, std::string_view(reinterpret_cast<const char*>(file.get()),
+                                               data_offset + compressed_size));
 }
 
 void write_pcd_file(const std::string& path, const PointCloud& cloud, PcdEncoding encoding,
-                    const HeaderComments& comments) {
+                    const HeaderComments& comments, const CloudWriteOptions& options) {
   const Shape shape = validate_cloud_for_writing(path, cloud);
   const std::vector<OutputField> fields = output_fields(cloud);
   std::vector<std::string> names;
@@ -755,8 +829,8 @@ void write_pcd_file(const std::string& path, const PointCloud& cloud, PcdEncodin
       append_binary_body(out, cloud.size(), fields);
       break;
     case PcdEncoding::kBinaryCompressed:
-      append_compressed_body(path, out, cloud.size(), fields);
-      break;
+      write_compressed_file(path, out, cloud.size(), fields, options);
+      return;
   }
   write_file_atomically(path, out);
 }
@@ -769,8 +843,8 @@ namespace primlabel {
 PointCloud read_pcd(const std::string& path) { return io_detail::read_pcd_file(path); }
 
 void write_pcd(const std::string& path, const PointCloud& cloud, PcdEncoding encoding,
-               const HeaderComments& comments) {
-  io_detail::write_pcd_file(path, cloud, encoding, comments);
+               const HeaderComments& comments, const CloudWriteOptions& options) {
+  io_detail::write_pcd_file(path, cloud, encoding, comments, options);
 }
 
 }  // namespace primlabel
