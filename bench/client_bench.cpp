@@ -100,7 +100,8 @@ FrameRun run_frame(client::Client& client, const std::string& model, const std::
   run.client["send"] = 1e3 * result.client_seconds.send;
   run.client["receive"] = 1e3 * result.client_seconds.receive;
   run.client["decode"] = 1e3 * result.client_seconds.decode;
-  for (const v1::StageTiming& t : result.summary.timings()) run.server[t.stage()] = 1e3 * t.seconds();
+  for (const v1::StageTiming& t : result.summary.timings())
+    run.server[t.stage()] = 1e3 * t.seconds();
 
   start = Clock::now();
   const PointCloud labeled = client::tools::labeled_cloud(std::move(cloud), result);
@@ -178,8 +179,9 @@ int run_client_bench(const Arguments& args) {
       best_client[stage] = std::min(
           best_client.count(stage) ? best_client[stage] : std::numeric_limits<double>::infinity(),
           ms);
-  const FrameRun& fastest_call = *std::min_element(
-      runs.begin(), runs.end(), [](const FrameRun& a, const FrameRun& b) { return a.call < b.call; });
+  const FrameRun& fastest_call =
+      *std::min_element(runs.begin(), runs.end(),
+                        [](const FrameRun& a, const FrameRun& b) { return a.call < b.call; });
   std::vector<double> beyond;
   double best_end_to_end = std::numeric_limits<double>::infinity();
   for (const FrameRun& run : runs) {
@@ -187,8 +189,8 @@ int run_client_bench(const Arguments& args) {
     best_end_to_end = std::min(best_end_to_end, run.end_to_end);
   }
   std::sort(beyond.begin(), beyond.end());
-  const double client_own = best_client["read"] + best_client["encode"] + best_client["decode"] +
-                            best_client["write"];
+  const double client_own =
+      best_client["read"] + best_client["encode"] + best_client["decode"] + best_client["write"];
 
   const PointCloud frame = read_cloud(input);
   std::printf("client frame %s: %zu points (%u x %u), %d reps, best of each stage\n",
@@ -196,12 +198,11 @@ int run_client_bench(const Arguments& args) {
               frame.size(), frame.width, frame.height, args.reps);
   print_stages("client stages ms:", {"read", "encode", "send", "receive", "decode", "write"},
                best_client);
-  print_stages("server stages ms:",
-               {"receive", "prefilter", "normals", "features", "inference", "send"},
-               fastest_call.server);
-  std::printf("call ms: %.2f = server %.2f + outside the server's stages %.2f\n",
-              fastest_call.call, fastest_call.server_total(),
-              fastest_call.call - fastest_call.server_total());
+  print_stages(
+      "server stages ms:", {"receive", "prefilter", "normals", "features", "inference", "send"},
+      fastest_call.server);
+  std::printf("call ms: %.2f = server %.2f + outside the server's stages %.2f\n", fastest_call.call,
+              fastest_call.server_total(), fastest_call.call - fastest_call.server_total());
   std::printf(
       "end to end ms: %.2f; beyond the server %.2f best, %.2f median; read + encode + decode + "
       "write %.2f\n",
@@ -209,7 +210,8 @@ int run_client_bench(const Arguments& args) {
 
   namespace json = primlabel::json;
   json::Json client_stages = json::Json::object(), server_stages = json::Json::object();
-  for (const auto& [stage, ms] : best_client) client_stages[stage + "_ms"] = json::rounded(ms, "%.2f");
+  for (const auto& [stage, ms] : best_client)
+    client_stages[stage + "_ms"] = json::rounded(ms, "%.2f");
   for (const auto& [stage, ms] : fastest_call.server)
     server_stages[stage + "_ms"] = json::rounded(ms, "%.2f");
   const json::Json line = {

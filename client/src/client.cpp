@@ -7,10 +7,10 @@
 #include <chrono>
 #include <cmath>
 #include <future>
+#include <list>
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <list>
 #include <thread>
 
 #include "call_control.hpp"
@@ -240,12 +240,14 @@ struct Client::Impl {
       });
       auto stream = labeler->Label(&context);
       // Writes stop at the first failure: the server has ended the call, Finish says why.
-      const v1::LabelRequest header = timed(seconds.encode, [&] { return header_request(cloud, o); });
+      const v1::LabelRequest header =
+          timed(seconds.encode, [&] { return header_request(cloud, o); });
       bool writing = timed(seconds.send, [&] { return stream->Write(header); });
       v1::LabelRequest request;
       for (std::size_t first = 0; writing && first < cloud.size(); first += chunk_points) {
         const std::size_t count = std::min(chunk_points, cloud.size() - first);
-        timed(seconds.encode, [&] { fill_chunk(cloud, o, first, count, *request.mutable_chunk()); });
+        timed(seconds.encode,
+              [&] { fill_chunk(cloud, o, first, count, *request.mutable_chunk()); });
         writing = timed(seconds.send, [&] { return stream->Write(request); });
         if (writing && on_progress) on_progress(first + count, cloud.size());
       }
@@ -296,9 +298,8 @@ struct Client::Impl {
       v1::LabelCloudResponse response;
       seconds.receive = 0;
       seconds.decode = 0;
-      grpc::Status status = timed(seconds.receive, [&] {
-        return labeler->LabelCloud(&context, request, &response);
-      });
+      grpc::Status status =
+          timed(seconds.receive, [&] { return labeler->LabelCloud(&context, request, &response); });
       if (!status.ok()) return status;
       result = timed(seconds.decode, [&] {
         LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities, o.primitives,

@@ -117,17 +117,17 @@ TEST(LzfDecode, AReferenceBeforeTheStartOrARunPastTheInputIsInvalid) {
             LzfStatus::kInvalid);
 
   const Bytes truncated_literal = {5, 1, 2};  // 6 literal bytes announced, 2 present
-  EXPECT_EQ(lzf_decode(truncated_literal.data(), truncated_literal.size(), out.data(), out.size())
-                .status,
-            LzfStatus::kInvalid);
+  EXPECT_EQ(
+      lzf_decode(truncated_literal.data(), truncated_literal.size(), out.data(), out.size()).status,
+      LzfStatus::kInvalid);
 
   Bytes truncated_reference;
   add_literals(truncated_reference, Bytes(4, 1));
   truncated_reference.push_back(0xe0);  // a long reference whose length and distance are cut off
-  EXPECT_EQ(lzf_decode(truncated_reference.data(), truncated_reference.size(), out.data(),
-                       out.size())
-                .status,
-            LzfStatus::kInvalid);
+  EXPECT_EQ(
+      lzf_decode(truncated_reference.data(), truncated_reference.size(), out.data(), out.size())
+          .status,
+      LzfStatus::kInvalid);
 }
 
 TEST(LzfDecode, AShortStreamReportsWhatItProduced) {

@@ -5,8 +5,6 @@
 // column in one typed loop. Every size taken from the header is checked against the bytes that
 // are really in the file before anything proportional to it is allocated.
 
-#include <lzf.h>
-
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -20,8 +18,8 @@
 
 #include "io_util.hpp"
 #include "lzf_decode.hpp"
+#include "lzf_encode.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
-#include "primlabel/geometry/parallel.hpp"
 
 namespace primlabel::io_detail {
 namespace {
@@ -468,13 +466,13 @@ std::unique_ptr<unsigned char[]> decompress_planes(const std::string& path, cons
                              uncompressed_size, " bytes (corrupt size header)"));
 
   auto planes = std::make_unique_for_overwrite<unsigned char[]>(uncompressed_size);
-  const LzfDecoded decoded = lzf_decode(bytes + 8, compressed_size, planes.get(), uncompressed_size);
+  const LzfDecoded decoded =
+      lzf_decode(bytes + 8, compressed_size, planes.get(), uncompressed_size);
   if (decoded.status != LzfStatus::kOk || decoded.produced != uncompressed_size) {
-    const std::string reason = decoded.status == LzfStatus::kOutputOverflow
-                                   ? "output exceeds the declared size"
-                               : decoded.status == LzfStatus::kInvalid
-                                   ? "invalid compressed stream"
-                                   : cat("produced ", decoded.produced, " bytes");
+    const std::string reason =
+        decoded.status == LzfStatus::kOutputOverflow ? "output exceeds the declared size"
+        : decoded.status == LzfStatus::kInvalid      ? "invalid compressed stream"
+                                                     : cat("produced ", decoded.produced, " bytes");
     throw_io_error(path, cat("LZF decompression failed: ", reason, " (expected ", uncompressed_size,
                              " bytes)"));
   }
@@ -731,44 +729,6 @@ void gather_plane(const OutputField& field, std::size_t points, unsigned char* p
     copy_value(plane, in, bytes);
 }
 
-// Room for LZF's worst-case expansion of `bytes` input bytes.
-std::uint64_t lzf_capacity(std::uint64_t bytes) { return bytes + bytes / 16 + 64; }
-
-// Compresses `size` bytes to `out` (room for lzf_capacity(size) bytes); returns the bytes written.
-std::size_t compress_lzf(const std::string& path, const unsigned char* in, std::size_t size,
-                         unsigned char* out) {
-  if (size == 0) return 0;
-  const unsigned written = lzf_compress(in, static_cast<unsigned>(size), out,
-                                        static_cast<unsigned>(lzf_capacity(size)));
-  if (written == 0) throw_io_error(path, "LZF compression failed");
-  return written;
-}
-
-// Compresses the planes as independent LZF streams of `segment_bytes` each, in parallel, and
-// concatenates them at `out` (CloudWriteOptions); returns the bytes written.
-std::size_t compress_lzf_segments(const std::string& path, const unsigned char* planes,
-                                  std::size_t size, std::size_t segment_bytes, int threads,
-                                  unsigned char* out) {
-  const std::size_t segments = (size + segment_bytes - 1) / segment_bytes;
-  std::vector<std::unique_ptr<unsigned char[]>> compressed(segments);
-  std::vector<std::size_t> compressed_size(segments, 0);
-  detail::parallel_for(std::ptrdiff_t(segments), threads, detail::Schedule::Dynamic(1),
-                       [&](std::ptrdiff_t s) {
-                         const std::size_t first = std::size_t(s) * segment_bytes;
-                         const std::size_t bytes = std::min(segment_bytes, size - first);
-                         compressed[s] =
-                             std::make_unique_for_overwrite<unsigned char[]>(lzf_capacity(bytes));
-                         compressed_size[s] =
-                             compress_lzf(path, planes + first, bytes, compressed[s].get());
-                       });
-  std::size_t written = 0;
-  for (std::size_t s = 0; s < segments; ++s) {
-    std::memcpy(out + written, compressed[s].get(), compressed_size[s]);
-    written += compressed_size[s];
-  }
-  return written;
-}
-
 // A whole binary_compressed file: the header, uint32 compressed and uncompressed sizes, the LZF
 // data of the planes. Built in one buffer that is neither zero-filled nor copied again: the LZF
 // data is compressed straight into place after the header.
@@ -776,13 +736,9 @@ void write_compressed_file(const std::string& path, const std::string& header, s
                            const std::vector<OutputField>& fields,
                            const CloudWriteOptions& options) {
   const std::uint64_t plane_bytes = points * record_bytes_of(fields);
-  // Both sizes are stored as uint32 (segments only add their per-segment slack below this).
-  const std::uint64_t segments =
-      options.lzf_segment_bytes > 0
-          ? (plane_bytes + options.lzf_segment_bytes - 1) / options.lzf_segment_bytes
-          : 1;
-  const std::uint64_t capacity = lzf_capacity(plane_bytes) + 64 * segments;
-  if (lzf_capacity(plane_bytes) > 0xffffffffu)
+  // Both sizes are stored as uint32; leave room for LZF's worst-case expansion.
+  const std::uint64_t capacity = lzf_encode_capacity(plane_bytes, options.lzf_segment_bytes);
+  if (capacity > 0xffffffffu)
     throw_io_error(path, cat("cannot write binary_compressed: ", plane_bytes,
                              " bytes of point data exceed the format's 32-bit size fields"));
 
@@ -796,14 +752,9 @@ void write_compressed_file(const std::string& path, const std::string& header, s
   const std::size_t data_offset = header.size() + 8;
   auto file = std::make_unique_for_overwrite<unsigned char[]>(data_offset + capacity);
   std::memcpy(file.get(), header.data(), header.size());
-  const std::size_t compressed =
-      options.lzf_segment_bytes > 0 && plane_bytes > options.lzf_segment_bytes
-          ? compress_lzf_segments(path, planes.get(), plane_bytes, options.lzf_segment_bytes,
-                                  options.threads, file.get() + data_offset)
-          : compress_lzf(path, planes.get(), plane_bytes, file.get() + data_offset);
-  if (compressed > 0xffffffffu)
-    throw_io_error(path, cat("cannot write binary_compressed: ", compressed,
-                             " compressed bytes exceed the format's 32-bit size field"));
+  const std::size_t compressed = lzf_encode(planes.get(), plane_bytes, options.lzf_segment_bytes,
+                                            options.threads, file.get() + data_offset);
+  if (plane_bytes > 0 && compressed == 0) throw_io_error(path, "LZF compression failed");
   const auto compressed_size = static_cast<std::uint32_t>(compressed);
   const auto uncompressed_size = static_cast<std::uint32_t>(plane_bytes);
   std::memcpy(file.get() + header.size(), &compressed_size, 4);
