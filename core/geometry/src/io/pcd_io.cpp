@@ -716,17 +716,41 @@ void append_binary_body(std::string& out, std::size_t points,
   }
 }
 
-// One field's values of every point, one after another (a binary_compressed plane).
-void gather_plane(const OutputField& field, std::size_t points, unsigned char* plane) {
+// Values of points [first, first + count) of one field, one after another (part of a
+// binary_compressed plane).
+void gather_values(const OutputField& field, std::size_t first, std::size_t count,
+                   unsigned char* out) {
   const std::size_t bytes = 4 * std::size_t{field.count};
-  if (points == 0) return;
+  if (count == 0) return;
   if (field.point_stride == bytes) {  // already contiguous: labels, rgba, scalar fields
-    std::memcpy(plane, field.point(0), points * bytes);
+    std::memcpy(out, field.point(first), count * bytes);
     return;
   }
-  const unsigned char* in = field.point(0);
-  for (std::size_t i = 0; i < points; ++i, in += field.point_stride, plane += bytes)
-    copy_value(plane, in, bytes);
+  const unsigned char* in = field.point(first);
+  for (std::size_t i = 0; i < count; ++i, in += field.point_stride, out += bytes)
+    copy_value(out, in, bytes);
+}
+
+// The planes cut into segments of at most `segment_bytes` (whole values, never across two
+// fields) for CloudWriteOptions: a field whose values are contiguous in the cloud is compressed
+// where it is, the others (x, y, z, normals) are gathered into a thread's scratch first.
+std::vector<LzfSegment> plane_segments(const std::vector<OutputField>& fields, std::size_t points,
+                                       std::size_t segment_bytes) {
+  std::vector<LzfSegment> segments;
+  for (const OutputField& field : fields) {
+    const std::size_t value_bytes = 4 * std::size_t{field.count};
+    const std::size_t per_segment = std::max<std::size_t>(1, segment_bytes / value_bytes);
+    for (std::size_t first = 0; first < points; first += per_segment) {
+      const std::size_t count = std::min(per_segment, points - first);
+      segments.push_back({count * value_bytes, [&field, first, count](unsigned char* scratch) {
+                            if (field.point_stride == 4 * std::size_t{field.count})
+                              return field.point(first);
+                            gather_values(field, first, count, scratch);
+                            return static_cast<const unsigned char*>(scratch);
+                          }});
+    }
+  }
+  return segments;
 }
 
 // A whole binary_compressed file: the header, uint32 compressed and uncompressed sizes, the LZF
@@ -736,24 +760,32 @@ void write_compressed_file(const std::string& path, const std::string& header, s
                            const std::vector<OutputField>& fields,
                            const CloudWriteOptions& options) {
   const std::uint64_t plane_bytes = points * record_bytes_of(fields);
+  const bool segmented = options.lzf_segment_bytes > 0 && plane_bytes > options.lzf_segment_bytes;
+  const std::vector<LzfSegment> segments =
+      segmented ? plane_segments(fields, points, options.lzf_segment_bytes)
+                : std::vector<LzfSegment>{};
   // Both sizes are stored as uint32; leave room for LZF's worst-case expansion.
-  const std::uint64_t capacity = lzf_encode_capacity(plane_bytes, options.lzf_segment_bytes);
+  const std::uint64_t capacity =
+      segmented ? lzf_segments_capacity(segments) : lzf_stream_capacity(plane_bytes);
   if (capacity > 0xffffffffu)
     throw_io_error(path, cat("cannot write binary_compressed: ", plane_bytes,
                              " bytes of point data exceed the format's 32-bit size fields"));
 
-  auto planes = std::make_unique_for_overwrite<unsigned char[]>(plane_bytes);
-  unsigned char* plane = planes.get();
-  for (const OutputField& field : fields) {
-    gather_plane(field, points, plane);
-    plane += points * 4 * std::size_t{field.count};
-  }
-
   const std::size_t data_offset = header.size() + 8;
   auto file = std::make_unique_for_overwrite<unsigned char[]>(data_offset + capacity);
   std::memcpy(file.get(), header.data(), header.size());
-  const std::size_t compressed = lzf_encode(planes.get(), plane_bytes, options.lzf_segment_bytes,
-                                            options.threads, file.get() + data_offset);
+  std::size_t compressed = 0;
+  if (segmented) {
+    compressed = lzf_encode_segments(segments, options.threads, file.get() + data_offset);
+  } else {
+    auto planes = std::make_unique_for_overwrite<unsigned char[]>(plane_bytes);
+    unsigned char* plane = planes.get();
+    for (const OutputField& field : fields) {
+      gather_values(field, 0, points, plane);
+      plane += points * 4 * std::size_t{field.count};
+    }
+    compressed = lzf_encode(planes.get(), plane_bytes, file.get() + data_offset);
+  }
   if (plane_bytes > 0 && compressed == 0) throw_io_error(path, "LZF compression failed");
   const auto compressed_size = static_cast<std::uint32_t>(compressed);
   const auto uncompressed_size = static_cast<std::uint32_t>(plane_bytes);

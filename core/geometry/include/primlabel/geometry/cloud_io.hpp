@@ -38,9 +38,10 @@ enum class PlyEncoding { kAscii, kBinaryLittleEndian };
 using HeaderComments = std::vector<std::string>;
 
 // How DATA binary_compressed is compressed. By default as one LZF stream over every field's
-// plane, as PCL writes it. With lzf_segment_bytes > 0 the planes are cut into segments of that
-// many bytes (the last shorter), each compressed as an LZF stream of its own on `threads` threads
-// (0: OpenMP's default) and concatenated: still one valid LZF stream, which every reader (ours,
+// plane, as PCL writes it. With lzf_segment_bytes > 0 each plane is cut into segments of at most
+// that many bytes (whole values), each compressed as an LZF stream of its own on `threads`
+// threads (0: OpenMP's default), straight from the cloud's arrays where its values lie one after
+// another, and concatenated in order: still one valid LZF stream, which every reader (ours,
 // PCL's) decodes to the same planes; only a segment's first 8 KiB can lose references (LZF
 // reaches no further back), under 1% of a frame's size with 1 MiB segments. The bytes written
 // depend on the segment size, never on the thread count. For writers on a latency path (the
