@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
        add_tabletop_command(app),
        add_primitives_command(app),
        add_can_radii_command(app),
-       add_scaling_command(app)},
+       add_scaling_command(app),
+       add_client_command(app)},
       version, argc, argv);
 }

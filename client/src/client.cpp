@@ -4,11 +4,13 @@
 #include <grpcpp/support/byte_buffer.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <future>
+#include <list>
+#include <optional>
 #include <stdexcept>
 #include <string>
-#include <list>
 #include <thread>
 
 #include "call_control.hpp"
@@ -63,6 +65,19 @@ v1::LabelRequest header_request(const PointCloud& cloud, const LabelOptions& o) 
   }
   header.set_expected_points(cloud.size());
   return request;
+}
+
+// Runs `work` and adds the seconds it took to `total`; returns what `work` returns.
+template <class Work>
+decltype(auto) timed(double& total, Work&& work) {
+  struct AddElapsed {
+    double& total;
+    std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+    ~AddElapsed() {
+      total += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+  } add{total};
+  return work();
 }
 
 void fill_chunk(const PointCloud& cloud, const LabelOptions& o, std::size_t first,
@@ -218,42 +233,53 @@ struct Client::Impl {
     const std::size_t chunk_points = std::max<std::size_t>(1, o.chunk_points);
     LabelResult result;
     result.attempts = with_retries(timeout_of(o), control, [&](grpc::ClientContext& context) {
-      LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities, o.primitives,
-                               o.objects);
+      ClientSeconds seconds;
+      LabelAssembler assembler = timed(seconds.decode, [&] {
+        return LabelAssembler(cloud.size(), o.descriptors, o.probabilities, o.primitives,
+                              o.objects);
+      });
       auto stream = labeler->Label(&context);
       // Writes stop at the first failure: the server has ended the call, Finish says why.
-      bool writing = stream->Write(header_request(cloud, o));
+      const v1::LabelRequest header =
+          timed(seconds.encode, [&] { return header_request(cloud, o); });
+      bool writing = timed(seconds.send, [&] { return stream->Write(header); });
+      v1::LabelRequest request;
       for (std::size_t first = 0; writing && first < cloud.size(); first += chunk_points) {
         const std::size_t count = std::min(chunk_points, cloud.size() - first);
-        v1::LabelRequest request;
-        fill_chunk(cloud, o, first, count, *request.mutable_chunk());
-        writing = stream->Write(request);
+        timed(seconds.encode,
+              [&] { fill_chunk(cloud, o, first, count, *request.mutable_chunk()); });
+        writing = timed(seconds.send, [&] { return stream->Write(request); });
         if (writing && on_progress) on_progress(first + count, cloud.size());
       }
       if (writing) {
         v1::LabelRequest end;
         end.mutable_end();
-        if (stream->Write(end)) stream->WritesDone();
+        timed(seconds.send, [&] {
+          if (stream->Write(end)) stream->WritesDone();
+        });
       }
       std::optional<v1::LabelSummary> summary;
       v1::LabelResponse response;
       try {
-        while (stream->Read(&response)) {
-          if (response.has_chunk()) {
-            assembler.add(response.chunk());
-          } else if (response.has_summary()) {
-            summary = response.summary();
-          }
+        while (timed(seconds.receive, [&] { return stream->Read(&response); })) {
+          timed(seconds.decode, [&] {
+            if (response.has_chunk()) {
+              assembler.add(response.chunk());
+            } else if (response.has_summary()) {
+              summary = std::move(*response.mutable_summary());
+            }
+          });
         }
       } catch (const ProtocolError&) {
         context.TryCancel();
         stream->Finish();
         throw;
       }
-      grpc::Status status = stream->Finish();
+      grpc::Status status = timed(seconds.receive, [&] { return stream->Finish(); });
       if (!status.ok()) return status;
       if (!summary) throw ProtocolError("the server closed the stream without a summary");
-      result = assembler.finish(*summary);
+      result = timed(seconds.decode, [&] { return assembler.finish(*summary); });
+      result.client_seconds = seconds;
       return status;
     });
     return result;
@@ -261,18 +287,27 @@ struct Client::Impl {
 
   LabelResult label_unary(const PointCloud& cloud, const LabelOptions& o, CallControl* control) {
     require_valid_units(o);
+    ClientSeconds seconds;
     v1::LabelCloudRequest request;
-    *request.mutable_header() = header_request(cloud, o).header();
-    fill_chunk(cloud, o, 0, cloud.size(), *request.mutable_points());
+    timed(seconds.encode, [&] {
+      *request.mutable_header() = header_request(cloud, o).header();
+      fill_chunk(cloud, o, 0, cloud.size(), *request.mutable_points());
+    });
     LabelResult result;
     result.attempts = with_retries(timeout_of(o), control, [&](grpc::ClientContext& context) {
       v1::LabelCloudResponse response;
-      grpc::Status status = labeler->LabelCloud(&context, request, &response);
+      seconds.receive = 0;
+      seconds.decode = 0;
+      grpc::Status status =
+          timed(seconds.receive, [&] { return labeler->LabelCloud(&context, request, &response); });
       if (!status.ok()) return status;
-      LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities, o.primitives,
-                               o.objects);
-      assembler.add(response.result());
-      result = assembler.finish(response.summary());
+      result = timed(seconds.decode, [&] {
+        LabelAssembler assembler(cloud.size(), o.descriptors, o.probabilities, o.primitives,
+                                 o.objects);
+        assembler.add(response.result());
+        return assembler.finish(response.summary());
+      });
+      result.client_seconds = seconds;
       return status;
     });
     return result;

@@ -294,6 +294,23 @@ TEST(ClientCalls, StreamsInChunksAndReassemblesLabelsDescriptorsProbabilities) {
   EXPECT_EQ(result.attempts, 1);
 }
 
+// LabelResult::client_seconds: every stage of a streamed call is timed, the wait for the
+// answer in `receive`; a unary call has no separate send.
+TEST(ClientCalls, TheClientsOwnStagesAreTimed) {
+  FakeServer server;
+  Client client(fast_options(server.address()));
+  const auto streamed = client.label(labeled_line(2000));
+  EXPECT_GT(streamed.client_seconds.encode, 0.0);
+  EXPECT_GT(streamed.client_seconds.send, 0.0);
+  EXPECT_GT(streamed.client_seconds.receive, 0.0);
+  EXPECT_GT(streamed.client_seconds.decode, 0.0);
+  const auto unary = client.label_unary(labeled_line(2000));
+  EXPECT_GT(unary.client_seconds.encode, 0.0);
+  EXPECT_EQ(unary.client_seconds.send, 0.0);
+  EXPECT_GT(unary.client_seconds.receive, 0.0);
+  EXPECT_GT(unary.client_seconds.decode, 0.0);
+}
+
 TEST(ClientCalls, ChunksAnsweredInReverseOrderStillLandInInputOrder) {
   FakeServer server;
   server.service.reversed_chunks = true;

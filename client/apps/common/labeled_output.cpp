@@ -107,7 +107,11 @@ std::string classes_json_path(const std::string& cloud_path) {
 void write_labeled_cloud(const std::string& path, const PointCloud& labeled,
                          const LabelResult& result) {
   atomic_write_file(classes_json_path(path), labeled_cloud_classes_json(labeled, result));
-  write_tagged_cloud(path, labeled, labeled_cloud_tags(result));
+  // The labeled frame is on the caller's latency path: its planes are compressed in 1 MiB
+  // segments on every core rather than as one stream (cloud_io.hpp: CloudWriteOptions).
+  CloudWriteOptions options;
+  options.lzf_segment_bytes = kLabeledCloudSegmentBytes;
+  write_tagged_cloud(path, labeled, labeled_cloud_tags(result), options);
 }
 
 std::optional<RenderView> render_view(const std::string& name) {
@@ -133,14 +137,22 @@ void write_label_png(const PointCloud& cloud, const std::string& path,
 
 std::string label_histogram(const PointCloud& labeled, int max) {
   const std::vector<std::uint32_t>& labels = labeled.labels;
-  std::map<std::uint32_t, std::size_t> counts;  // points with a position, by label
+  // Points with a position, by label: taxonomy ids are small, so counted in an array (a map
+  // lookup per point cost milliseconds on a frame); any other id in the map.
+  constexpr std::uint32_t kArrayIds = 256;
+  std::vector<std::size_t> small_ids(kArrayIds, 0);
+  std::map<std::uint32_t, std::size_t> counts;
   std::size_t no_position = 0;
   for (std::size_t i = 0; i < labels.size(); ++i) {
     if (i < labeled.xyz.size() && !is_finite(labeled.xyz[i]))
       ++no_position;
+    else if (labels[i] < kArrayIds)
+      ++small_ids[labels[i]];
     else
       ++counts[labels[i]];
   }
+  for (std::uint32_t id = 0; id < kArrayIds; ++id)
+    if (small_ids[id] > 0) counts[id] = small_ids[id];
   // The same name as the picture's legend (color_by_class).
   constexpr const char* kNoPosition = "no point (NaN)";
   std::vector<std::pair<std::size_t, std::string>> order;

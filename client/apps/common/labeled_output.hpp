@@ -3,6 +3,7 @@
 // plus `fpfh` (or `descriptor`) and `probability` fields when the result carries them, and a PNG
 // picture coloured by class.
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -37,7 +38,9 @@ std::string labeled_cloud_classes_json(const PointCloud& labeled, const LabelRes
 std::string classes_json_path(const std::string& cloud_path);
 
 // Writes the labeled cloud with its header tags, and first the classes JSON beside it, so a cloud
-// that exists always has its JSON.
+// that exists always has its JSON. A PCD's planes are compressed in independent LZF segments of
+// kLabeledCloudSegmentBytes, in parallel (any PCD reader reads them as one stream).
+inline constexpr std::size_t kLabeledCloudSegmentBytes = std::size_t(1) << 20;
 void write_labeled_cloud(const std::string& path, const PointCloud& labeled,
                          const LabelResult& result);
 

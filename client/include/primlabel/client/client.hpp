@@ -88,6 +88,17 @@ struct LabelOptions {
   std::uint64_t stamp_ns = 0;  // nanoseconds since the epoch; 0 = none
 };
 
+// Where one call's time went on the client, in seconds (of the attempt that answered): building
+// the request messages from the cloud, handing them to gRPC (serialising and sending them),
+// waiting for and reading the answer (the server's work is in here), and decoding the answer
+// into LabelResult. A unary call sends and receives in one step, counted as `receive`.
+struct ClientSeconds {
+  double encode = 0;
+  double send = 0;
+  double receive = 0;
+  double decode = 0;
+};
+
 // The labels of one cloud, in the order of its points.
 struct LabelResult {
   std::vector<std::uint32_t> labels;     // taxonomy class id per point, 0 = unknown
@@ -103,6 +114,7 @@ struct LabelResult {
   std::vector<std::uint32_t> object_ids;
   v1::LabelSummary summary;
   int attempts = 1;  // calls made, including retries
+  ClientSeconds client_seconds;
 
   std::size_t size() const { return labels.size(); }
   // LabelOptions::frame_id and stamp_ns as the server echoed them.

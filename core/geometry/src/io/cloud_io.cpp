@@ -32,9 +32,10 @@ PointCloud read_cloud(const std::string& path) {
   return format_of(path) == CloudFormat::kPcd ? read_pcd(path) : read_ply(path);
 }
 
-void write_cloud(const std::string& path, const PointCloud& cloud, const HeaderComments& comments) {
+void write_cloud(const std::string& path, const PointCloud& cloud, const HeaderComments& comments,
+                 const CloudWriteOptions& options) {
   if (format_of(path) == CloudFormat::kPcd)
-    write_pcd(path, cloud, PcdEncoding::kBinaryCompressed, comments);
+    write_pcd(path, cloud, PcdEncoding::kBinaryCompressed, comments, options);
   else
     write_ply(path, cloud, PlyEncoding::kBinaryLittleEndian, comments);
 }

@@ -32,8 +32,9 @@ HeaderComments tag_comments(const CloudTags& tags) {
 
 }  // namespace
 
-void write_tagged_cloud(const std::string& path, const PointCloud& cloud, const CloudTags& tags) {
-  write_cloud(path, cloud, tag_comments(tags));
+void write_tagged_cloud(const std::string& path, const PointCloud& cloud, const CloudTags& tags,
+                        const CloudWriteOptions& options) {
+  write_cloud(path, cloud, tag_comments(tags), options);
 }
 
 CloudTags read_cloud_tags(const std::string& path) {

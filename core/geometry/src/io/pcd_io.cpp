@@ -5,8 +5,6 @@
 // column in one typed loop. Every size taken from the header is checked against the bytes that
 // are really in the file before anything proportional to it is allocated.
 
-#include <lzf.h>
-
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -19,6 +17,8 @@
 #include <vector>
 
 #include "io_util.hpp"
+#include "lzf_decode.hpp"
+#include "lzf_encode.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 
 namespace primlabel::io_detail {
@@ -466,14 +466,13 @@ std::unique_ptr<unsigned char[]> decompress_planes(const std::string& path, cons
                              uncompressed_size, " bytes (corrupt size header)"));
 
   auto planes = std::make_unique_for_overwrite<unsigned char[]>(uncompressed_size);
-  errno = 0;
-  const unsigned int produced =
-      lzf_decompress(bytes + 8, compressed_size, planes.get(), uncompressed_size);
-  if (produced != uncompressed_size) {
-    const std::string reason = produced == 0 && errno == E2BIG ? "output exceeds the declared size"
-                               : produced == 0 && errno == EINVAL
-                                   ? "invalid compressed stream"
-                                   : cat("produced ", produced, " bytes");
+  const LzfDecoded decoded =
+      lzf_decode(bytes + 8, compressed_size, planes.get(), uncompressed_size);
+  if (decoded.status != LzfStatus::kOk || decoded.produced != uncompressed_size) {
+    const std::string reason =
+        decoded.status == LzfStatus::kOutputOverflow ? "output exceeds the declared size"
+        : decoded.status == LzfStatus::kInvalid      ? "invalid compressed stream"
+                                                     : cat("produced ", decoded.produced, " bytes");
     throw_io_error(path, cat("LZF decompression failed: ", reason, " (expected ", uncompressed_size,
                              " bytes)"));
   }
@@ -694,6 +693,15 @@ std::uint64_t record_bytes_of(const std::vector<OutputField>& fields) {
   return bytes;
 }
 
+// Copies one value of `bytes` bytes; the common 4-byte case with a constant size, which the
+// compiler turns into one load and store instead of a memcpy call per value.
+inline void copy_value(unsigned char* out, const unsigned char* in, std::size_t bytes) {
+  if (bytes == 4)
+    std::memcpy(out, in, 4);
+  else
+    std::memcpy(out, in, bytes);
+}
+
 void append_binary_body(std::string& out, std::size_t points,
                         const std::vector<OutputField>& fields) {
   const std::size_t start = out.size();
@@ -702,44 +710,93 @@ void append_binary_body(std::string& out, std::size_t points,
   for (std::size_t i = 0; i < points; ++i) {
     for (const OutputField& field : fields) {
       const std::size_t bytes = 4 * std::size_t{field.count};
-      std::memcpy(record, field.point(i), bytes);
+      copy_value(record, field.point(i), bytes);
       record += bytes;
     }
   }
 }
 
-void append_compressed_body(const std::string& path, std::string& out, std::size_t points,
-                            const std::vector<OutputField>& fields) {
+// Values of points [first, first + count) of one field, one after another (part of a
+// binary_compressed plane).
+void gather_values(const OutputField& field, std::size_t first, std::size_t count,
+                   unsigned char* out) {
+  const std::size_t bytes = 4 * std::size_t{field.count};
+  if (count == 0) return;
+  if (field.point_stride == bytes) {  // already contiguous: labels, rgba, scalar fields
+    std::memcpy(out, field.point(first), count * bytes);
+    return;
+  }
+  const unsigned char* in = field.point(first);
+  for (std::size_t i = 0; i < count; ++i, in += field.point_stride, out += bytes)
+    copy_value(out, in, bytes);
+}
+
+// The planes cut into segments of at most `segment_bytes` (whole values, never across two
+// fields) for CloudWriteOptions: a field whose values are contiguous in the cloud is compressed
+// where it is, the others (x, y, z, normals) are gathered into a thread's scratch first.
+std::vector<LzfSegment> plane_segments(const std::vector<OutputField>& fields, std::size_t points,
+                                       std::size_t segment_bytes) {
+  std::vector<LzfSegment> segments;
+  for (const OutputField& field : fields) {
+    const std::size_t value_bytes = 4 * std::size_t{field.count};
+    const std::size_t per_segment = std::max<std::size_t>(1, segment_bytes / value_bytes);
+    for (std::size_t first = 0; first < points; first += per_segment) {
+      const std::size_t count = std::min(per_segment, points - first);
+      segments.push_back({count * value_bytes, [&field, first, count](unsigned char* scratch) {
+                            if (field.point_stride == 4 * std::size_t{field.count})
+                              return field.point(first);
+                            gather_values(field, first, count, scratch);
+                            return static_cast<const unsigned char*>(scratch);
+                          }});
+    }
+  }
+  return segments;
+}
+
+// A whole binary_compressed file: the header, uint32 compressed and uncompressed sizes, the LZF
+// data of the planes. Built in one buffer that is neither zero-filled nor copied again: the LZF
+// data is compressed straight into place after the header.
+void write_compressed_file(const std::string& path, const std::string& header, std::size_t points,
+                           const std::vector<OutputField>& fields,
+                           const CloudWriteOptions& options) {
   const std::uint64_t plane_bytes = points * record_bytes_of(fields);
+  const bool segmented = options.lzf_segment_bytes > 0 && plane_bytes > options.lzf_segment_bytes;
+  const std::vector<LzfSegment> segments =
+      segmented ? plane_segments(fields, points, options.lzf_segment_bytes)
+                : std::vector<LzfSegment>{};
   // Both sizes are stored as uint32; leave room for LZF's worst-case expansion.
-  const std::uint64_t capacity = plane_bytes + plane_bytes / 16 + 64;
+  const std::uint64_t capacity =
+      segmented ? lzf_segments_capacity(segments) : lzf_stream_capacity(plane_bytes);
   if (capacity > 0xffffffffu)
     throw_io_error(path, cat("cannot write binary_compressed: ", plane_bytes,
                              " bytes of point data exceed the format's 32-bit size fields"));
 
-  std::vector<unsigned char> planes(plane_bytes);
-  unsigned char* plane = planes.data();
-  for (const OutputField& field : fields) {
-    const std::size_t bytes = 4 * std::size_t{field.count};
-    for (std::size_t i = 0; i < points; ++i, plane += bytes)
-      std::memcpy(plane, field.point(i), bytes);
+  const std::size_t data_offset = header.size() + 8;
+  auto file = std::make_unique_for_overwrite<unsigned char[]>(data_offset + capacity);
+  std::memcpy(file.get(), header.data(), header.size());
+  std::size_t compressed = 0;
+  if (segmented) {
+    compressed = lzf_encode_segments(segments, options.threads, file.get() + data_offset);
+  } else {
+    auto planes = std::make_unique_for_overwrite<unsigned char[]>(plane_bytes);
+    unsigned char* plane = planes.get();
+    for (const OutputField& field : fields) {
+      gather_values(field, 0, points, plane);
+      plane += points * 4 * std::size_t{field.count};
+    }
+    compressed = lzf_encode(planes.get(), plane_bytes, file.get() + data_offset);
   }
-
-  std::uint32_t compressed_size = 0;
-  std::vector<unsigned char> compressed(capacity);
-  if (plane_bytes > 0) {
-    compressed_size = lzf_compress(planes.data(), static_cast<unsigned>(plane_bytes),
-                                   compressed.data(), static_cast<unsigned>(capacity));
-    if (compressed_size == 0) throw_io_error(path, "LZF compression failed");
-  }
+  if (plane_bytes > 0 && compressed == 0) throw_io_error(path, "LZF compression failed");
+  const auto compressed_size = static_cast<std::uint32_t>(compressed);
   const auto uncompressed_size = static_cast<std::uint32_t>(plane_bytes);
-  out.append(reinterpret_cast<const char*>(&compressed_size), 4);
-  out.append(reinterpret_cast<const char*>(&uncompressed_size), 4);
-  out.append(reinterpret_cast<const char*>(compressed.data()), compressed_size);
+  std::memcpy(file.get() + header.size(), &compressed_size, 4);
+  std::memcpy(file.get() + header.size() + 4, &uncompressed_size, 4);
+  write_file_atomically(path, std::string_view(reinterpret_cast<const char*>(file.get()),
+                                               data_offset + compressed_size));
 }
 
 void write_pcd_file(const std::string& path, const PointCloud& cloud, PcdEncoding encoding,
-                    const HeaderComments& comments) {
+                    const HeaderComments& comments, const CloudWriteOptions& options) {
   const Shape shape = validate_cloud_for_writing(path, cloud);
   const std::vector<OutputField> fields = output_fields(cloud);
   std::vector<std::string> names;
@@ -755,8 +812,8 @@ void write_pcd_file(const std::string& path, const PointCloud& cloud, PcdEncodin
       append_binary_body(out, cloud.size(), fields);
       break;
     case PcdEncoding::kBinaryCompressed:
-      append_compressed_body(path, out, cloud.size(), fields);
-      break;
+      write_compressed_file(path, out, cloud.size(), fields, options);
+      return;
   }
   write_file_atomically(path, out);
 }
@@ -769,8 +826,8 @@ namespace primlabel {
 PointCloud read_pcd(const std::string& path) { return io_detail::read_pcd_file(path); }
 
 void write_pcd(const std::string& path, const PointCloud& cloud, PcdEncoding encoding,
-               const HeaderComments& comments) {
-  io_detail::write_pcd_file(path, cloud, encoding, comments);
+               const HeaderComments& comments, const CloudWriteOptions& options) {
+  io_detail::write_pcd_file(path, cloud, encoding, comments, options);
 }
 
 }  // namespace primlabel

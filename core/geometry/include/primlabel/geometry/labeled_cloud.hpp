@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 #include "primlabel/geometry/taxonomy.hpp"
 
@@ -17,7 +18,8 @@ using CloudTags = std::map<std::string, std::string>;
 
 // Writes the cloud (format by extension, as write_cloud) with `tags` in its header. Keys are
 // single words; values single lines.
-void write_tagged_cloud(const std::string& path, const PointCloud& cloud, const CloudTags& tags);
+void write_tagged_cloud(const std::string& path, const PointCloud& cloud, const CloudTags& tags,
+                        const CloudWriteOptions& options = {});
 
 // The tags in a file's header (empty when it has none). Throws IoError if it cannot be read.
 CloudTags read_cloud_tags(const std::string& path);
