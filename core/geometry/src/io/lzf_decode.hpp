@@ -1,8 +1,8 @@
 #pragma once
-// LZF decompression for PCD binary_compressed data, the format liblzf's lzf_decompress reads
-// (PCL writes it with lzf_compress). The stream decodes to the same bytes as with liblzf; it
-// copies literal runs and back-references in 8- to 32-byte blocks where liblzf copies byte by
-// byte, which matters for a 6 MB Kinect frame read on every labeling call.
+// LZF decompression for PCD binary_compressed data (PCL writes it with liblzf's lzf_compress):
+// liblzf's lzf_decompress, with its errno outcomes as a status. A hand-written decoder with block
+// copies was measured at 5.5 -> 3.1 ms a Kinect frame (2026-12-07) and not kept: the Debian
+// library is the one to trust with hostile input.
 
 #include <cstddef>
 
