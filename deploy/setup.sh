@@ -46,7 +46,8 @@ PACKAGES=(
 # Only the tests need these: the deployment checks (YAML, nginx -t, promtool, the local
 # three-replica proof), TLS certificates made on the fly, clang with libFuzzer for the fuzz
 # targets (tests/fuzz), the Python client's runtime and pytest (client/python; its stubs come
-# from protoc and protobuf-compiler-grpc's grpc_python_plugin, above) and what pip needs to
+# from protoc and protobuf-compiler-grpc's grpc_python_plugin, above, its PCD/PLY module from
+# pybind11 and the Python headers) and what pip needs to
 # install it offline into a venv (setuptools, wheel, pip, venv), Open3D for the
 # interoperability check (tests/interop), CGAL for the Efficient RANSAC peer's test
 # (tests/test_cgal_peer), ROS 1 (roscpp, sensor_msgs, std_msgs and rosmaster) for the ROS
@@ -54,6 +55,7 @@ PACKAGES=(
 # idlc IDL compiler) for the ROS 2 node client/ros2 and its test ros2.LabelsPointCloud2.
 TEST_PACKAGES=(python3 python3-yaml nginx prometheus openssl clang-14 libclang-rt-14-dev
   python3-grpcio python3-numpy python3-protobuf python3-pytest python3-open3d libcgal-dev
+  pybind11-dev python3-dev
   python3-setuptools python3-wheel python3-pip python3-venv
   libroscpp-dev libsensor-msgs-dev libstd-msgs-dev python3-rosmaster
   cyclonedds-dev cyclonedds-tools)

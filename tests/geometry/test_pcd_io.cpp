@@ -713,6 +713,8 @@ std::vector<MalformedFile> malformed_cases() {
        "header line 9: data value '1' before any DATA line (missing DATA line?)"},
       {"UnknownKeyword", v7 + "FIELDS x y z\nCOLOUR red\nDATA ascii\n",
        "header line 4: unknown header keyword 'COLOUR'"},
+      {"PlyFile", "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n",
+       "header line 1: a PLY file, not a PCD file (read it with the PLY reader)"},
       {"UnsupportedVersion", "VERSION 2.0\nFIELDS x y z\nPOINTS 0\nDATA ascii\n",
        "header line 1: unsupported VERSION '2.0'"},
       {"DuplicateWidth", v7 + "FIELDS x y z\nWIDTH 1\nWIDTH 1\nPOINTS 1\nDATA ascii\n1 2 3\n",

@@ -144,17 +144,19 @@ TEST(PlyWrite, LabelsBeyondIntRangeStayUintAndEveryLabelRoundTrips) {
   test::TempDir dir;
   PointCloud cloud;
   cloud.resize_unorganized(3);
-  for (const std::uint32_t big : {0x7fffffffu, 0x80000000u}) {
-    cloud.labels = {0u, 7u, big};
-    const std::string path = dir.file("labels.ply");
-    write_ply(path, cloud, PlyEncoding::kBinaryLittleEndian);
-    std::ifstream in(path, std::ios::binary);
-    std::string header, line;
-    while (std::getline(in, line) && line != "end_header") header += line + "\n";
-    const char* expected = big <= 0x7fffffffu ? "property int label\n" : "property uint label\n";
-    EXPECT_NE(header.find(expected), std::string::npos) << header;
-    EXPECT_EQ(read_ply(path).labels, cloud.labels);
-  }
+  // Ascii too: an "int" label was once written as the float of its bits ("1e-45").
+  for (const auto encoding : {PlyEncoding::kBinaryLittleEndian, PlyEncoding::kAscii})
+    for (const std::uint32_t big : {0x7fffffffu, 0x80000000u}) {
+      cloud.labels = {0u, 7u, big};
+      const std::string path = dir.file("labels.ply");
+      write_ply(path, cloud, encoding);
+      std::ifstream in(path, std::ios::binary);
+      std::string header, line;
+      while (std::getline(in, line) && line != "end_header") header += line + "\n";
+      const char* expected = big <= 0x7fffffffu ? "property int label\n" : "property uint label\n";
+      EXPECT_NE(header.find(expected), std::string::npos) << header;
+      EXPECT_EQ(read_ply(path).labels, cloud.labels);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

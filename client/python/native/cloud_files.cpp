@@ -56,8 +56,8 @@ py::dict cloud_to_python(const PointCloud& cloud) {
       cloud.has_rgba() ? py::object(to_array(cloud.rgba.data(), n, 1, false)) : py::none();
   py::list fields;
   for (const auto& field : cloud.fields)
-    fields.append(py::make_tuple(
-        field.name, to_array(field.values.data(), n, field.count, field.count != 1)));
+    fields.append(py::make_tuple(field.name,
+                                 to_array(field.values.data(), n, field.count, field.count != 1)));
   out["fields"] = fields;
   out["width"] = cloud.width;
   out["height"] = cloud.height;
@@ -95,8 +95,8 @@ std::vector<T> values_from(const std::string& path, const std::string& what, con
                            std::size_t n) {
   const bool column = array.ndim() == 2 && array.shape(1) == 1;
   if ((array.ndim() != 1 && !column) || static_cast<std::size_t>(array.shape(0)) != n)
-    refuse(path, what + " has shape " + shape_text(array) + ", expected (" + std::to_string(n) +
-                     ",)");
+    refuse(path,
+           what + " has shape " + shape_text(array) + ", expected (" + std::to_string(n) + ",)");
   return std::vector<T>(array.data(), array.data() + n);
 }
 
@@ -135,9 +135,9 @@ PointCloud cloud_from_python(const std::string& path, const FloatArray& xyz,
   cloud.width = static_cast<std::uint32_t>(row);
   cloud.height = static_cast<std::uint32_t>(height);
   if (viewpoint.size() != 7) refuse(path, "viewpoint needs 7 values (tx ty tz qw qx qy qz)");
-  cloud.viewpoint.origin = primlabel::Vec3f(static_cast<float>(viewpoint[0]),
-                                            static_cast<float>(viewpoint[1]),
-                                            static_cast<float>(viewpoint[2]));
+  cloud.viewpoint.origin =
+      primlabel::Vec3f(static_cast<float>(viewpoint[0]), static_cast<float>(viewpoint[1]),
+                       static_cast<float>(viewpoint[2]));
   cloud.viewpoint.orientation =
       Eigen::Quaternionf(static_cast<float>(viewpoint[3]), static_cast<float>(viewpoint[4]),
                          static_cast<float>(viewpoint[5]), static_cast<float>(viewpoint[6]));
@@ -174,10 +174,12 @@ PYBIND11_MODULE(_cloud_files, module) {
   // A ValueError, as the Python readers' PcdError and PlyError, whose messages start with the path.
   py::register_exception<IoError>(module, "IoError", PyExc_ValueError);
 
-  module.def("read_pcd", [](const std::string& path) { return read_with(primlabel::read_pcd, path); },
-             py::arg("path"));
-  module.def("read_ply", [](const std::string& path) { return read_with(primlabel::read_ply, path); },
-             py::arg("path"));
+  module.def(
+      "read_pcd", [](const std::string& path) { return read_with(primlabel::read_pcd, path); },
+      py::arg("path"));
+  module.def(
+      "read_ply", [](const std::string& path) { return read_with(primlabel::read_ply, path); },
+      py::arg("path"));
   module.def(
       "write_pcd",
       [](const std::string& path, const FloatArray& xyz, const std::optional<FloatArray>& normals,
@@ -192,9 +194,9 @@ PYBIND11_MODULE(_cloud_files, module) {
         py::gil_scoped_release unlocked;
         primlabel::write_pcd(path, cloud, kind);
       },
-      py::arg("path"), py::arg("xyz"), py::arg("normals"), py::arg("curvature"),
-      py::arg("labels"), py::arg("rgba"), py::arg("fields"), py::arg("width"), py::arg("height"),
-      py::arg("viewpoint"), py::arg("encoding"));
+      py::arg("path"), py::arg("xyz"), py::arg("normals"), py::arg("curvature"), py::arg("labels"),
+      py::arg("rgba"), py::arg("fields"), py::arg("width"), py::arg("height"), py::arg("viewpoint"),
+      py::arg("encoding"));
   module.def(
       "write_ply",
       [](const std::string& path, const FloatArray& xyz, const std::optional<FloatArray>& normals,
@@ -209,7 +211,7 @@ PYBIND11_MODULE(_cloud_files, module) {
         py::gil_scoped_release unlocked;
         primlabel::write_ply(path, cloud, kind);
       },
-      py::arg("path"), py::arg("xyz"), py::arg("normals"), py::arg("curvature"),
-      py::arg("labels"), py::arg("rgba"), py::arg("fields"), py::arg("width"), py::arg("height"),
-      py::arg("viewpoint"), py::arg("encoding"));
+      py::arg("path"), py::arg("xyz"), py::arg("normals"), py::arg("curvature"), py::arg("labels"),
+      py::arg("rgba"), py::arg("fields"), py::arg("width"), py::arg("height"), py::arg("viewpoint"),
+      py::arg("encoding"));
 }

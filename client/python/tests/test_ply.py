@@ -67,15 +67,35 @@ def test_every_encoding_reads_the_same_cloud(tmp_path, encoding):
     assert sorted(cloud.fields) == ["fpfh", "height", "intensity", "prob_plane"]
     np.testing.assert_array_equal(cloud.fields["fpfh"],
                                   np.arange(5)[:, None] + np.array([0, 0.5, 0.25]))
-    assert cloud.fields["intensity"].dtype == np.uint16
+    assert cloud.fields["intensity"].dtype == np.float32  # the C++ reader's FloatField
     np.testing.assert_array_equal(cloud.fields["intensity"], np.arange(5) * 300)
-    assert cloud.fields["height"].dtype == np.float64
-    np.testing.assert_allclose(cloud.fields["height"], np.arange(5) / 3)
+    np.testing.assert_array_equal(cloud.fields["height"], np.float32(np.arange(5) / 3))
     assert cloud.viewpoint == primlabel.pcd.PointCloud(xyz=xyz).viewpoint  # PLY has none
     # By the extension, in any case.
     upper = tmp_path / "CLOUD.PLY"
     upper.write_bytes(path.read_bytes())
     np.testing.assert_array_equal(primlabel.read(str(upper)).label, cloud.label)
+
+
+@pytest.mark.parametrize("encoding", ["ascii", "binary_little_endian"])
+def test_written_ply_reads_back(tmp_path, encoding):
+    rng = np.random.default_rng(6)
+    cloud = primlabel.pcd.PointCloud(
+        xyz=rng.normal(size=(4, 3)).astype(np.float32), label=np.arange(4, dtype=np.uint32),
+        rgb=np.array([0xFF102030, 0xFF000000, 0x80FFFFFF, 0xFFABCDEF], np.uint32),
+        fields={"fpfh": rng.uniform(size=(4, 3)).astype(np.float32),
+                "prob_plane": np.linspace(0, 1, 4, dtype=np.float32)})
+    path = tmp_path / "written.ply"
+    primlabel.ply.write(path, cloud, encoding=encoding)
+    assert f"format {encoding} 1.0".encode() in path.read_bytes()[:200]
+    back = primlabel.ply.read(path)
+    for name in ("xyz", "label", "rgb"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(cloud, name), err_msg=name)
+    assert back.fields.keys() == cloud.fields.keys()
+    for name, values in cloud.fields.items():
+        np.testing.assert_array_equal(back.fields[name], values, err_msg=name)
+    with pytest.raises(primlabel.ply.PlyError, match="encoding must be"):
+        primlabel.ply.write(path, cloud, encoding="binary_big_endian")
 
 
 def test_elements_before_the_vertex_are_skipped(tmp_path):
@@ -102,7 +122,7 @@ def test_elements_before_the_vertex_are_skipped(tmp_path):
      b"end_header\n1 2\n", "lacks property x, y or z"),
     (b"ply\nformat ascii 1.0\nelement face 0\nend_header\n", "no 'vertex' element"),
     (b"ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
-     b"property float z\nend_header\n1 2 3\n", "ascii data ends after 0 of 2 'vertex' records"),
+     b"property float z\nend_header\n1 2 3\n", "ascii data ends after 1 of 2 'vertex' records"),
     (b"ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty float x\n"
      b"property float y\nproperty float z\nend_header\n" + b"\0" * 12,
      "truncated binary data: expected 12000000000 bytes"),
@@ -110,7 +130,7 @@ def test_elements_before_the_vertex_are_skipped(tmp_path):
      b"property float z\nproperty float label\nend_header\n1 2 3 0.5\n", "is not a label"),
     (b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
      b"property float z\nproperty uchar u\nend_header\n1 2 3 256\n",
-     "value of vertex property 'u' is not a valid u1"),
+     "vertex 0: property 'u': '256' is not a valid uchar"),
     (b"ply\nformat ascii 1.0\nproperty float x\n", "property before any element"),
     (b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\n", "missing end_header"),
 ])
@@ -127,7 +147,7 @@ def test_pcd_read_and_the_generic_read_name_the_format(tmp_path):
     _, columns = example_columns(2)
     ply = tmp_path / "cloud.ply"
     ply.write_bytes(ply_bytes("ascii", columns[:3]))
-    with pytest.raises(primlabel.pcd.PcdError, match="a PLY file, not a PCD file.*ply.read"):
+    with pytest.raises(primlabel.pcd.PcdError, match="a PLY file, not a PCD file"):
         primlabel.pcd.read(ply)
     for name in ("cloud.xyz", "cloud"):
         (tmp_path / name).write_bytes(b"1 2 3\n")

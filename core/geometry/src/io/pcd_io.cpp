@@ -150,6 +150,9 @@ class PcdHeaderParser {
       } else if (looks_numeric(keyword)) {
         fail_at(line_number, cat("data value ", in_quotes(keyword),
                                  " before any DATA line (missing DATA line?)"));
+      } else if (line_number == 1 && keyword == "ply" && values.empty()) {
+        // The one mistake worth naming: a PLY given to the PCD reader (a wrong extension).
+        fail_at(line_number, "a PLY file, not a PCD file (read it with the PLY reader)");
       } else {
         fail_at(line_number, cat("unknown header keyword ", in_quotes(keyword)));
       }

@@ -687,7 +687,7 @@ void write_ply_file(const std::string& path, const PointCloud& cloud, PlyEncodin
         if (p > 0) out += ' ';
         if (property.size == 1)
           append_integer(out, unsigned{*property.point(i)});
-        else if (property.type[0] == 'u')
+        else if (property.type[0] == 'u' || property.type[0] == 'i')  // labels: uint or int
           append_integer(out, load_scalar<std::uint32_t>(property.point(i)));
         else
           append_floating(out, load_scalar<float>(property.point(i)));
