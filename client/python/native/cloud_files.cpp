@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "primlabel/geometry/cloud_io.hpp"
+#include "primlabel/geometry/labeled_cloud.hpp"
 #include "primlabel/geometry/point_cloud.hpp"
 
 namespace py = pybind11;
@@ -179,6 +180,14 @@ PYBIND11_MODULE(_cloud_files, module) {
       py::arg("path"));
   module.def(
       "read_ply", [](const std::string& path) { return read_with(primlabel::read_ply, path); },
+      py::arg("path"));
+  // The "primlabel <key> <value>" header tags (the class list of a labeled file), a dict.
+  module.def(
+      "read_tags",
+      [](const std::string& path) {
+        py::gil_scoped_release unlocked;
+        return primlabel::read_cloud_tags(path);
+      },
       py::arg("path"));
   module.def(
       "write_pcd",

@@ -8,28 +8,7 @@ from __future__ import annotations
 import json
 import os
 
-_HEADER_LINES = 10000  # as the C++ reader: a header is never longer
-
-
-def header_tags(raw: bytes, ply: bool) -> dict:
-    """The primlabel tags of a PCD (ply=False) or PLY header, name -> value text."""
-    prefix = b"comment primlabel " if ply else b"# primlabel "
-    end = b"end_header" if ply else b"DATA"
-    tags = {}
-    pos = 0
-    for _ in range(_HEADER_LINES):
-        if pos >= len(raw):
-            break
-        stop = raw.find(b"\n", pos)
-        stop = len(raw) if stop < 0 else stop
-        line = raw[pos:stop].rstrip(b"\r")
-        pos = stop + 1
-        if line.startswith(prefix):
-            name, _, value = line[len(prefix):].decode("utf-8", "replace").partition(" ")
-            tags[name] = value
-        if line.startswith(end):
-            break
-    return tags
+from . import _cloud_files
 
 
 def _classes_tag(value: str) -> dict | None:
@@ -54,15 +33,14 @@ def _classes_json(path: str) -> dict | None:
 
 def classes(path, raw: bytes | None = None, ply: bool = False) -> dict | None:
     """label id -> class name for a labeled file (its header's tag first, then the JSON beside
-    it), or None for a file that says nothing about its labels. `raw`: the file's bytes, when
-    already read."""
+    it), or None for a file that says nothing about its labels. The tags are read by the C++
+    reader (read_cloud_tags), which tells a PLY by its extension: `raw` and `ply` are accepted
+    as before and no longer needed."""
+    del raw, ply
     path = os.fspath(path)
-    if raw is None:
-        try:
-            with open(path, "rb") as f:
-                raw = f.read(1 << 20)
-        except OSError:
-            return None
-    tag = header_tags(raw, ply).get("classes")
+    try:
+        tag = _cloud_files.read_tags(path).get("classes")
+    except _cloud_files.IoError:
+        return None
     found = _classes_tag(tag) if tag is not None else None
     return found if found is not None else _classes_json(path)
