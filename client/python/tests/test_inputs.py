@@ -62,7 +62,7 @@ def test_a_ply_path_is_read_and_sent(client, cloud, tmp_path, from_the_origin):
 
 
 def test_a_bad_path_is_refused_before_any_call(client, tmp_path):
-    for path, message in ((tmp_path / "missing.pcd", "cannot read"),
+    for path, message in ((tmp_path / "missing.pcd", "cannot open"),
                           (str(tmp_path / "scan.xyz"), "unknown point cloud format")):
         with pytest.raises(primlabel.InvalidInput, match=message):
             client.label(path)
