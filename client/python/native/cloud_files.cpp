@@ -168,6 +168,31 @@ py::dict read_with(Reader reader, const std::string& path) {
   return cloud_to_python(cloud);
 }
 
+// write_pcd and write_ply: the cloud as keyword arguments, the encoding by name; they differ only
+// in the encodings they know and the writer they call.
+template <typename Encoding, typename Write>
+void def_writer(py::module_& module, const char* name,
+                Encoding (*encoding_named)(const std::string&, const std::string&), Write write) {
+  module.def(
+      name,
+      [encoding_named, write](
+          const std::string& path, const FloatArray& xyz, const std::optional<FloatArray>& normals,
+          const std::optional<FloatArray>& curvature, const std::optional<UintArray>& labels,
+          const std::optional<UintArray>& rgba,
+          const std::vector<std::pair<std::string, FloatArray>>& fields,
+          std::optional<std::uint64_t> width, std::uint64_t height,
+          const std::vector<double>& viewpoint, const std::string& encoding) {
+        const Encoding kind = encoding_named(path, encoding);
+        const PointCloud cloud = cloud_from_python(path, xyz, normals, curvature, labels, rgba,
+                                                   fields, width, height, viewpoint);
+        py::gil_scoped_release unlocked;  // writing and compressing a frame takes milliseconds
+        write(path, cloud, kind);
+      },
+      py::arg("path"), py::arg("xyz"), py::arg("normals"), py::arg("curvature"), py::arg("labels"),
+      py::arg("rgba"), py::arg("fields"), py::arg("width"), py::arg("height"), py::arg("viewpoint"),
+      py::arg("encoding"));
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_cloud_files, module) {
@@ -189,38 +214,12 @@ PYBIND11_MODULE(_cloud_files, module) {
         return primlabel::read_cloud_tags(path);
       },
       py::arg("path"));
-  module.def(
-      "write_pcd",
-      [](const std::string& path, const FloatArray& xyz, const std::optional<FloatArray>& normals,
-         const std::optional<FloatArray>& curvature, const std::optional<UintArray>& labels,
-         const std::optional<UintArray>& rgba,
-         const std::vector<std::pair<std::string, FloatArray>>& fields,
-         std::optional<std::uint64_t> width, std::uint64_t height,
-         const std::vector<double>& viewpoint, const std::string& encoding) {
-        const auto kind = pcd_encoding(path, encoding);
-        const PointCloud cloud = cloud_from_python(path, xyz, normals, curvature, labels, rgba,
-                                                   fields, width, height, viewpoint);
-        py::gil_scoped_release unlocked;
-        primlabel::write_pcd(path, cloud, kind);
-      },
-      py::arg("path"), py::arg("xyz"), py::arg("normals"), py::arg("curvature"), py::arg("labels"),
-      py::arg("rgba"), py::arg("fields"), py::arg("width"), py::arg("height"), py::arg("viewpoint"),
-      py::arg("encoding"));
-  module.def(
-      "write_ply",
-      [](const std::string& path, const FloatArray& xyz, const std::optional<FloatArray>& normals,
-         const std::optional<FloatArray>& curvature, const std::optional<UintArray>& labels,
-         const std::optional<UintArray>& rgba,
-         const std::vector<std::pair<std::string, FloatArray>>& fields,
-         std::optional<std::uint64_t> width, std::uint64_t height,
-         const std::vector<double>& viewpoint, const std::string& encoding) {
-        const auto kind = ply_encoding(path, encoding);
-        const PointCloud cloud = cloud_from_python(path, xyz, normals, curvature, labels, rgba,
-                                                   fields, width, height, viewpoint);
-        py::gil_scoped_release unlocked;
-        primlabel::write_ply(path, cloud, kind);
-      },
-      py::arg("path"), py::arg("xyz"), py::arg("normals"), py::arg("curvature"), py::arg("labels"),
-      py::arg("rgba"), py::arg("fields"), py::arg("width"), py::arg("height"), py::arg("viewpoint"),
-      py::arg("encoding"));
+  def_writer(module, "write_pcd", pcd_encoding,
+             [](const std::string& path, const PointCloud& cloud, primlabel::PcdEncoding kind) {
+               primlabel::write_pcd(path, cloud, kind);
+             });
+  def_writer(module, "write_ply", ply_encoding,
+             [](const std::string& path, const PointCloud& cloud, primlabel::PlyEncoding kind) {
+               primlabel::write_ply(path, cloud, kind);
+             });
 }
