@@ -28,6 +28,7 @@
 
 #include "bench_commands.hpp"
 #include "common/labeled_output.hpp"
+#include "loopback_server_config.hpp"
 #include "primlabel/client/client.hpp"
 #include "primlabel/geometry/cloud_io.hpp"
 #include "primlabel/geometry/json_text.hpp"
@@ -151,12 +152,8 @@ int run_client_bench(const Arguments& args) {
   else
     fs::copy_file(args.model, model_dir / "model.plm");
 
-  ops::ServerConfig config;
-  config.models_dir = (scratch / "models").string();
-  config.listen = "127.0.0.1:0";
+  ops::ServerConfig config = test::loopback_server_config((scratch / "models").string());
   config.metrics_listen = "";
-  config.reload_seconds = 0;
-  config.workers = 1;
   config.threads_per_job = args.threads;
   rpc::LabelServer server(config);
   client::ClientOptions client_options;

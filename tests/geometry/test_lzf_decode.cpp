@@ -1,7 +1,7 @@
-// The LZF decoder of PCD binary_compressed (core/geometry/src/io/lzf_decode.hpp, liblzf) against a
-// byte-by-byte reference decoder of the format: back-references of every short period (its
-// block copies' special case), near the end of the output (where blocks may not run past it)
-// and far from it, and the three ways a stream can be wrong.
+// The LZF decoder of PCD binary_compressed (core/geometry/src/io/lzf_decode.hpp, over liblzf)
+// against a byte-by-byte reference decoder of the format: back-references of every short period,
+// near the end of the output and far from it, and the three ways a stream can be wrong (each
+// with the status the PCD reader turns into its message).
 
 #include <gtest/gtest.h>
 

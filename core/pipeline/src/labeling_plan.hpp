@@ -3,8 +3,8 @@
 // the table-top stage on the input (only the table and its objects are labeled), voxel
 // downsampling (a voxel's centroid stands for its members) and exact duplicates (duplicates.hpp:
 // one representative per position, the lowest index), in that order, each on what the one before
-// kept. The described
-// cloud holds one point per slot; every input point has a slot, or none and stays unknown.
+// kept. The described cloud holds one point per slot; every input point has a slot, or none and
+// stays unknown.
 
 #include <cstdint>
 #include <optional>
