@@ -32,12 +32,15 @@ TabletopOptions given_up(bool creases = true) {
 }
 
 // Euclidean clustering joins the touching objects into one cluster; the crease cut separates
-// them, each object then matching one cluster closely.
+// them, each object then matching one cluster closely. (The shape split, which also cuts a can
+// from a box, is off in both runs.)
 void expect_split(const PointCloud& cloud, std::size_t objects) {
-  const TabletopResult joined = segment_tabletop(cloud, given_up(false), RunContext{2});
+  TabletopOptions clusters_only = given_up(false), creases_only = given_up();
+  clusters_only.shapes.enabled = creases_only.shapes.enabled = false;
+  const TabletopResult joined = segment_tabletop(cloud, clusters_only, RunContext{2});
   ASSERT_TRUE(joined.ok()) << joined.message;
   EXPECT_LT(joined.clusters.size(), objects) << "the scene does not test a crease";
-  const TabletopResult split = segment_tabletop(cloud, given_up(), RunContext{2});
+  const TabletopResult split = segment_tabletop(cloud, creases_only, RunContext{2});
   ASSERT_TRUE(split.ok()) << split.message;
   EXPECT_EQ(split.clusters.size(), objects);
   const SegmentationScores scores = evaluate_segmentation(cloud, split);

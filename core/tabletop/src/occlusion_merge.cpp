@@ -147,7 +147,8 @@ float top_height(const std::vector<std::uint32_t>& cluster, const std::vector<fl
 
 std::vector<std::vector<std::uint32_t>> merge_occluded(
     const PointCloud& cloud, const std::vector<float>& height, const PlaneGrid& table,
-    std::vector<std::vector<std::uint32_t>> clusters, const OcclusionMergeOptions& options) {
+    std::vector<std::vector<std::uint32_t>> clusters, const OcclusionMergeOptions& options,
+    const KeptApart& kept_apart) {
   options.validate();
   const auto by_size = [](const auto& a, const auto& b) {
     return a.size() != b.size() ? a.size() > b.size() : a.front() < b.front();
@@ -190,10 +191,21 @@ std::vector<std::vector<std::uint32_t>> merge_occluded(
     while (root[k] != k) k = root[k] = root[root[k]];
     return k;
   };
+  // Every cluster lies in one piece of whatever a refinement cut apart, so its first point tells.
+  const auto held_apart = [&](std::uint32_t a, std::uint32_t b) {
+    if (kept_apart.piece.empty()) return false;
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = 0; j < n; ++j)
+        if (find(std::uint32_t(i)) == a && find(std::uint32_t(j)) == b &&
+            kept_apart.apart(clusters[i].front(), clusters[j].front()))
+          return true;
+    return false;
+  };
   for (const auto& [pair, link] : links) {
     const std::uint32_t a = find(pair.first), b = find(pair.second);
     if (a == b || std::abs(top[a] - top[b]) > options.top_tolerance || link.gap > options.max_gap)
       continue;
+    if (held_apart(a, b)) continue;
     // Without a separate occluder, neighbouring objects look the same: ask for one material.
     const float colour_difference = (colour[pair.first] - colour[pair.second]).norm();
     if (link.across_occluder < options.min_scanlines &&

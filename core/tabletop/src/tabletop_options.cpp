@@ -39,6 +39,7 @@ void TabletopOptions::validate() const {
   support.validate();
   table_noise.validate();
   creases.validate();
+  shapes.validate();
   split.validate();
   merge.validate();
 }

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/tabletop/kept_apart.hpp"
 #include "primlabel/tabletop/plane_grid.hpp"
 
 namespace primlabel::tabletop {
@@ -54,8 +55,10 @@ struct OcclusionMergeOptions {
 // ordered by size (largest first, ties by first index). Unorganised clouds are returned as they
 // are. `height` holds the signed distance above the table of every point the clusters name;
 // `table` bins the points of the table's band (the table and what touches it) in the table plane.
+// Clusters holding points `kept_apart` says are other objects are never joined.
 std::vector<std::vector<std::uint32_t>> merge_occluded(
     const PointCloud& cloud, const std::vector<float>& height, const PlaneGrid& table,
-    std::vector<std::vector<std::uint32_t>> clusters, const OcclusionMergeOptions& options);
+    std::vector<std::vector<std::uint32_t>> clusters, const OcclusionMergeOptions& options,
+    const KeptApart& kept_apart = {});
 
 }  // namespace primlabel::tabletop

@@ -25,6 +25,7 @@
 #include "primlabel/tabletop/euclidean_clusters.hpp"
 #include "primlabel/tabletop/occlusion_merge.hpp"
 #include "primlabel/tabletop/plane_fit.hpp"
+#include "primlabel/tabletop/shape_split.hpp"
 #include "primlabel/tabletop/stacked_split.hpp"
 #include "primlabel/tabletop/support_surface.hpp"
 #include "primlabel/tabletop/table_noise.hpp"
@@ -70,6 +71,7 @@ struct TabletopOptions {
   SupportOptions support;         // the table among several horizontal surfaces
   TableNoiseOptions table_noise;  // flat clusters within the depth noise of the table: table
   ConvexitySplitOptions creases;  // touching objects, cut at concave creases
+  ShapeSplitOptions shapes;       // touching objects, cut where their fitted shapes meet
   StackSplitOptions split;        // objects standing on objects
   OcclusionMergeOptions merge;    // parts of one object cut apart by occlusion (organised clouds)
 

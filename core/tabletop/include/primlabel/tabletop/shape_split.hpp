@@ -1,0 +1,64 @@
+#pragma once
+// Splits a cluster where a can ends and a touching neighbour starts (a can against a box of its
+// height and colour, a can standing on a box, two cans side by side), which the crease split
+// misses: at a tangent contact the two surfaces run on parallel, so no sharp fold is seen.
+//
+// The cluster is over-segmented into fitted instances: planes and cylinders taken one after the
+// other by MSAC (primitives::fit_model; a cylinder only when its description length beats a
+// plane's, and only as one unbroken arc of at least 90 degrees around its axis, as a can's side
+// is seen; a rounded edge bends less, a cylinder through strips of two faces leaves a gap), each
+// instance the image-connected piece of its inliers, with per-point normals from the pixel grid.
+// A plane through a can's lid and the top of a box of the can's height is cut by the can's solid
+// into the lid and the rest. Points no instance took join the instance they touch in the image.
+//
+// A can's surface bounds its solid all round, so what lies outside it is another object: a
+// fitted instance (plane or can) is kept apart from an object-sized can when most of it lies
+// beyond the can's radius by more than the band, it reaches farther from the axis than the can's
+// diameter (a handle or spout stays closer) and, where it touches the can, its surface does not
+// run on from the can's (the wider top of a tapered cup). Instances join by contact, longest
+// first, never bringing a can and an instance kept apart from it together. A plane bounds only a
+// half-space, which a neighbour's visible part may lie in (a can beside a box is below the box's
+// top), so two planes never cut here: their concave creases are the crease split's. The inside of
+// a mug faces its axis and bounds no solid. Pieces smaller than min_object_points, then pieces
+// with no fitted surface of half that size (a handle), join the piece they touch most.
+//
+// The depth noise sets the bands: the inlier band and "outside" are noise_sigmas Kinect sigmas at
+// the cluster's mean range (depth_noise_per_m2 * z^2), never narrower than min_band.
+// Deterministic: instances are fitted from fixed seeds, joins ordered by contact then index.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/tabletop/kept_apart.hpp"
+
+namespace primlabel::tabletop {
+
+struct ShapeSplitOptions {
+  bool enabled = true;
+  int normal_step = 2;                  // pixels either side for a point's grid normal
+  float depth_noise_per_m2 = 2.82e-3f;  // the sensor's depth sigma / range^2 (Kinect, measured)
+  float noise_sigmas = 3.0f;            // inlier band and "in front of" margin, in sigmas
+  float min_band = 0.003f;              // (m) never narrower (quantisation, near objects)
+  float normal_angle_deg = 30.0f;       // an inlier's normal within this of the surface's
+  float min_radius = 0.015f, max_radius = 0.25f;  // object-sized cylinders (m)
+  std::size_t min_instance_points = 120;          // smaller pieces are not fitted instances
+  int max_instances = 24;                         // per cluster
+  float max_neighbour_gap = 0.015f;               // pixels farther apart in 3D do not touch (m)
+  float outside_share = 0.5f;  // of an instance's inliers outside a touching can: another object
+  std::size_t min_object_points = 400;  // both sides of a cut (and a can) hold this many points
+  std::uint64_t seed = 1;
+
+  void validate() const;  // throws std::invalid_argument naming the bad option
+};
+
+// Organised clouds only (grid normals face the sensor); others are returned as they are.
+// Returns the clusters with each cut where a can meets what lies outside it: input indices
+// ascending within each piece, pieces ordered by size (largest first, ties by first index).
+// `kept_apart`, when given, is set to the pieces of every cut cluster.
+std::vector<std::vector<std::uint32_t>> split_by_shape(
+    const PointCloud& cloud, std::vector<std::vector<std::uint32_t>> clusters,
+    const ShapeSplitOptions& options, KeptApart* kept_apart = nullptr);
+
+}  // namespace primlabel::tabletop

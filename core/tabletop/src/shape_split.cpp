@@ -1,0 +1,610 @@
+#include "primlabel/tabletop/shape_split.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "disjoint_sets.hpp"
+#include "primlabel/primitives/fitters.hpp"
+
+namespace primlabel::tabletop {
+
+void ShapeSplitOptions::validate() const {
+  const auto fail = [](const std::string& what) { throw std::invalid_argument(what); };
+  const auto positive = [&](float v, const char* name) {
+    if (!(v > 0.0f) || !std::isfinite(v))
+      fail(std::string("shape split ") + name + " must be positive, got " + std::to_string(v));
+  };
+  if (normal_step < 1) fail("shape split normal step must be at least 1 pixel");
+  positive(depth_noise_per_m2, "depth noise");
+  positive(noise_sigmas, "noise sigmas");
+  positive(min_band, "minimum band");
+  positive(max_neighbour_gap, "neighbour gap");
+  positive(min_radius, "minimum radius");
+  if (!(max_radius > min_radius)) fail("shape split radius range is empty");
+  if (!(normal_angle_deg > 0.0f && normal_angle_deg < 90.0f))
+    fail("shape split normal angle must be in (0, 90) degrees");
+  if (!(outside_share > 0.0f && outside_share < 1.0f))
+    fail("shape split outside share must be in (0, 1)");
+  if (min_instance_points < 3) fail("shape split instances need at least 3 points");
+  if (max_instances < 1) fail("shape split needs at least one instance per cluster");
+}
+
+namespace {
+
+using Vec3d = Eigen::Vector3d;
+constexpr double kDegree = M_PI / 180.0;
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+// A fitted instance: its surface, and which side of it is outside the object.
+struct Instance {
+  enum class Kind { kPlane, kConvexCylinder, kNoSolid } kind = Kind::kNoSolid;
+  Vec3d normal = Vec3d::Zero();  // plane: facing the sensor
+  double offset = 0;
+  Vec3d axis_point = Vec3d::Zero(), axis = Vec3d::UnitZ();  // cylinder
+  double radius = 0;
+  std::vector<std::uint32_t> inliers;  // cluster-local ids
+
+  // Signed distance outside the object's solid behind this surface (> 0: in front of it).
+  double in_front(const Vec3d& p) const {
+    if (kind == Kind::kPlane) return normal.dot(p) + offset;
+    const Vec3d q = p - axis_point;
+    return (q - q.dot(axis) * axis).norm() - radius;
+  }
+};
+
+class ShapeSplitter {
+ public:
+  ShapeSplitter(const PointCloud& cloud, const ShapeSplitOptions& options)
+      : xyz_(cloud.xyz),
+        width_(int(cloud.width)),
+        height_(int(cloud.height)),
+        viewpoint_(cloud.viewpoint.origin),
+        options_(options),
+        local_(cloud.xyz.size(), kNone),
+        normals_(cloud.xyz.size(), Vec3f::Constant(std::numeric_limits<float>::quiet_NaN())) {}
+
+  std::vector<std::vector<std::uint32_t>> split(const std::vector<std::uint32_t>& cluster) {
+    if (cluster.size() < 2 * options_.min_object_points) return {cluster};
+    cluster_ = &cluster;
+    for (std::uint32_t k = 0; k < cluster.size(); ++k) local_[cluster[k]] = k;
+    set_band();
+    grid_normals();
+    fit_instances();
+    cut_planes_by_cans();
+    assign_the_rest();
+    auto pieces = join_instances();
+    for (std::uint32_t i : cluster) {
+      local_[i] = kNone;
+      normals_[i] = Vec3f::Constant(std::numeric_limits<float>::quiet_NaN());
+    }
+    return pieces;
+  }
+
+ private:
+  // The cluster-local id of the pixel (row, col), kNone when outside the cluster.
+  std::uint32_t at(int row, int col) const {
+    if (row < 0 || col < 0 || row >= height_ || col >= width_) return kNone;
+    return local_[std::size_t(row) * std::size_t(width_) + std::size_t(col)];
+  }
+  std::uint32_t global(std::uint32_t local) const { return (*cluster_)[local]; }
+  Vec3d point(std::uint32_t local) const { return xyz_[global(local)].cast<double>(); }
+  bool touching(std::uint32_t a, std::uint32_t b, int pixels) const {
+    return (xyz_[global(a)] - xyz_[global(b)]).norm() <= options_.max_neighbour_gap * float(pixels);
+  }
+  // Calls f(neighbour) for the 8 pixel neighbours of `local` in the cluster that touch it in 3D.
+  template <typename F>
+  void for_each_touching(std::uint32_t local, F&& f) const {
+    const std::uint32_t i = global(local);
+    const int row = int(i / std::uint32_t(width_)), col = int(i % std::uint32_t(width_));
+    for (int dr = -1; dr <= 1; ++dr)
+      for (int dc = -1; dc <= 1; ++dc) {
+        if (dr == 0 && dc == 0) continue;
+        const std::uint32_t j = at(row + dr, col + dc);
+        if (j != kNone && touching(local, j, 1)) f(j);
+      }
+  }
+
+  void set_band() {
+    double range = 0;
+    for (std::uint32_t i : *cluster_) range += (xyz_[i] - viewpoint_).norm();
+    range /= double(cluster_->size());
+    band_ = std::max(double(options_.min_band),
+                     options_.noise_sigmas * options_.depth_noise_per_m2 * range * range);
+  }
+
+  // Central differences on the pixel grid, normal_step pixels either side (1 where the farther
+  // pixel is not this surface's), facing the sensor.
+  void grid_normals() {
+    for (std::uint32_t k = 0; k < cluster_->size(); ++k) {
+      const std::uint32_t i = global(k);
+      const int row = int(i / std::uint32_t(width_)), col = int(i % std::uint32_t(width_));
+      const auto difference = [&](int dr, int dc) -> std::optional<Vec3f> {
+        for (int step = options_.normal_step; step >= 1; --step) {
+          const std::uint32_t a = at(row - dr * step, col - dc * step);
+          const std::uint32_t b = at(row + dr * step, col + dc * step);
+          if (a != kNone && b != kNone && touching(a, k, step) && touching(b, k, step))
+            return xyz_[global(b)] - xyz_[global(a)];
+        }
+        return std::nullopt;
+      };
+      const auto across = difference(0, 1), down = difference(1, 0);
+      if (!across || !down) continue;
+      Vec3f n = across->cross(*down);
+      const float length = n.norm();
+      if (!(length > 0.0f)) continue;
+      n /= length;
+      if (n.dot(viewpoint_ - xyz_[i]) < 0.0f) n = -n;
+      normals_[i] = n;
+    }
+  }
+
+  primitives::FitSettings fit_settings() const {
+    primitives::FitSettings settings;
+    settings.distance_threshold = band_;
+    settings.normal_angle_deg = options_.normal_angle_deg;
+    settings.hypotheses = 100;
+    settings.max_scoring_points = 600;
+    settings.max_refine_points = 3000;
+    settings.min_radius = options_.min_radius;
+    settings.max_radius = options_.max_radius;
+    return settings;
+  }
+
+  // The instance a fit describes, with no inliers yet; nothing for models other than planes and
+  // cylinders.
+  static std::optional<Instance> instance_of(const primitives::Model& model) {
+    Instance instance;
+    if (const auto* plane = std::get_if<primitives::PlaneModel>(&model)) {
+      instance.kind = Instance::Kind::kPlane;
+      instance.normal = plane->normal;
+      instance.offset = plane->offset;
+      return instance;
+    }
+    if (const auto* cylinder = std::get_if<primitives::CylinderModel>(&model)) {
+      instance.kind = Instance::Kind::kConvexCylinder;
+      instance.axis_point = cylinder->center;
+      instance.axis = cylinder->axis.normalized();
+      instance.radius = cylinder->radius;
+      return instance;
+    }
+    return std::nullopt;
+  }
+
+  bool explains(const Instance& instance, std::uint32_t local) const {
+    const Vec3f& nf = normals_[global(local)];
+    if (!nf.allFinite()) return false;
+    const Vec3d p = point(local), n = nf.cast<double>();
+    Vec3d surface_normal;
+    if (instance.kind == Instance::Kind::kPlane) {
+      surface_normal = instance.normal;
+    } else {
+      const Vec3d q = p - instance.axis_point;
+      surface_normal = (q - q.dot(instance.axis) * instance.axis).normalized();
+    }
+    return std::abs(instance.in_front(p)) <= band_ &&
+           std::abs(surface_normal.dot(n)) >= std::cos(options_.normal_angle_deg * kDegree);
+  }
+
+  // The largest image-connected piece of the free points `instance` explains (ties: the piece
+  // with the lowest id).
+  std::vector<std::uint32_t> largest_piece(const Instance& instance,
+                                           const std::vector<std::uint32_t>& free) {
+    std::fill(mark_.begin(), mark_.end(), 0);
+    for (std::uint32_t k : free)
+      if (explains(instance, k)) mark_[k] = 1;
+    std::vector<std::uint32_t> best, piece;
+    for (std::uint32_t k : free) {
+      if (mark_[k] != 1) continue;
+      piece.clear();
+      mark_[k] = 2;
+      piece.push_back(k);
+      for (std::size_t q = 0; q < piece.size(); ++q)
+        for_each_touching(piece[q], [&](std::uint32_t j) {
+          if (mark_[j] == 1) {
+            mark_[j] = 2;
+            piece.push_back(j);
+          }
+        });
+      if (piece.size() > best.size()) best = piece;
+    }
+    std::sort(best.begin(), best.end());
+    return best;
+  }
+
+  // Planes and cylinders, one after the other, each the largest connected piece of its inliers
+  // among the points no earlier instance took.
+  void fit_instances() {
+    instances_.clear();
+    owner_.assign(cluster_->size(), kNone);
+    mark_.assign(cluster_->size(), 0);
+    std::vector<std::uint32_t> free;
+    for (std::uint32_t k = 0; k < cluster_->size(); ++k)
+      if (normals_[global(k)].allFinite()) free.push_back(k);
+    const primitives::FitSettings settings = fit_settings();
+    for (int round = 0; round < options_.max_instances; ++round) {
+      if (free.size() < options_.min_instance_points) break;
+      std::vector<std::uint32_t> indices(free.size());
+      for (std::size_t k = 0; k < free.size(); ++k) indices[k] = global(free[k]);
+      const primitives::SegmentPoints points{xyz_, normals_, indices};
+      const std::uint64_t seed = options_.seed + 2 * std::uint64_t(round);
+      std::optional<Instance> best;
+      std::vector<std::uint32_t> best_inliers;
+      for (const auto kind :
+           {primitives::PrimitiveKind::kPlane, primitives::PrimitiveKind::kCylinder}) {
+        const auto fit = primitives::fit_model(
+            kind, points, settings, seed + (kind == primitives::PrimitiveKind::kPlane ? 0 : 1));
+        if (!fit) continue;
+        auto instance = instance_of(fit->model);
+        if (!instance) continue;
+        if (instance->kind == Instance::Kind::kPlane) orient_to_sensor(*instance, free);
+        auto inliers = largest_piece(*instance, free);
+        if (instance->kind == Instance::Kind::kConvexCylinder && !covers_an_arc(*instance, inliers))
+          continue;
+        if (inliers.size() > best_inliers.size()) {
+          best = std::move(instance);
+          best_inliers = std::move(inliers);
+        }
+      }
+      if (!best || best_inliers.size() < options_.min_instance_points) break;
+      const std::uint32_t id = std::uint32_t(instances_.size());
+      for (std::uint32_t k : best_inliers) owner_[k] = id;
+      if (best->kind == Instance::Kind::kConvexCylinder && !seen_from_outside(*best, best_inliers))
+        best->kind = Instance::Kind::kNoSolid;
+      best->inliers = std::move(best_inliers);
+      instances_.push_back(std::move(*best));
+      std::erase_if(free, [&](std::uint32_t k) { return owner_[k] != kNone; });
+    }
+  }
+
+  // A can's side is seen as one unbroken arc around its axis. A cylinder through strips of two
+  // faces of a box (within the band where it crosses them) leaves the arc between them empty.
+  bool covers_an_arc(const Instance& cylinder, const std::vector<std::uint32_t>& inliers) const {
+    constexpr double kBin = 10.0 * kDegree, kMinSpan = 90.0 * kDegree;
+    if (inliers.empty()) return false;
+    const Vec3d u = cylinder.axis.unitOrthogonal(), v = cylinder.axis.cross(u);
+    std::vector<double> angle;
+    angle.reserve(inliers.size());
+    for (std::uint32_t k : inliers) {
+      const Vec3d q = point(k) - cylinder.axis_point;
+      angle.push_back(std::atan2(q.dot(v), q.dot(u)));
+    }
+    std::sort(angle.begin(), angle.end());
+    // The arc starts after the widest empty gap around the circle.
+    std::size_t start = 0;
+    double widest = angle.front() + 2 * M_PI - angle.back();
+    for (std::size_t k = 1; k < angle.size(); ++k)
+      if (angle[k] - angle[k - 1] > widest) {
+        widest = angle[k] - angle[k - 1];
+        start = k;
+      }
+    const double span = 2 * M_PI - widest;
+    if (span < kMinSpan) return false;
+    const std::size_t bins = std::size_t(std::ceil(span / kBin));
+    std::vector<std::size_t> count(bins, 0);
+    for (double a : angle) {
+      double offset = a - angle[start];
+      if (offset < 0) offset += 2 * M_PI;
+      ++count[std::min(bins - 1, std::size_t(offset / kBin))];
+    }
+    const double expected = double(angle.size()) / double(bins);
+    const auto filled = std::count_if(count.begin(), count.end(),
+                                      [&](std::size_t c) { return double(c) >= 0.25 * expected; });
+    return double(filled) >= 0.8 * double(bins);
+  }
+
+  // A plane's front is the side its points' normals face (the sensor's side).
+  void orient_to_sensor(Instance& plane, const std::vector<std::uint32_t>& free) const {
+    double facing = 0;
+    for (std::uint32_t k : free)
+      if (std::abs(plane.in_front(point(k))) <= band_)
+        facing += plane.normal.dot(normals_[global(k)].cast<double>());
+    if (facing < 0) {
+      plane.normal = -plane.normal;
+      plane.offset = -plane.offset;
+    }
+  }
+
+  // A can seen from outside: its points' normals (facing the sensor) point away from the axis;
+  // the inside of a mug's wall faces the axis and bounds no solid this test could use.
+  bool seen_from_outside(const Instance& cylinder,
+                         const std::vector<std::uint32_t>& inliers) const {
+    std::size_t outward = 0;
+    for (std::uint32_t k : inliers) {
+      const Vec3d q = point(k) - cylinder.axis_point;
+      const Vec3d radial = q - q.dot(cylinder.axis) * cylinder.axis;
+      if (radial.dot(normals_[global(k)].cast<double>()) > 0) ++outward;
+    }
+    return 2 * outward > inliers.size();
+  }
+
+  // Points no instance took join the instance they touch in the image, nearest first; pieces
+  // touching none become instances without a solid.
+  void assign_the_rest() {
+    std::deque<std::uint32_t> queue;
+    for (std::uint32_t k = 0; k < cluster_->size(); ++k)
+      if (owner_[k] != kNone) queue.push_back(k);
+    while (!queue.empty()) {
+      const std::uint32_t k = queue.front();
+      queue.pop_front();
+      for_each_touching(k, [&](std::uint32_t j) {
+        if (owner_[j] == kNone) {
+          owner_[j] = owner_[k];
+          queue.push_back(j);
+        }
+      });
+    }
+    for (std::uint32_t k = 0; k < cluster_->size(); ++k) {
+      if (owner_[k] != kNone) continue;
+      const std::uint32_t id = std::uint32_t(instances_.size());
+      instances_.emplace_back();
+      owner_[k] = id;
+      queue.push_back(k);
+      while (!queue.empty()) {
+        const std::uint32_t q = queue.front();
+        queue.pop_front();
+        for_each_touching(q, [&](std::uint32_t j) {
+          if (owner_[j] == kNone) {
+            owner_[j] = id;
+            queue.push_back(j);
+          }
+        });
+      }
+    }
+  }
+
+  // Whether the surface at `local` runs on from `can`'s: its normal (its plane's, when a plane
+  // took it, which is steadier than a point's) along the can's outward radial direction. A box's
+  // face that a can touches faces the other way.
+  bool continues(const Instance& can, std::uint32_t local) const {
+    const Instance& owner = instances_[owner_[local]];
+    Vec3d normal;
+    if (owner.kind == Instance::Kind::kPlane) {
+      normal = owner.normal;
+    } else {
+      const Vec3f& nf = normals_[global(local)];
+      if (!nf.allFinite()) return false;
+      normal = nf.cast<double>();
+    }
+    const Vec3d q = point(local) - can.axis_point;
+    const Vec3d radial = (q - q.dot(can.axis) * can.axis).normalized();
+    return radial.dot(normal) >= std::cos(options_.normal_angle_deg * kDegree);
+  }
+
+  // Share of a's inliers outside b's solid (in front of its surface) by more than the band.
+  double share_in_front(const Instance& a, const Instance& b) const {
+    if (a.inliers.empty()) return 0.0;
+    std::size_t in_front = 0;
+    for (std::uint32_t k : a.inliers)
+      if (b.in_front(point(k)) > band_) ++in_front;
+    return double(in_front) / double(a.inliers.size());
+  }
+
+  // Whether x reaches farther from the can's axis than the can's own diameter: a handle or a
+  // spout stays closer to the wall than the can is wide; a neighbour object reaches beyond.
+  bool reaches_beyond(const Instance& x, const Instance& can) const {
+    std::size_t beyond = 0;
+    for (std::uint32_t k : x.inliers) {
+      const Vec3d q = point(k) - can.axis_point;
+      if ((q - q.dot(can.axis) * can.axis).norm() > 2 * can.radius) ++beyond;
+    }
+    return beyond * 20 >= x.inliers.size();  // 5%: more than noise at its far end
+  }
+
+  // A can's surface bounds its solid all round, so what touches it from outside is another
+  // object: a box's face or top beside it, the top it stands on, another can. A plane bounds only
+  // a half-space that a neighbour's visible part may well lie in (a can beside a box is below
+  // the box's top), and planes meeting at concave creases are the crease split's.
+  bool separate(std::uint32_t a, std::uint32_t b) const {
+    using Kind = Instance::Kind;
+    const auto outside_can = [&](std::uint32_t x, std::uint32_t can) {
+      const Instance &other = instances_[x], &solid = instances_[can];
+      return solid.kind == Kind::kConvexCylinder &&
+             solid.inliers.size() >= options_.min_object_points &&
+             (other.kind == Kind::kPlane || other.kind == Kind::kConvexCylinder) &&
+             !continuing_.contains({can, x}) &&
+             share_in_front(other, solid) > options_.outside_share && reaches_beyond(other, solid);
+    };
+    return outside_can(a, b) || outside_can(b, a);
+  }
+
+  // A plane through a can's lid and the top of a box of its height is one fitted instance; the
+  // can's solid cuts it into the lid (inside the radius, at the can's end) and the rest.
+  void cut_planes_by_cans() {
+    const std::size_t fitted = instances_.size();
+    for (std::size_t c = 0; c < fitted; ++c) {
+      if (instances_[c].kind != Instance::Kind::kConvexCylinder) continue;
+      const Instance& can = instances_[c];
+      double low = std::numeric_limits<double>::infinity(), high = -low;
+      for (std::uint32_t k : can.inliers) {
+        const double along = (point(k) - can.axis_point).dot(can.axis);
+        low = std::min(low, along);
+        high = std::max(high, along);
+      }
+      for (std::size_t p = 0; p < fitted; ++p) {
+        if (instances_[p].kind != Instance::Kind::kPlane) continue;
+        std::vector<std::uint32_t> inside, outside;
+        for (std::uint32_t k : instances_[p].inliers) {
+          const Vec3d q = point(k) - instances_[c].axis_point;
+          const double along = q.dot(instances_[c].axis);
+          const bool within = along >= low - band_ && along <= high + band_ &&
+                              instances_[c].in_front(point(k)) <= band_;
+          (within ? inside : outside).push_back(k);
+        }
+        if (inside.size() < options_.min_instance_points / 2 ||
+            outside.size() < options_.min_instance_points / 2)
+          continue;
+        Instance lid = instances_[p];
+        lid.inliers = std::move(inside);
+        instances_[p].inliers = std::move(outside);
+        const std::uint32_t id = std::uint32_t(instances_.size());
+        for (std::uint32_t k : lid.inliers) owner_[k] = id;
+        instances_.push_back(std::move(lid));
+      }
+    }
+  }
+
+  struct PieceStats {
+    std::size_t size = 0;
+  };
+
+  // Per piece (by root): its size.
+  std::map<std::uint32_t, PieceStats> piece_stats(DisjointSets& objects) const {
+    std::map<std::uint32_t, PieceStats> stats;
+    for (std::uint32_t k = 0; k < cluster_->size(); ++k) ++stats[objects.find(owner_[k])].size;
+    return stats;
+  }
+
+  // Joins pieces for which must_join(root, stats) holds to the piece they touch most (or, touching
+  // none, the largest), smallest first, until none is left or one piece remains.
+  template <typename MustJoin>
+  void absorb(DisjointSets& objects,
+              const std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t>& contact,
+              MustJoin&& must_join) {
+    for (;;) {
+      stats_ = piece_stats(objects);
+      if (stats_.size() < 2) return;
+      std::uint32_t chosen = kNone;
+      for (const auto& [root, piece] : stats_)
+        if (must_join(root, piece) && (chosen == kNone || piece.size < stats_[chosen].size))
+          chosen = root;
+      if (chosen == kNone) return;
+      std::map<std::uint32_t, std::size_t> touch;
+      for (const auto& [pair, count] : contact) {
+        const std::uint32_t a = objects.find(pair.first), b = objects.find(pair.second);
+        if (a == b) continue;
+        if (a == chosen) touch[b] += count;
+        if (b == chosen) touch[a] += count;
+      }
+      std::uint32_t best = kNone;
+      for (const auto& [other, count] : touch)
+        if (best == kNone || count > touch[best]) best = other;
+      if (best == kNone)
+        for (const auto& [root, piece] : stats_)
+          if (root != chosen && (best == kNone || piece.size > stats_[best].size)) best = root;
+      objects.join(chosen, best);
+    }
+  }
+
+  std::vector<std::vector<std::uint32_t>> join_instances() {
+    const std::uint32_t n = std::uint32_t(instances_.size());
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::size_t> contact;
+    // Per (can, neighbour): their contacts, and those where the neighbour's surface runs on
+    // from the can's (the wider top of a tapered cup, a bottle's shoulder).
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::pair<std::size_t, std::size_t>> runs_on;
+    for (std::uint32_t k = 0; k < cluster_->size(); ++k)
+      for_each_touching(k, [&](std::uint32_t j) {
+        const std::uint32_t a = owner_[k], b = owner_[j];
+        if (a == b) return;
+        if (k < j) ++contact[{std::min(a, b), std::max(a, b)}];
+        if (instances_[a].kind == Instance::Kind::kConvexCylinder) {
+          auto& [touching, smooth] = runs_on[{a, b}];
+          ++touching;
+          if (continues(instances_[a], j)) ++smooth;
+        }
+      });
+    continuing_.clear();
+    for (const auto& [pair, counts] : runs_on)
+      if (double(counts.second) > options_.outside_share * double(counts.first))
+        continuing_.insert(pair);
+    DisjointSets objects(n);
+    // What lies outside a can is never joined to it, even through a third instance (the lid of a
+    // can beside a box of its height touches the box's top): joins go by contact length, longest
+    // first, each only when no can and an instance outside it would end up together.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> apart;
+    for (std::uint32_t a = 0; a < n; ++a)
+      for (std::uint32_t b = a + 1; b < n; ++b)
+        if (separate(a, b)) apart.emplace_back(a, b);
+    std::vector<std::pair<std::pair<std::uint32_t, std::uint32_t>, std::size_t>> joins(
+        contact.begin(), contact.end());
+    std::stable_sort(joins.begin(), joins.end(),
+                     [](const auto& x, const auto& y) { return x.second > y.second; });
+    for (const auto& [pair, count] : joins) {
+      const std::uint32_t a = objects.find(pair.first), b = objects.find(pair.second);
+      if (a == b) continue;
+      const bool kept_apart = std::any_of(apart.begin(), apart.end(), [&](const auto& x) {
+        const std::uint32_t u = objects.find(x.first), v = objects.find(x.second);
+        return (u == a && v == b) || (u == b && v == a);
+      });
+      if (!kept_apart) objects.join(a, b);
+    }
+
+    // Pieces too small to be objects, then pieces with no fitted surface of their own (a pot's
+    // handle, outside the pot's wall), join the piece they touch most, smallest first.
+    absorb(objects, contact, [&](std::uint32_t, const PieceStats& piece) {
+      return piece.size < options_.min_object_points;
+    });
+    absorb(objects, contact, [&](std::uint32_t root, const PieceStats&) {
+      for (std::uint32_t i = 0; i < n; ++i)
+        if (objects.find(i) == root && instances_[i].kind != Instance::Kind::kNoSolid &&
+            2 * instances_[i].inliers.size() >= options_.min_object_points)
+          return false;
+      return true;
+    });
+
+    std::map<std::uint32_t, std::vector<std::uint32_t>> pieces;
+    for (std::uint32_t k = 0; k < cluster_->size(); ++k)
+      pieces[objects.find(owner_[k])].push_back(global(k));
+    std::vector<std::vector<std::uint32_t>> out;
+    for (auto& [root, members] : pieces) {
+      std::sort(members.begin(), members.end());
+      out.push_back(std::move(members));
+    }
+    return out;
+  }
+
+  const std::vector<Vec3f>& xyz_;
+  int width_, height_;
+  Vec3f viewpoint_;
+  const ShapeSplitOptions& options_;
+  std::vector<std::uint32_t> local_;  // per input point: cluster-local id, kNone outside
+  std::vector<Vec3f> normals_;        // per input point: grid normal, NaN when none
+  const std::vector<std::uint32_t>* cluster_ = nullptr;
+  double band_ = 0;
+  std::vector<Instance> instances_;
+  std::vector<std::uint32_t> owner_;                              // per cluster point: its instance
+  std::map<std::uint32_t, PieceStats> stats_;                     // per piece while joining
+  std::set<std::pair<std::uint32_t, std::uint32_t>> continuing_;  // (can, neighbour) running on
+  std::vector<std::uint8_t> mark_;
+};
+
+}  // namespace
+
+std::vector<std::vector<std::uint32_t>> split_by_shape(
+    const PointCloud& cloud, std::vector<std::vector<std::uint32_t>> clusters,
+    const ShapeSplitOptions& options, KeptApart* kept_apart) {
+  options.validate();
+  if (kept_apart) *kept_apart = {};
+  std::vector<std::vector<std::uint32_t>> out;
+  if (!options.enabled || !cloud.organized()) {
+    out = std::move(clusters);
+  } else {
+    ShapeSplitter splitter(cloud, options);
+    for (std::uint32_t c = 0; c < clusters.size(); ++c) {
+      if (clusters[c].empty()) continue;
+      auto pieces = splitter.split(clusters[c]);
+      if (kept_apart && pieces.size() > 1) {
+        if (kept_apart->piece.empty()) kept_apart->piece.assign(cloud.size(), -1);
+        for (const auto& piece : pieces) {
+          for (std::uint32_t i : piece)
+            kept_apart->piece[i] = std::int32_t(kept_apart->origin.size());
+          kept_apart->origin.push_back(c);
+        }
+      }
+      for (auto& piece : pieces) out.push_back(std::move(piece));
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) {
+    return a.size() != b.size() ? a.size() > b.size() : a.front() < b.front();
+  });
+  return out;
+}
+
+}  // namespace primlabel::tabletop
