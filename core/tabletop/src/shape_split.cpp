@@ -5,6 +5,7 @@
 #include <deque>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <stdexcept>
@@ -12,6 +13,7 @@
 #include <utility>
 
 #include "disjoint_sets.hpp"
+#include "primlabel/geometry/parallel.hpp"
 #include "primlabel/primitives/fitters.hpp"
 
 namespace primlabel::tabletop {
@@ -146,13 +148,18 @@ class ShapeSplitter {
     }
   }
 
-  primitives::FitSettings fit_settings() const {
+  // Fewer cylinder hypotheses, each scored on fewer points: a cylinder hypothesis costs several
+  // times a plane's, and a can missed in one round is drawn again in the next, from fewer points.
+  // Least squares on a strided subset of the inliers: it was most of the cost.
+  primitives::FitSettings fit_settings(primitives::PrimitiveKind kind) const {
+    const bool plane = kind == primitives::PrimitiveKind::kPlane;
     primitives::FitSettings settings;
     settings.distance_threshold = band_;
     settings.normal_angle_deg = options_.normal_angle_deg;
-    settings.hypotheses = 100;
-    settings.max_scoring_points = 600;
-    settings.max_refine_points = 3000;
+    settings.hypotheses = plane ? 60 : 40;
+    settings.max_scoring_points = plane ? 600 : 300;
+    settings.max_refine_points = 800;  // plenty for 5 parameters; least squares dominated
+    settings.refine_iterations = 10;
     settings.min_radius = options_.min_radius;
     settings.max_radius = options_.max_radius;
     return settings;
@@ -228,7 +235,6 @@ class ShapeSplitter {
     std::vector<std::uint32_t> free;
     for (std::uint32_t k = 0; k < cluster_->size(); ++k)
       if (normals_[global(k)].allFinite()) free.push_back(k);
-    const primitives::FitSettings settings = fit_settings();
     for (int round = 0; round < options_.max_instances; ++round) {
       if (free.size() < options_.min_instance_points) break;
       std::vector<std::uint32_t> indices(free.size());
@@ -239,8 +245,9 @@ class ShapeSplitter {
       std::vector<std::uint32_t> best_inliers;
       for (const auto kind :
            {primitives::PrimitiveKind::kPlane, primitives::PrimitiveKind::kCylinder}) {
-        const auto fit = primitives::fit_model(
-            kind, points, settings, seed + (kind == primitives::PrimitiveKind::kPlane ? 0 : 1));
+        const auto fit =
+            primitives::fit_model(kind, points, fit_settings(kind),
+                                  seed + (kind == primitives::PrimitiveKind::kPlane ? 0 : 1));
         if (!fit) continue;
         auto instance = instance_of(fit->model);
         if (!instance) continue;
@@ -579,17 +586,25 @@ class ShapeSplitter {
 
 std::vector<std::vector<std::uint32_t>> split_by_shape(
     const PointCloud& cloud, std::vector<std::vector<std::uint32_t>> clusters,
-    const ShapeSplitOptions& options, KeptApart* kept_apart) {
+    const ShapeSplitOptions& options, KeptApart* kept_apart, const RunContext& context) {
   options.validate();
   if (kept_apart) *kept_apart = {};
   std::vector<std::vector<std::uint32_t>> out;
   if (!options.enabled || !cloud.organized()) {
     out = std::move(clusters);
   } else {
-    ShapeSplitter splitter(cloud, options);
+    // Clusters are independent: one splitter (with its image-sized buffers) per thread, the
+    // pieces gathered in cluster order, so the result is the same for any thread count.
+    std::vector<std::vector<std::vector<std::uint32_t>>> split(clusters.size());
+    detail::parallel_for(
+        std::ptrdiff_t(clusters.size()), context.threads, detail::Schedule::Dynamic(1),
+        [&] { return std::make_unique<ShapeSplitter>(cloud, options); },
+        [&](std::unique_ptr<ShapeSplitter>& splitter, std::ptrdiff_t c) {
+          if (!clusters[c].empty() && !context.stopped()) split[c] = splitter->split(clusters[c]);
+        });
+    context.throw_if_stopped("table-top shape split");
     for (std::uint32_t c = 0; c < clusters.size(); ++c) {
-      if (clusters[c].empty()) continue;
-      auto pieces = splitter.split(clusters[c]);
+      auto& pieces = split[c];
       if (kept_apart && pieces.size() > 1) {
         if (kept_apart->piece.empty()) kept_apart->piece.assign(cloud.size(), -1);
         for (const auto& piece : pieces) {

@@ -104,7 +104,7 @@ TabletopResult segment_tabletop(const PointCloud& cloud, const TabletopOptions& 
   context.throw_if_stopped(kWhat);
   // 5. Objects as wholes: split and joined.
   const auto refine_start = Clock::now();
-  result.clusters = refine_objects(cloud, surface, std::move(result.clusters), options);
+  result.clusters = refine_objects(cloud, surface, std::move(result.clusters), options, context);
   context.throw_if_stopped(kWhat);
   result.timings.refine_ms = ms_since(refine_start);
   result.timings.objects_ms = ms_since(objects_start);

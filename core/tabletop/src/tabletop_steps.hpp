@@ -90,6 +90,7 @@ void separate_table_noise_from_objects(const PointCloud& cloud, const TableSurfa
 // that the lower object's occluded parts can still be joined to what remains of it.
 std::vector<std::vector<std::uint32_t>> refine_objects(
     const PointCloud& cloud, const TableSurface& surface,
-    std::vector<std::vector<std::uint32_t>> clusters, const TabletopOptions& options);
+    std::vector<std::vector<std::uint32_t>> clusters, const TabletopOptions& options,
+    const RunContext& context);
 
 }  // namespace primlabel::tabletop::steps

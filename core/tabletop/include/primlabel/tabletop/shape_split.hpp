@@ -24,13 +24,15 @@
 //
 // The depth noise sets the bands: the inlier band and "outside" are noise_sigmas Kinect sigmas at
 // the cluster's mean range (depth_noise_per_m2 * z^2), never narrower than min_band.
-// Deterministic: instances are fitted from fixed seeds, joins ordered by contact then index.
+// Clusters are split in parallel on context.threads; the result does not depend on them:
+// instances are fitted from fixed seeds, joins ordered by contact then index.
 
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "primlabel/geometry/point_cloud.hpp"
+#include "primlabel/geometry/run_context.hpp"
 #include "primlabel/tabletop/kept_apart.hpp"
 
 namespace primlabel::tabletop {
@@ -59,6 +61,7 @@ struct ShapeSplitOptions {
 // `kept_apart`, when given, is set to the pieces of every cut cluster.
 std::vector<std::vector<std::uint32_t>> split_by_shape(
     const PointCloud& cloud, std::vector<std::vector<std::uint32_t>> clusters,
-    const ShapeSplitOptions& options, KeptApart* kept_apart = nullptr);
+    const ShapeSplitOptions& options, KeptApart* kept_apart = nullptr,
+    const RunContext& context = {});
 
 }  // namespace primlabel::tabletop
