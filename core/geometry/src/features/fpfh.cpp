@@ -424,8 +424,8 @@ class FpfhRun {
             if (counted && received != expected[p] && subset_) {
               // On the subset's band: only the pairs with the lower neighbours pass 1 skipped.
               if (!cache_.load(p, list)) list = neighbors_of(p, scratch.list);
-              received +=
-                  count_skipped_lower_pairs(cloud_, p, list, usable_or_all_, needed_, scratch, counts);
+              received += count_skipped_lower_pairs(cloud_, p, list, usable_or_all_, needed_,
+                                                    scratch, counts);
             }
             if (!counted || received != expected[p]) {
               if (list.empty() && !cache_.load(p, list)) list = neighbors_of(p, scratch.list);

@@ -193,8 +193,7 @@ std::span<const std::uint32_t> NeighborLists::view(std::size_t i, const Neighbor
       kept += sq_dists[p] < sq_radius;  // the search's comparison, as in find()
     }
     scratch.indices.resize(kept);
-    if (hood.max_neighbors == 0 || kept < std::size_t(hood.max_neighbors))
-      return scratch.indices;
+    if (hood.max_neighbors == 0 || kept < std::size_t(hood.max_neighbors)) return scratch.indices;
   }
   search_.find(points_[i], hood, scratch, /*sorted=*/false);
   return scratch.indices;
