@@ -56,6 +56,26 @@ TEST_F(NeighborListsTest, SmallerAndCappedRadiiMatchTheirOwnSearch) {
   EXPECT_THROW(lists.find(5, Neighborhood::Radius(0.07f), got), std::invalid_argument);
 }
 
+// view() answers with find()'s indices in find()'s order: the kept list itself at the lists'
+// radius, the indices alone filtered for a smaller one, and a list that was not kept (a budget of
+// a few lists) searched again into the scratch and filtered there in place.
+TEST_F(NeighborListsTest, ViewIsFindsIndicesInItsOrderWhateverWasKept) {
+  for (const std::size_t budget : {std::size_t(1) << 30, std::size_t(4096)}) {
+    const NeighborLists lists(cloud_.xyz, *search_, Neighborhood::Hybrid(0.06f, 50), budget);
+    NeighborList scratch, want;
+    for (const Neighborhood hood : {Neighborhood::Radius(0.04f), Neighborhood::Hybrid(0.06f, 50),
+                                    Neighborhood::Hybrid(0.05f, 8), Neighborhood::Radius(0.06f)})
+      for (std::size_t i = 0; i < cloud_.size(); ++i) {
+        scratch.indices.assign(7, 12345u);  // stale contents must not leak into the answer
+        const std::span<const std::uint32_t> got = lists.view(i, hood, scratch);
+        lists.find(i, hood, want);
+        ASSERT_EQ(std::vector<std::uint32_t>(got.begin(), got.end()), want.indices)
+            << hood.describe() << " point " << i << " budget " << budget;
+      }
+    EXPECT_THROW(lists.view(5, Neighborhood::Radius(0.07f), scratch), std::invalid_argument);
+  }
+}
+
 TEST_F(NeighborListsTest, WhatIsKeptChangesNeitherTheSetsNorTheirOrder) {
   const Neighborhood hood = Neighborhood::Hybrid(0.05f, 50);
   const NeighborLists all(cloud_.xyz, *search_, hood, 1 << 30, RunContext{2});

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <span>
 #include <stdexcept>
 
 #include "primlabel/geometry/cancellation.hpp"
@@ -17,11 +18,11 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // Plane normal and surface variation of one neighbourhood.
-bool fit_normal(const std::vector<Vec3f>& xyz, const Vec3f& query, const NeighborList& neighbors,
-                Vec3f& normal, float& curvature) {
+bool fit_normal(const std::vector<Vec3f>& xyz, const Vec3f& query,
+                std::span<const std::uint32_t> neighbors, Vec3f& normal, float& curvature) {
   if (neighbors.size() < 3) return false;
   PointMoments moments;
-  for (std::uint32_t index : neighbors.indices) moments.add(xyz[index], query);
+  for (std::uint32_t index : neighbors) moments.add(xyz[index], query);
   const Eigen::Matrix3d cov = moments.covariance();
 
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
@@ -77,13 +78,17 @@ NormalStats estimate_normals(PointCloud& cloud, const NormalOptions& options,
             ++block_invalid;
             continue;
           }
-          if (use_lists)
-            lists->find(i, options.neighborhood, neighbors);
-          else
+          // From the shared lists without a copy where they answer as they are.
+          std::span<const std::uint32_t> found;
+          if (use_lists) {
+            found = lists->view(i, options.neighborhood, neighbors);
+          } else {
             search->find(p, options.neighborhood, neighbors, /*sorted=*/false);
+            found = neighbors.indices;
+          }
           Vec3f normal;
           float curvature;
-          if (fit_normal(cloud.xyz, p, neighbors, normal, curvature)) {
+          if (fit_normal(cloud.xyz, p, found, normal, curvature)) {
             // Face the sensor, as PCL's flipNormalTowardsViewpoint does.
             if ((viewpoint - p).dot(normal) < 0.0f) normal = -normal;
             cloud.normals[i] = normal;

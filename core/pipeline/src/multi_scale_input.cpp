@@ -43,11 +43,21 @@ std::vector<std::vector<float>> scaled_variations(const std::vector<Vec3f>& xyz,
           if (!is_finite(xyz[i]) || (!wanted.empty() && !wanted[i])) continue;
           lists.find(i, widest, list);
           std::fill(moments.begin(), moments.end(), PointMoments{});
-          for (std::size_t j = 0; j < list.size(); ++j)
+          for (std::size_t j = 0; j < list.size(); ++j) {
+            // The terms PointMoments::add sums, computed once for every radius the neighbour is
+            // within: the same values added in the same order, so the same bits.
+            const Vec3f& p = xyz[list.indices[j]];
+            const double x = double(p.x()) - xyz[i].x(), y = double(p.y()) - xyz[i].y(),
+                         z = double(p.z()) - xyz[i].z();
+            const double xx = x * x, xy = x * y, xz = x * z, yy = y * y, yz = y * z, zz = z * z;
             for (std::size_t r = scales; r-- > 0;) {
               if (list.sq_dists[j] > radii[r] * radii[r]) break;  // nor within any smaller radius
-              moments[r].add(xyz[list.indices[j]], xyz[i]);
+              PointMoments& m = moments[r];
+              m.count += 1;
+              m.sx += x, m.sy += y, m.sz += z;
+              m.sxx += xx, m.sxy += xy, m.sxz += xz, m.syy += yy, m.syz += yz, m.szz += zz;
             }
+          }
           for (std::size_t r = 0; r < scales; ++r) {
             const double variation = moments[r].surface_variation();
             if (std::isfinite(variation)) out[r][i] = float(variation) * kSurfaceVariationScale;

@@ -222,6 +222,33 @@ std::uint64_t count_upper_pairs(const PointCloud& cloud, std::size_t p,
   return expected;
 }
 
+// A subset's band: a needed point whose lower neighbours were not all needed misses their pairs
+// in the counts. Those pairs of p, and only those, computed from p's end as compute_spfh computes
+// every pair of p, are added to `counts`; returns the sum of their tags (what p then received
+// in all). The same bins compute_spfh would count for them, so the row is the same bits.
+std::uint64_t count_skipped_lower_pairs(const PointCloud& cloud, std::size_t p,
+                                        std::span<const std::uint32_t> list, const char* usable,
+                                        const std::vector<std::uint8_t>& needed,
+                                        SpfhScratch& scratch, std::uint32_t* counts) {
+  scratch.reserve(list.size());
+  std::size_t pairs = 0;
+  std::uint64_t tags = 0;
+  for (std::uint32_t q : list)
+    if (q < p && takes_part(usable, q) && !needed[q]) {
+      scratch.targets.set(pairs++, cloud.xyz[q], cloud.normals[q]);
+      tags += tag(q);
+    }
+  if (pairs == 0) return tags;
+  detail::pair_bins_batch(cloud.xyz[p], cloud.normals[p], scratch.targets, scratch.pad(pairs),
+                          kBins, scratch.alpha.data(), scratch.phi.data(), scratch.theta.data());
+  for (std::size_t j = 0; j < pairs; ++j) {
+    ++counts[scratch.alpha[j]];
+    ++counts[kBins + scratch.phi[j]];
+    ++counts[2 * kBins + scratch.theta[j]];
+  }
+  return tags;
+}
+
 // Squared distance, recomputed the same way for cached and searched lists so that the weights
 // never depend on which of the two a point got.
 inline float squared_distance(const Vec3f& a, const Vec3f& b) {
@@ -392,9 +419,16 @@ class FpfhRun {
               for (int b = 0; b < kFpfhSize; ++b) counts[b] += row[b];
             }
             float* row = &spfh_[p * kFpfhSize];
-            if (cut[p] || received != expected[p] || neighbor_count_[p] > kMaxCountedNeighbors) {
-              std::span<const std::uint32_t> list;
+            bool counted = !cut[p] && neighbor_count_[p] <= kMaxCountedNeighbors;
+            std::span<const std::uint32_t> list;
+            if (counted && received != expected[p] && subset_) {
+              // On the subset's band: only the pairs with the lower neighbours pass 1 skipped.
               if (!cache_.load(p, list)) list = neighbors_of(p, scratch.list);
+              received += count_skipped_lower_pairs(cloud_, p, list, usable_or_all_, needed_,
+                                                    scratch, counts);
+            }
+            if (!counted || received != expected[p]) {
+              if (list.empty() && !cache_.load(p, list)) list = neighbors_of(p, scratch.list);
               compute_spfh(cloud_, p, list, usable_or_all_, neighbor_count_[p], scratch, row);
             } else {
               const float* sum_of = scratch.sums.for_neighbors(neighbor_count_[p]);

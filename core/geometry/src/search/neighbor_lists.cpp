@@ -172,8 +172,30 @@ std::span<const std::uint32_t> NeighborLists::view(std::size_t i, const Neighbor
     if (shared(i, scratch, indices, sq_dists, count) &&
         (hood.max_neighbors == 0 || count < std::size_t(hood.max_neighbors)))
       return {indices, count};
+    find(i, hood, scratch);
+    return scratch.indices;
   }
-  find(i, hood, scratch);
+  if (!(hood.radius > 0.0f) || hood.radius > hood_.radius)
+    throw std::invalid_argument("neighbour lists of radius " + std::to_string(hood_.radius) +
+                                " cannot answer " + hood.describe());
+  // A smaller radius: find()'s filter, writing the indices alone (no distances to copy). A list
+  // searched again lands in `scratch` itself and is compacted in place (kept <= p).
+  const std::uint32_t* indices = nullptr;
+  const float* sq_dists = nullptr;
+  std::size_t count = 0;
+  if (shared(i, scratch, indices, sq_dists, count)) {
+    const float sq_radius = hood.radius * hood.radius;
+    if (indices != scratch.indices.data()) scratch.indices.resize(count);
+    std::uint32_t* out = scratch.indices.data();
+    std::size_t kept = 0;
+    for (std::size_t p = 0; p < count; ++p) {
+      out[kept] = indices[p];
+      kept += sq_dists[p] < sq_radius;  // the search's comparison, as in find()
+    }
+    scratch.indices.resize(kept);
+    if (hood.max_neighbors == 0 || kept < std::size_t(hood.max_neighbors)) return scratch.indices;
+  }
+  search_.find(points_[i], hood, scratch, /*sorted=*/false);
   return scratch.indices;
 }
 

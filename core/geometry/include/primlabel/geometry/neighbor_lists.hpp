@@ -47,8 +47,9 @@ class NeighborLists {
   void find(std::size_t i, const Neighborhood& hood, NeighborList& out) const;
 
   // The indices find(i, hood) gives, in its order, without a copy when the kept shared list is
-  // the answer as it is (a radius neighbourhood of the lists' own radius); otherwise find()
-  // writes them into `scratch`. Valid while this object and `scratch` are. Thread-safe.
+  // the answer as it is (a radius neighbourhood of the lists' own radius); otherwise they are
+  // written into scratch.indices (for a smaller radius the indices alone: scratch.sq_dists is
+  // then not the answer's). Valid while this object and `scratch` are. Thread-safe.
   std::span<const std::uint32_t> view(std::size_t i, const Neighborhood& hood,
                                       NeighborList& scratch) const;
 
