@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <stdexcept>
 
 #include "primlabel/tabletop/segmentation_eval.hpp"
@@ -40,6 +41,7 @@ void expect_split(const PointCloud& cloud, std::size_t objects) {
 }
 
 constexpr std::uint32_t kRed = 0xC81E1E;
+constexpr std::uint32_t kBlue = 0x1E5AC8;
 
 TEST(TabletopShapeSplit, CanAgainstABoxOfItsHeightAndColourIsSplit) {
   // The can touches the box's right face (0.5 mm apart); both are 12 cm tall and red.
@@ -82,6 +84,28 @@ TEST(TabletopShapeSplit, APotKeepsItsHandle) {
   EXPECT_GT(evaluate_segmentation(cloud, result).mean_object_iou, 0.95);
 }
 
+TEST(TabletopShapeSplit, StackOfOneFootprintIsCutAtItsColourSeam) {
+  // A blue box on a red box of the same footprint: one plane fits each side of both, and no
+  // strip of the lower top is seen beside the upper box for the stacked split.
+  const PointCloud stack = scan({{{-0.06f, 0.15f, 0.0f}, {0.06f, 0.25f, 0.08f}, 20, kRed},
+                                 {{-0.06f, 0.15f, 0.08f}, {0.06f, 0.25f, 0.15f}, 30, kBlue}});
+  expect_split(stack, 2);
+  // Of one colour, nothing tells them apart.
+  const PointCloud one_colour = scan({{{-0.06f, 0.15f, 0.0f}, {0.06f, 0.25f, 0.08f}, 20, kRed},
+                                      {{-0.06f, 0.15f, 0.08f}, {0.06f, 0.25f, 0.15f}, 30, kRed}});
+  const TabletopResult result = segment_tabletop(one_colour, given_up(true), RunContext{2});
+  ASSERT_TRUE(result.ok()) << result.message;
+  EXPECT_EQ(result.clusters.size(), 1u);
+}
+
+TEST(TabletopShapeSplit, SurfacesOfTwoEvenColoursInOnePlaneAreCut) {
+  // Two boxes of one height side by side, 0.5 mm apart, their fronts and tops in one plane each:
+  // no crease between them, one fitted plane across both, a red half and a blue half.
+  expect_split(scan({{{-0.12f, 0.15f, 0.0f}, {0.0f, 0.25f, 0.10f}, 20, kRed},
+                     {{0.0005f, 0.15f, 0.0f}, {0.12f, 0.25f, 0.10f}, 30, kBlue}}),
+               2);
+}
+
 TEST(TabletopShapeSplit, SameResultForAnyThreadCount) {
   const PointCloud cloud = scan({{{-0.15f, 0.10f, 0.0f}, {0.0f, 0.22f, 0.12f}, 20, kRed}},
                                 {{0.0405f, 0.16f, 0.04f, 0.0f, 0.12f, 30, kRed}});
@@ -96,20 +120,31 @@ TEST(TabletopShapeSplit, UnorganisedCloudsAreReturnedAsTheyAre) {
   cloud.width = static_cast<std::uint32_t>(cloud.size());
   cloud.height = 1;
   const std::vector<std::vector<std::uint32_t>> clusters = {{0, 1, 2}, {5}};
-  EXPECT_EQ(split_by_shape(cloud, clusters, ShapeSplitOptions{}),
+  EXPECT_EQ(split_by_shape(cloud, {}, Vec3f::UnitZ(), clusters, ShapeSplitOptions{}),
             (std::vector<std::vector<std::uint32_t>>{{0, 1, 2}, {5}}));
 }
 
 TEST(TabletopShapeSplit, BadOptionsAreRejected) {
   ShapeSplitOptions options;
   options.noise_sigmas = 0.0f;
-  EXPECT_THROW(split_by_shape(PointCloud{}, {}, options), std::invalid_argument);
+  EXPECT_THROW(split_by_shape(PointCloud{}, {}, Vec3f::UnitZ(), {}, options),
+               std::invalid_argument);
   options = {};
   options.outside_share = 1.0f;
   EXPECT_THROW(options.validate(), std::invalid_argument);
   options = {};
   options.max_radius = options.min_radius;
   EXPECT_THROW(options.validate(), std::invalid_argument);
+  options = {};
+  options.seam_explained = 1.0f;
+  EXPECT_THROW(options.validate(), std::invalid_argument);
+  options = {};
+  options.material_separation = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(options.validate(), std::invalid_argument);
+  // An organised cloud needs a height for every point.
+  PointCloud organised = scan({{{-0.15f, 0.10f, 0.0f}, {0.0f, 0.22f, 0.12f}, 20, kRed}});
+  EXPECT_THROW(split_by_shape(organised, {}, Vec3f::UnitZ(), {{0, 1}}, ShapeSplitOptions{}),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "disjoint_sets.hpp"
 #include "primlabel/geometry/parallel.hpp"
 #include "primlabel/primitives/fitters.hpp"
+#include "surface_colour.hpp"
 
 namespace primlabel::tabletop {
 
@@ -37,6 +38,13 @@ void ShapeSplitOptions::validate() const {
     fail("shape split outside share must be in (0, 1)");
   if (min_instance_points < 3) fail("shape split instances need at least 3 points");
   if (max_instances < 1) fail("shape split needs at least one instance per cluster");
+  if (!(seam_explained > 0.0f && seam_explained < 1.0f))
+    fail("shape split seam share must be in (0, 1)");
+  positive(seam_chromaticity_step, "seam chromaticity step");
+  positive(seam_min_rise, "seam rise");
+  positive(material_separation, "material separation");
+  if (!(upright_deg > 0.0f && upright_deg < 90.0f))
+    fail("shape split upright angle must be in (0, 90) degrees");
 }
 
 namespace {
@@ -64,8 +72,12 @@ struct Instance {
 
 class ShapeSplitter {
  public:
-  ShapeSplitter(const PointCloud& cloud, const ShapeSplitOptions& options)
+  ShapeSplitter(const PointCloud& cloud, const std::vector<float>& height, const Vec3f& up,
+                const ShapeSplitOptions& options)
       : xyz_(cloud.xyz),
+        rgba_(cloud.rgba),
+        height_of_(height),
+        up_(up.cast<double>().normalized()),
         width_(int(cloud.width)),
         height_(int(cloud.height)),
         viewpoint_(cloud.viewpoint.origin),
@@ -78,9 +90,14 @@ class ShapeSplitter {
     cluster_ = &cluster;
     for (std::uint32_t k = 0; k < cluster.size(); ++k) local_[cluster[k]] = k;
     set_band();
+    colour_apart_.clear();
     grid_normals();
     fit_instances();
     cut_planes_by_cans();
+    if (!rgba_.empty()) {
+      cut_at_colour_seams();
+      cut_mixed_materials();
+    }
     assign_the_rest();
     auto pieces = join_instances();
     for (std::uint32_t i : cluster) {
@@ -458,6 +475,129 @@ class ShapeSplitter {
     }
   }
 
+  bool upright(const Instance& instance) const {
+    const double sine = std::sin(options_.upright_deg * kDegree);
+    if (instance.kind == Instance::Kind::kPlane) return std::abs(instance.normal.dot(up_)) <= sine;
+    if (instance.kind == Instance::Kind::kConvexCylinder)
+      return std::abs(instance.axis.dot(up_)) >= std::cos(options_.upright_deg * kDegree);
+    return false;
+  }
+
+  colour::TwoColourRule colour_rule() const {
+    colour::TwoColourRule rule;
+    rule.explained = options_.seam_explained;
+    rule.step = options_.seam_chromaticity_step;
+    rule.separation = options_.material_separation;
+    rule.least = options_.min_instance_points / 2;
+    return rule;
+  }
+
+  // Two objects of one footprint stacked share their side faces' instances: every upright
+  // instance whose colour steps at one height (within the band) is cut there, and no piece below
+  // the seam may join one above it.
+  void cut_at_colour_seams() {
+    std::vector<std::pair<std::size_t, double>> seams;  // instance, height; largest first
+    for (std::size_t i = 0; i < instances_.size(); ++i) {
+      if (!upright(instances_[i])) continue;
+      std::vector<std::pair<double, Eigen::Vector2d>> samples;
+      for (std::uint32_t k : instances_[i].inliers)
+        if (const auto c = colour::chromaticity(rgba_[global(k)]))
+          samples.emplace_back(height_of_[global(k)], *c);
+      if (const auto seam =
+              colour::height_step(std::move(samples), options_.seam_min_rise, colour_rule()))
+        seams.emplace_back(i, *seam);
+    }
+    std::stable_sort(seams.begin(), seams.end(), [&](const auto& a, const auto& b) {
+      return instances_[a.first].inliers.size() > instances_[b.first].inliers.size();
+    });
+    std::vector<bool> done(seams.size(), false);
+    for (std::size_t s = 0; s < seams.size(); ++s) {
+      if (done[s]) continue;
+      const double at_height = seams[s].second;
+      std::vector<std::uint32_t> below, above;
+      for (std::size_t t = s; t < seams.size(); ++t) {
+        if (done[t] || std::abs(seams[t].second - at_height) > band_) continue;
+        done[t] = true;
+        Instance& instance = instances_[seams[t].first];
+        Instance upper = instance;
+        upper.inliers.clear();
+        std::vector<std::uint32_t> lower;
+        for (std::uint32_t k : instance.inliers)
+          (height_of_[global(k)] > at_height ? upper.inliers : lower).push_back(k);
+        instance.inliers = std::move(lower);
+        const std::uint32_t id = std::uint32_t(instances_.size());
+        for (std::uint32_t k : upper.inliers) owner_[k] = id;
+        below.push_back(std::uint32_t(seams[t].first));
+        above.push_back(id);
+        instances_.push_back(std::move(upper));
+      }
+      // The other instances lying wholly below or above the seam (the lower box's face the upper
+      // one hides, the upper box's top) take their side too.
+      const std::size_t cut_end = instances_.size();
+      for (std::size_t i = 0; i < cut_end; ++i) {
+        const auto& inliers = instances_[i].inliers;
+        if (inliers.empty() || std::count(below.begin(), below.end(), i) ||
+            std::count(above.begin(), above.end(), i))
+          continue;
+        const auto [low, high] = std::minmax_element(
+            inliers.begin(), inliers.end(), [&](std::uint32_t a, std::uint32_t b) {
+              return height_of_[global(a)] < height_of_[global(b)];
+            });
+        if (height_of_[global(*high)] <= at_height + band_)
+          below.push_back(std::uint32_t(i));
+        else if (height_of_[global(*low)] >= at_height - band_)
+          above.push_back(std::uint32_t(i));
+      }
+      for (std::uint32_t a : below)
+        for (std::uint32_t b : above) colour_apart_.emplace_back(a, b);
+    }
+  }
+
+  // A fitted surface through two objects of different even colours (a box's top in the plane of
+  // the book leaning on it) is two surfaces, which never join.
+  void cut_mixed_materials() {
+    const std::size_t fitted = instances_.size();
+    for (std::size_t i = 0; i < fitted; ++i) {
+      Instance& instance = instances_[i];
+      if (instance.kind == Instance::Kind::kNoSolid) continue;
+      std::vector<std::uint32_t> counted;
+      std::vector<Eigen::Vector2d> colours;
+      for (std::uint32_t k : instance.inliers)
+        if (const auto c = colour::chromaticity(rgba_[global(k)])) {
+          counted.push_back(k);
+          colours.push_back(*c);
+        }
+      const auto group = colour::two_materials(colours, colour_rule());
+      if (!group) continue;
+      // Pixels too dark to tell stay with the first group; the second becomes an instance.
+      Instance second = instance;
+      second.inliers.clear();
+      for (std::size_t k = 0; k < counted.size(); ++k)
+        if ((*group)[k]) second.inliers.push_back(counted[k]);
+      std::vector<std::uint32_t> first;
+      std::set_difference(instance.inliers.begin(), instance.inliers.end(), second.inliers.begin(),
+                          second.inliers.end(), std::back_inserter(first));
+      instance.inliers = std::move(first);
+      const std::uint32_t id = std::uint32_t(instances_.size());
+      for (std::uint32_t k : second.inliers) owner_[k] = id;
+      colour_apart_.emplace_back(std::uint32_t(i), id);
+      instances_.push_back(std::move(second));
+    }
+  }
+
+  // Per instance: its material; none for instances without a solid or too small to tell.
+  std::vector<colour::Material> instance_materials() const {
+    std::vector<colour::Material> materials(instances_.size());
+    for (std::size_t i = 0; i < instances_.size(); ++i) {
+      if (instances_[i].kind == Instance::Kind::kNoSolid) continue;
+      std::vector<Eigen::Vector2d> colours;
+      for (std::uint32_t k : instances_[i].inliers)
+        if (const auto c = colour::chromaticity(rgba_[global(k)])) colours.push_back(*c);
+      materials[i] = colour::material_of(colours, options_.min_object_points / 2);
+    }
+    return materials;
+  }
+
   struct PieceStats {
     std::size_t size = 0;
   };
@@ -525,14 +665,23 @@ class ShapeSplitter {
     // What lies outside a can is never joined to it, even through a third instance (the lid of a
     // can beside a box of its height touches the box's top): joins go by contact length, longest
     // first, each only when no can and an instance outside it would end up together.
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> apart;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> apart = colour_apart_;
+    const auto materials = instance_materials();
     for (std::uint32_t a = 0; a < n; ++a)
       for (std::uint32_t b = a + 1; b < n; ++b)
-        if (separate(a, b)) apart.emplace_back(a, b);
+        if (separate(a, b) || colour::different(materials[a], materials[b], colour_rule()))
+          apart.emplace_back(a, b);
     std::vector<std::pair<std::pair<std::uint32_t, std::uint32_t>, std::size_t>> joins(
         contact.begin(), contact.end());
-    std::stable_sort(joins.begin(), joins.end(),
-                     [](const auto& x, const auto& y) { return x.second > y.second; });
+    // Surfaces of one even material join first: the top of a box that a book leans on belongs
+    // with the box's sides even where it touches the book along more pixels.
+    const auto same = [&](const auto& join) {
+      return colour::same(materials[join.first.first], materials[join.first.second], colour_rule());
+    };
+    std::stable_sort(joins.begin(), joins.end(), [&](const auto& x, const auto& y) {
+      const bool sx = same(x), sy = same(y);
+      return sx != sy ? sx : x.second > y.second;
+    });
     for (const auto& [pair, count] : joins) {
       const std::uint32_t a = objects.find(pair.first), b = objects.find(pair.second);
       if (a == b) continue;
@@ -568,6 +717,9 @@ class ShapeSplitter {
   }
 
   const std::vector<Vec3f>& xyz_;
+  const std::vector<std::uint32_t>& rgba_;
+  const std::vector<float>& height_of_;  // per input point: above the table
+  Vec3d up_;
   int width_, height_;
   Vec3f viewpoint_;
   const ShapeSplitOptions& options_;
@@ -579,26 +731,30 @@ class ShapeSplitter {
   std::vector<std::uint32_t> owner_;                              // per cluster point: its instance
   std::map<std::uint32_t, PieceStats> stats_;                     // per piece while joining
   std::set<std::pair<std::uint32_t, std::uint32_t>> continuing_;  // (can, neighbour) running on
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> colour_apart_;  // instances colour parts
   std::vector<std::uint8_t> mark_;
 };
 
 }  // namespace
 
 std::vector<std::vector<std::uint32_t>> split_by_shape(
-    const PointCloud& cloud, std::vector<std::vector<std::uint32_t>> clusters,
-    const ShapeSplitOptions& options, KeptApart* kept_apart, const RunContext& context) {
+    const PointCloud& cloud, const std::vector<float>& height, const Vec3f& up,
+    std::vector<std::vector<std::uint32_t>> clusters, const ShapeSplitOptions& options,
+    KeptApart* kept_apart, const RunContext& context) {
   options.validate();
   if (kept_apart) *kept_apart = {};
   std::vector<std::vector<std::uint32_t>> out;
   if (!options.enabled || !cloud.organized()) {
     out = std::move(clusters);
   } else {
+    if (height.size() != cloud.size())
+      throw std::invalid_argument("shape split needs a height above the table for every point");
     // Clusters are independent: one splitter (with its image-sized buffers) per thread, the
     // pieces gathered in cluster order, so the result is the same for any thread count.
     std::vector<std::vector<std::vector<std::uint32_t>>> split(clusters.size());
     detail::parallel_for(
         std::ptrdiff_t(clusters.size()), context.threads, detail::Schedule::Dynamic(1),
-        [&] { return std::make_unique<ShapeSplitter>(cloud, options); },
+        [&] { return std::make_unique<ShapeSplitter>(cloud, height, up, options); },
         [&](std::unique_ptr<ShapeSplitter>& splitter, std::ptrdiff_t c) {
           if (!clusters[c].empty() && !context.stopped()) split[c] = splitter->split(clusters[c]);
         });

@@ -217,7 +217,8 @@ std::vector<std::vector<std::uint32_t>> refine_objects(
     const RunContext& context) {
   clusters = split_at_concave_creases(cloud, std::move(clusters), options.creases);
   KeptApart other_objects;
-  clusters = split_by_shape(cloud, std::move(clusters), options.shapes, &other_objects, context);
+  clusters = split_by_shape(cloud, surface.height, surface.plane.head<3>(), std::move(clusters),
+                            options.shapes, &other_objects, context);
   clusters =
       split_stacked(cloud.xyz, surface.height, surface.plane, std::move(clusters), options.split);
   return merge_occluded(cloud, surface.height, *surface.band_grid, std::move(clusters),

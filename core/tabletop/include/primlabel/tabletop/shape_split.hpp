@@ -11,6 +11,13 @@
 // A plane through a can's lid and the top of a box of the can's height is cut by the can's solid
 // into the lid and the rest. Points no instance took join the instance they touch in the image.
 //
+// Two objects of one footprint stacked (a box on a box, a can on a can of its radius) share their
+// side faces' fitted planes or cylinder. Where the cloud has colour, such an upright instance is
+// cut at a colour seam: a height at which its material (mean chromaticity) changes from one
+// colour below to another above, explaining most of its colour variation (a printed face changes
+// colour in many places and directions, so no one horizontal line explains it). Every upright
+// instance showing the seam at that height is cut, and no piece below it joins one above.
+//
 // A can's surface bounds its solid all round, so what lies outside it is another object: a
 // fitted instance (plane or can) is kept apart from an object-sized can when most of it lies
 // beyond the can's radius by more than the band, it reaches farther from the axis than the can's
@@ -50,18 +57,28 @@ struct ShapeSplitOptions {
   float max_neighbour_gap = 0.015f;               // pixels farther apart in 3D do not touch (m)
   float outside_share = 0.5f;  // of an instance's inliers outside a touching can: another object
   std::size_t min_object_points = 400;  // both sides of a cut (and a can) hold this many points
+  // Colour seams: the step's share of an upright instance's chromaticity variance, the least
+  // step between the mean chromaticities, and the least height of either part (m).
+  float seam_explained = 0.8f;
+  float seam_chromaticity_step = 0.05f;
+  float seam_min_rise = 0.02f;
+  // Two fitted surfaces of even colours this many spreads apart (and a seam step) never join.
+  float material_separation = 4.0f;
+  float upright_deg =
+      20.0f;  // upright: a plane's normal, a cylinder's axis within this of level/up
   std::uint64_t seed = 1;
 
   void validate() const;  // throws std::invalid_argument naming the bad option
 };
 
 // Organised clouds only (grid normals face the sensor); others are returned as they are.
+// `height` holds every clustered point's signed distance above the table, whose normal is `up`.
 // Returns the clusters with each cut where a can meets what lies outside it: input indices
 // ascending within each piece, pieces ordered by size (largest first, ties by first index).
 // `kept_apart`, when given, is set to the pieces of every cut cluster.
 std::vector<std::vector<std::uint32_t>> split_by_shape(
-    const PointCloud& cloud, std::vector<std::vector<std::uint32_t>> clusters,
-    const ShapeSplitOptions& options, KeptApart* kept_apart = nullptr,
-    const RunContext& context = {});
+    const PointCloud& cloud, const std::vector<float>& height, const Vec3f& up,
+    std::vector<std::vector<std::uint32_t>> clusters, const ShapeSplitOptions& options,
+    KeptApart* kept_apart = nullptr, const RunContext& context = {});
 
 }  // namespace primlabel::tabletop
