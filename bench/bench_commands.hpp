@@ -17,5 +17,6 @@ BenchCommand add_primitives_command(CLI::App& parent);  // primitives_bench.cpp
 BenchCommand add_can_radii_command(CLI::App& parent);   // can_radii_bench.cpp
 BenchCommand add_scaling_command(CLI::App& parent);     // scaling_bench.cpp
 BenchCommand add_client_command(CLI::App& parent);      // client_bench.cpp
+BenchCommand add_organised_command(CLI::App& parent);   // organised_bench.cpp
 
 }  // namespace primlabel::bench

@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
        add_primitives_command(app),
        add_can_radii_command(app),
        add_scaling_command(app),
-       add_client_command(app)},
+       add_client_command(app),
+       add_organised_command(app)},
       version, argc, argv);
 }
