@@ -177,6 +177,9 @@ class ShapeSplitter {
     settings.max_scoring_points = plane ? 600 : 300;
     settings.max_refine_points = 800;  // plenty for 5 parameters; least squares dominated
     settings.refine_iterations = 10;
+    // The round's own plane competes with each cylinder (the larger connected piece wins), so
+    // the fitter's refit of a plane to judge a cylinder is not needed: same objects, -4% a frame.
+    settings.prefer_simpler = false;
     settings.min_radius = options_.min_radius;
     settings.max_radius = options_.max_radius;
     return settings;

@@ -4,12 +4,13 @@
 // misses: at a tangent contact the two surfaces run on parallel, so no sharp fold is seen.
 //
 // The cluster is over-segmented into fitted instances: planes and cylinders taken one after the
-// other by MSAC (primitives::fit_model; a cylinder only when its description length beats a
-// plane's, and only as one unbroken arc of at least 90 degrees around its axis, as a can's side
-// is seen; a rounded edge bends less, a cylinder through strips of two faces leaves a gap), each
-// instance the image-connected piece of its inliers, with per-point normals from the pixel grid.
-// A plane through a can's lid and the top of a box of the can's height is cut by the can's solid
-// into the lid and the rest. Points no instance took join the instance they touch in the image.
+// other by MSAC (primitives::fit_model; each round keeps the plane or the cylinder whose
+// connected piece is larger, a cylinder only as one unbroken arc of at least 90 degrees around
+// its axis, as a can's side is seen; a rounded edge bends less, a cylinder through strips of two
+// faces leaves a gap), each instance the image-connected piece of its inliers, with per-point
+// normals from the pixel grid. A plane through a can's lid and the top of a box of the can's height
+// is cut by the can's solid into the lid and the rest. Points no instance took join the instance
+// they touch in the image.
 //
 // Two objects of one footprint stacked (a box on a box, a can on a can of its radius) share their
 // side faces' fitted planes or cylinder. Where the cloud has colour, such an upright instance is
