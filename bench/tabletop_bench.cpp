@@ -37,7 +37,7 @@ using namespace primlabel::tabletop;
 
 struct Arguments {
   std::vector<std::string> inputs;
-  bool compare_pcl = false, no_crease_split = false, no_shape_split = false;
+  bool compare_pcl = false, no_crease_split = false, no_shape_split = false, no_colour = false;
   int threads = 2, repeat = 5;
 };
 
@@ -215,6 +215,7 @@ int run_tabletop_bench(const Arguments& args) {
   TabletopOptions options;
   options.creases.enabled = !args.no_crease_split;
   options.shapes.enabled = !args.no_shape_split;
+  options.shapes.use_colour = !args.no_colour;
   const RunContext context{args.threads};
   std::vector<std::string> methods = {"ours"};
   if (args.compare_pcl) {
@@ -318,7 +319,8 @@ BenchCommand add_tabletop_command(CLI::App& parent) {
   cmd->add_flag("--no-crease-split", args->no_crease_split,
                 "ours without the cut at concave creases (the previous pipeline)");
   cmd->add_flag("--no-shape-split", args->no_shape_split,
-                "ours without the cut where fitted shapes meet concavely");
+                "ours without the cut where fitted shapes or colours meet");
+  cmd->add_flag("--no-colour", args->no_colour, "ours with the shape split but no colour evidence");
   cmd->add_option("--threads", args->threads, "threads for primlabel (PCL's steps are serial)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--repeat", args->repeat, "runs per scene; the fastest counts")

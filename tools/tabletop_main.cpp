@@ -187,11 +187,13 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--min-cluster-size", min_size, "smallest object (points)");
   app.add_option("--max-cluster-size", max_size, "largest object (points)");
-  bool no_split = false, no_merge = false, no_creases = false, no_shapes = false;
+  bool no_split = false, no_merge = false, no_creases = false, no_shapes = false, no_colour = false;
   app.add_flag("--no-crease-split", no_creases,
                "keep touching objects in one cluster (no cut at concave creases)");
   app.add_flag("--no-shape-split", no_shapes,
-               "keep touching objects whose fitted shapes meet concavely in one cluster");
+               "keep touching objects in one cluster where their fitted shapes or colours meet");
+  app.add_flag("--no-colour", no_colour,
+               "shape split without colour evidence (colour not registered to depth)");
   app.add_flag("--no-split", no_split, "keep objects standing on objects in one cluster");
   app.add_flag("--no-merge", no_merge, "do not join parts of objects cut apart by occlusion");
   app.add_option("--voxel-leaf", o.voxel_leaf, "fit and cluster on voxel centroids (m; 0 = off)")
@@ -212,6 +214,7 @@ int main(int argc, char** argv) {
   try {
     o.creases.enabled = !no_creases;
     o.shapes.enabled = !no_shapes;
+    o.shapes.use_colour = !no_colour;
     o.split.enabled = !no_split;
     o.merge.enabled = !no_merge;
     o.clusters.min_size = min_size;

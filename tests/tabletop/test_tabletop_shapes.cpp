@@ -90,6 +90,12 @@ TEST(TabletopShapeSplit, StackOfOneFootprintIsCutAtItsColourSeam) {
   const PointCloud stack = scan({{{-0.06f, 0.15f, 0.0f}, {0.06f, 0.25f, 0.08f}, 20, kRed},
                                  {{-0.06f, 0.15f, 0.08f}, {0.06f, 0.25f, 0.15f}, 30, kBlue}});
   expect_split(stack, 2);
+  // Without colour evidence (colour not registered to depth), nothing tells them apart.
+  TabletopOptions no_colour = given_up(true);
+  no_colour.shapes.use_colour = false;
+  const TabletopResult blind = segment_tabletop(stack, no_colour, RunContext{2});
+  ASSERT_TRUE(blind.ok()) << blind.message;
+  EXPECT_EQ(blind.clusters.size(), 1u);
   // Of one colour, nothing tells them apart.
   const PointCloud one_colour = scan({{{-0.06f, 0.15f, 0.0f}, {0.06f, 0.25f, 0.08f}, 20, kRed},
                                       {{-0.06f, 0.15f, 0.08f}, {0.06f, 0.25f, 0.15f}, 30, kRed}});

@@ -94,7 +94,7 @@ class ShapeSplitter {
     grid_normals();
     fit_instances();
     cut_planes_by_cans();
-    if (!rgba_.empty()) {
+    if (colour_known()) {
       cut_at_colour_seams();
       cut_mixed_materials();
     }
@@ -588,9 +588,13 @@ class ShapeSplitter {
     }
   }
 
-  // Per instance: its material; none for instances without a solid or too small to tell.
+  bool colour_known() const { return options_.use_colour && !rgba_.empty(); }
+
+  // Per instance: its material; none for instances without a solid or too small to tell, or
+  // without colour.
   std::vector<colour::Material> instance_materials() const {
     std::vector<colour::Material> materials(instances_.size());
+    if (!colour_known()) return materials;
     for (std::size_t i = 0; i < instances_.size(); ++i) {
       if (instances_[i].kind == Instance::Kind::kNoSolid) continue;
       std::vector<Eigen::Vector2d> colours;

@@ -58,6 +58,9 @@ struct ShapeSplitOptions {
   float max_neighbour_gap = 0.015f;               // pixels farther apart in 3D do not touch (m)
   float outside_share = 0.5f;  // of an instance's inliers outside a touching can: another object
   std::size_t min_object_points = 400;  // both sides of a cut (and a can) hold this many points
+  // Colour evidence (seams, two-colour surfaces, joins) where the cloud has colour; off for
+  // scans whose colour is not registered to their depth.
+  bool use_colour = true;
   // Colour seams: the step's share of an upright instance's chromaticity variance, the least
   // step between the mean chromaticities, and the least height of either part (m).
   float seam_explained = 0.8f;
