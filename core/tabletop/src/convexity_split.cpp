@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "disjoint_sets.hpp"
+#include "surface_colour.hpp"
 
 namespace primlabel::tabletop {
 
@@ -138,14 +139,11 @@ class CreaseSplitter {
       }
       const std::uint32_t i = cluster[local];
       patches_.back().members.push_back(i);
-      if (!rgba_.empty()) {
-        const std::uint32_t c = rgba_[i];
-        const double r = (c >> 16) & 0xFF, g = (c >> 8) & 0xFF, b = c & 0xFF;
-        if (r + g + b >= 60.0) {  // darker pixels do not tell a material
-          patches_.back().chroma_sum += Eigen::Vector2d(r, g) / (r + g + b);
+      if (!rgba_.empty())
+        if (const auto chroma = colour::chromaticity(rgba_[i])) {
+          patches_.back().chroma_sum += *chroma;
           ++patches_.back().chroma_count;
         }
-      }
       const Eigen::Vector3d p = points_[i].cast<double>() - origin_;
       Moments& m = moments.back();
       ++m.count;

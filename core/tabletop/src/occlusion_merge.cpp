@@ -9,6 +9,7 @@
 #include <string>
 
 #include "primlabel/tabletop/convex_hull.hpp"
+#include "surface_colour.hpp"
 
 namespace primlabel::tabletop {
 
@@ -122,13 +123,11 @@ Eigen::Vector2f chromaticity(const std::vector<std::uint32_t>& cluster, const Po
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
   std::size_t counted = 0;
   if (cloud.has_rgba())
-    for (std::uint32_t i : cluster) {
-      const std::uint32_t c = cloud.rgba[i];
-      const double r = (c >> 16) & 0xFF, g = (c >> 8) & 0xFF, b = c & 0xFF;
-      if (r + g + b < 60.0) continue;
-      sum += Eigen::Vector2d(r, g) / (r + g + b);
-      ++counted;
-    }
+    for (std::uint32_t i : cluster)
+      if (const auto chroma = colour::chromaticity(cloud.rgba[i])) {
+        sum += *chroma;
+        ++counted;
+      }
   if (counted == 0) return Eigen::Vector2f::Constant(std::numeric_limits<float>::quiet_NaN());
   return (sum / double(counted)).cast<float>();
 }

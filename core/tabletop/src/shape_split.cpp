@@ -674,16 +674,17 @@ class ShapeSplitter {
     // first, each only when no can and an instance outside it would end up together.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> apart = colour_apart_;
     const auto materials = instance_materials();
+    const colour::TwoColourRule rule = colour_rule();
     for (std::uint32_t a = 0; a < n; ++a)
       for (std::uint32_t b = a + 1; b < n; ++b)
-        if (separate(a, b) || colour::different(materials[a], materials[b], colour_rule()))
+        if (separate(a, b) || colour::different(materials[a], materials[b], rule))
           apart.emplace_back(a, b);
     std::vector<std::pair<std::pair<std::uint32_t, std::uint32_t>, std::size_t>> joins(
         contact.begin(), contact.end());
     // Surfaces of one even material join first: the top of a box that a book leans on belongs
     // with the box's sides even where it touches the book along more pixels.
     const auto same = [&](const auto& join) {
-      return colour::same(materials[join.first.first], materials[join.first.second], colour_rule());
+      return colour::same(materials[join.first.first], materials[join.first.second], rule);
     };
     std::stable_sort(joins.begin(), joins.end(), [&](const auto& x, const auto& y) {
       const bool sx = same(x), sy = same(y);

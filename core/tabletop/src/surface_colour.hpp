@@ -1,6 +1,7 @@
 #pragma once
-// Colour evidence for the shape split: a fitted surface's material is its pixels' chromaticity
-// (r, g) / (r + g + b), which its shading scales away. Pixels too dark to tell are not counted.
+// Colour evidence for the table-top refinements (the crease cut, the shape split, the occlusion
+// merge): a surface's material is its pixels' chromaticity (r, g) / (r + g + b), which its
+// shading scales away. Pixels too dark to tell are not counted.
 
 #include <Eigen/Core>
 #include <cstddef>

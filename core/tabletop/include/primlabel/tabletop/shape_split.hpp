@@ -17,7 +17,9 @@
 // cut at a colour seam: a height at which its material (mean chromaticity) changes from one
 // colour below to another above, explaining most of its colour variation (a printed face changes
 // colour in many places and directions, so no one horizontal line explains it). Every upright
-// instance showing the seam at that height is cut, and no piece below it joins one above.
+// instance showing the seam at that height is cut, and no piece below it joins one above. A
+// surface of two even colours (a box's top in one plane with the book leaning on it) is cut in
+// two, and surfaces of even, clearly different colours never join.
 //
 // A can's surface bounds its solid all round, so what lies outside it is another object: a
 // fitted instance (plane or can) is kept apart from an object-sized can when most of it lies
@@ -68,8 +70,8 @@ struct ShapeSplitOptions {
   float seam_min_rise = 0.02f;
   // Two fitted surfaces of even colours this many spreads apart (and a seam step) never join.
   float material_separation = 4.0f;
-  float upright_deg =
-      20.0f;  // upright: a plane's normal, a cylinder's axis within this of level/up
+  // Upright: a plane's normal within this of level, a cylinder's axis within this of up.
+  float upright_deg = 20.0f;
   std::uint64_t seed = 1;
 
   void validate() const;  // throws std::invalid_argument naming the bad option
