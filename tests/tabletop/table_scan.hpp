@@ -1,6 +1,7 @@
 #pragma once
-// Organised table-top scans for the table-top tests: boxes and upright cans on a table, ray-cast
-// from a Kinect-like camera (shared by the crease-cut and refinement tests).
+// Organised table-top scans for the table-top tests: boxes, upright cans, balls and boxes with
+// rounded edges on a table, ray-cast from a Kinect-like camera (shared by the crease-cut,
+// shape-split and refinement tests).
 
 #include <cmath>
 #include <cstdint>
@@ -21,6 +22,50 @@ struct Can {  // upright cylinder standing on z = base
   float x, y, radius, base, top;
   std::uint32_t label, rgb;
 };
+
+struct Ball {  // resting on the table (z = 0)
+  float x, y, radius;
+  std::uint32_t label, rgb;
+};
+
+// A box [lo, hi] with every edge and corner rounded to `radius` (its faces' flat parts shrink
+// by it).
+struct RoundedBox {
+  Vec3f lo, hi;
+  float radius;
+  std::uint32_t label, rgb;
+};
+
+inline float hit_ball(const Ball& ball, const Vec3f& eye, const Vec3f& ray) {
+  const Vec3f o = eye - Vec3f(ball.x, ball.y, ball.radius);
+  const float b = o.dot(ray), c = o.squaredNorm() - ball.radius * ball.radius;
+  const float disc = b * b - c;
+  if (disc < 0) return std::numeric_limits<float>::infinity();
+  const float t = -b - std::sqrt(disc);
+  return t > 0 ? t : std::numeric_limits<float>::infinity();
+}
+
+// Sphere tracing of the rounded box's distance field from where the ray enters its bounds.
+inline float hit_rounded_box(const RoundedBox& box, const Vec3f& eye, const Vec3f& ray) {
+  const float none = std::numeric_limits<float>::infinity();
+  float t0 = 0.0f, t1 = none;
+  for (int a = 0; a < 3; ++a) {
+    const float ta = (box.lo[a] - eye[a]) / ray[a], tb = (box.hi[a] - eye[a]) / ray[a];
+    t0 = std::max(t0, std::min(ta, tb));
+    t1 = std::min(t1, std::max(ta, tb));
+  }
+  if (t0 > t1) return none;
+  const Vec3f center = 0.5f * (box.lo + box.hi);
+  const Vec3f half = 0.5f * (box.hi - box.lo) - Vec3f::Constant(box.radius);
+  float t = t0;
+  for (int step = 0; step < 200 && t <= t1 + 1e-4f; ++step) {
+    const Vec3f q = ((eye + t * ray) - center).cwiseAbs() - half;
+    const float d = q.cwiseMax(0.0f).norm() + std::min(q.maxCoeff(), 0.0f) - box.radius;
+    if (d < 1e-5f) return t;
+    t += d;
+  }
+  return none;
+}
 
 // Ray parameter of the nearest hit of an upright closed cylinder, or infinity.
 inline float hit_can(const Can& can, const Vec3f& eye, const Vec3f& ray) {
@@ -43,11 +88,12 @@ inline float hit_can(const Can& can, const Vec3f& eye, const Vec3f& ray) {
   return nearest;
 }
 
-// Boxes and cans on a 1.2 x 1.3 m table (z = 0), ray-cast into an organised 640 x 480 scan
-// (Kinect-like optics) from a camera above and in front, with mOSD labels (1 table, 10k+ object
-// k), colours and 0.5 mm noise drawn from `noise_seed`.
+// Boxes, cans, balls and rounded boxes on a 1.2 x 1.3 m table (z = 0), ray-cast into an
+// organised 640 x 480 scan (Kinect-like optics) from a camera above and in front, with mOSD
+// labels (1 table, 10k+ object k), colours and 0.5 mm noise drawn from `noise_seed`.
 inline PointCloud scan(const std::vector<Box>& boxes, const std::vector<Can>& cans = {},
-                       unsigned noise_seed = 5) {
+                       unsigned noise_seed = 5, const std::vector<Ball>& balls = {},
+                       const std::vector<RoundedBox>& rounded = {}) {
   const int width = 640, height = 480;
   const float focal = 525.0f;
   const Vec3f eye(0.0f, -0.7f, 0.6f), target(0.0f, 0.2f, 0.0f);
@@ -96,6 +142,22 @@ inline PointCloud scan(const std::vector<Box>& boxes, const std::vector<Can>& ca
           nearest = t;
           label = can.label;
           rgb = can.rgb;
+        }
+      }
+      for (const Ball& ball : balls) {
+        const float t = hit_ball(ball, eye, ray);
+        if (t < nearest) {
+          nearest = t;
+          label = ball.label;
+          rgb = ball.rgb;
+        }
+      }
+      for (const RoundedBox& box : rounded) {
+        const float t = hit_rounded_box(box, eye, ray);
+        if (t < nearest) {
+          nearest = t;
+          label = box.label;
+          rgb = box.rgb;
         }
       }
       const bool hit = std::isfinite(nearest);

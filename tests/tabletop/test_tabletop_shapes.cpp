@@ -1,10 +1,12 @@
 // Touching objects are cut where a fitted can ends and its neighbour starts (shape_split.hpp): a
 // can against a box of its height and colour, whose tangent contact the crease cut does not see.
-// Objects alone stay whole. Organised scans ray-cast from boxes and upright cans on a table
-// (table_scan.hpp).
+// Objects alone stay whole. Balls in contact, which the crease split cuts apart and the
+// occlusion merge would join, stay apart. Organised scans ray-cast from boxes, upright cans,
+// balls and rounded boxes on a table (table_scan.hpp).
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 
@@ -16,8 +18,10 @@
 namespace primlabel::tabletop {
 namespace {
 
+using test::Ball;
 using test::Box;
 using test::Can;
+using test::RoundedBox;
 using test::scan;
 
 TabletopOptions given_up(bool shapes) {
@@ -110,6 +114,37 @@ TEST(TabletopShapeSplit, SurfacesOfTwoEvenColoursInOnePlaneAreCut) {
   expect_split(scan({{{-0.12f, 0.15f, 0.0f}, {0.0f, 0.25f, 0.10f}, 20, kRed},
                      {{0.0005f, 0.15f, 0.0f}, {0.12f, 0.25f, 0.10f}, 30, kBlue}}),
                2);
+}
+
+// A ball of `radius` touching `ball` (0.5 mm apart) in the horizontal direction (dx, dy).
+Ball touching(const Ball& ball, float radius, float dx, float dy, std::uint32_t label) {
+  const float apart = ball.radius + radius + 0.0005f, rise = ball.radius - radius;
+  const float across = std::sqrt(apart * apart - rise * rise) / std::hypot(dx, dy);
+  return {ball.x + across * dx, ball.y + across * dy, radius, label, ball.rgb};
+}
+
+TEST(TabletopShapeSplit, BallsInContactAreSplit) {
+  // Two red balls of one size touching, partly one behind the other. The crease split cuts them
+  // at their contact, but the occlusion merge joins them again (one height and colour, no table
+  // seen between them) unless each ball's solid keeps the other apart.
+  const Ball ball{-0.05f, 0.20f, 0.045f, 20, kRed};
+  expect_split(scan({}, {}, 5, {ball, touching(ball, 0.045f, 0.8f, 0.6f, 30)}), 2);
+  const Ball small{0.05f, 0.15f, 0.035f, 20, kRed};
+  expect_split(scan({}, {}, 5, {small, touching(small, 0.035f, -1.0f, 1.0f, 30)}), 2);
+}
+
+TEST(TabletopShapeSplit, BallsAndRoundedBoxesAloneStayWhole) {
+  // A ball alone is one object; so are boxes whose edges are rounded to 2 and 4 cm (strips of
+  // cylinders, corners eighths of a ball of an object's size).
+  const PointCloud cloud = scan({}, {}, 5, {{-0.22f, 0.10f, 0.045f, 20, kRed}},
+                                {{{-0.10f, 0.30f, 0.0f}, {0.04f, 0.40f, 0.12f}, 0.02f, 30, kRed},
+                                 {{0.10f, 0.30f, 0.0f}, {0.24f, 0.40f, 0.12f}, 0.04f, 40, kBlue}});
+  for (const bool shapes : {false, true}) {
+    const TabletopResult result = segment_tabletop(cloud, given_up(shapes), RunContext{2});
+    ASSERT_TRUE(result.ok()) << result.message;
+    EXPECT_EQ(result.clusters.size(), 3u) << "shape split " << shapes;
+    EXPECT_GT(evaluate_segmentation(cloud, result).mean_object_iou, 0.95);
+  }
 }
 
 TEST(TabletopShapeSplit, SameResultForAnyThreadCount) {

@@ -190,14 +190,39 @@ std::vector<std::vector<std::uint32_t>> merge_occluded(
     while (root[k] != k) k = root[k] = root[root[k]];
     return k;
   };
+  // Per fitted solid (a can's, a ball's): the cluster holding it, none when no cluster does.
+  std::vector<std::int64_t> solid_cluster(kept_apart.solids.size(), -1);
+  if (!kept_apart.solids.empty()) {
+    std::vector<std::int64_t> cluster_of(cloud.size(), -1);
+    for (std::size_t k = 0; k < n; ++k)
+      for (std::uint32_t i : clusters[k]) cluster_of[i] = std::int64_t(k);
+    for (std::size_t s = 0; s < kept_apart.solids.size(); ++s)
+      solid_cluster[s] = cluster_of[kept_apart.solids[s].anchor];
+  }
+  // Whether cluster k lies outside solid s (cached: asked again as groups grow).
+  std::map<std::pair<std::size_t, std::size_t>, bool> outside;
+  const auto outside_solid = [&](std::size_t s, std::size_t k) {
+    const auto [at, added] = outside.try_emplace({s, k}, false);
+    if (added) at->second = KeptApart::outside(kept_apart.solids[s], cloud.xyz, clusters[k]);
+    return at->second;
+  };
   // Every cluster lies in one piece of whatever a refinement cut apart, so its first point tells.
+  // A cluster outside a solid another holds is another object.
   const auto held_apart = [&](std::uint32_t a, std::uint32_t b) {
-    if (kept_apart.piece.empty()) return false;
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t j = 0; j < n; ++j)
-        if (find(std::uint32_t(i)) == a && find(std::uint32_t(j)) == b &&
-            kept_apart.apart(clusters[i].front(), clusters[j].front()))
-          return true;
+    if (!kept_apart.piece.empty())
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = 0; j < n; ++j)
+          if (find(std::uint32_t(i)) == a && find(std::uint32_t(j)) == b &&
+              kept_apart.apart(clusters[i].front(), clusters[j].front()))
+            return true;
+    for (std::size_t s = 0; s < solid_cluster.size(); ++s) {
+      if (solid_cluster[s] < 0) continue;
+      const std::uint32_t own = find(std::uint32_t(solid_cluster[s]));
+      if (own != a && own != b) continue;
+      const std::uint32_t other = own == a ? b : a;
+      for (std::size_t k = 0; k < n; ++k)
+        if (find(std::uint32_t(k)) == other && outside_solid(s, k)) return true;
+    }
     return false;
   };
   for (const auto& [pair, link] : links) {

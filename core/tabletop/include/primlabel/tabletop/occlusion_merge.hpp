@@ -55,7 +55,8 @@ struct OcclusionMergeOptions {
 // ordered by size (largest first, ties by first index). Unorganised clouds are returned as they
 // are. `height` holds the signed distance above the table of every point the clusters name;
 // `table` bins the points of the table's band (the table and what touches it) in the table plane.
-// Clusters holding points `kept_apart` says are other objects are never joined.
+// Clusters holding points `kept_apart` says are other objects are never joined, nor a cluster
+// holding a ball's solid (KeptApart::solids) and one lying outside it.
 std::vector<std::vector<std::uint32_t>> merge_occluded(
     const PointCloud& cloud, const std::vector<float>& height, const PlaneGrid& table,
     std::vector<std::vector<std::uint32_t>> clusters, const OcclusionMergeOptions& options,
