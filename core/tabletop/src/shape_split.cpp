@@ -123,7 +123,7 @@ class ShapeSplitter {
     return pieces;
   }
 
-  // The balls fitted in the last cluster, for later steps (KeptApart::solids).
+  // The balls and cans fitted in the last cluster, for later steps (KeptApart::solids).
   const std::vector<KeptApart::Solid>& solids() const { return solids_; }
 
  private:
@@ -273,9 +273,11 @@ class ShapeSplitter {
 
   void record_solids() {
     for (const Instance& instance : instances_) {
-      if (instance.kind != Instance::Kind::kConvexSphere ||
+      const bool can = instance.kind == Instance::Kind::kConvexCylinder;
+      if ((instance.kind != Instance::Kind::kConvexSphere && !can) ||
           instance.inliers.size() < options_.min_object_points)
         continue;
+      if (can && rounded_box_edge(instance)) continue;
       KeptApart::Solid solid;
       solid.centre = instance.axis_point.cast<float>();
       solid.axis = instance.axis.cast<float>();
@@ -342,6 +344,80 @@ class ShapeSplitter {
       instances_.push_back(std::move(*best));
       std::erase_if(free, [&](std::uint32_t k) { return owner_[k] != kNone; });
     }
+  }
+
+  // A box's rounded edge fitted as a can: beyond one end of its arc the surface runs on as a flat
+  // face tangent to the cylinder (its plane at the radius, the axis behind it, its normal across
+  // the axis) that then leaves the cylinder. A can's arc ends at its silhouette (nothing of the
+  // cluster beyond), at its lid (a normal along the axis), or at another object (whose face has
+  // the can in front of it); a can's rim stays on its cylinder.
+  bool rounded_box_edge(const Instance& cylinder) const {
+    constexpr double kEndSpan = 10.0 * kDegree;  // the arc's end: inliers this close to it
+    constexpr int kPixelsOn = 8;                 // how far on from the end the face is read
+    constexpr std::size_t kLeastFace = 20;
+    constexpr double kFlatShare = 0.7, kLeavingShare = 0.3, kRadiusTolerance = 0.25;
+    const std::vector<std::uint32_t>& inliers = cylinder.inliers;
+    if (inliers.empty()) return false;
+    const Vec3d u = cylinder.axis.unitOrthogonal(), v = cylinder.axis.cross(u);
+    std::vector<std::pair<double, std::uint32_t>> by_angle;
+    by_angle.reserve(inliers.size());
+    for (std::uint32_t k : inliers) {
+      const Vec3d q = point(k) - cylinder.axis_point;
+      by_angle.emplace_back(std::atan2(q.dot(v), q.dot(u)), k);
+    }
+    std::sort(by_angle.begin(), by_angle.end());
+    // The arc runs from `first` over `span`: the complement of the widest empty gap.
+    std::size_t start = 0;
+    double widest = by_angle.front().first + 2 * M_PI - by_angle.back().first;
+    for (std::size_t k = 1; k < by_angle.size(); ++k)
+      if (by_angle[k].first - by_angle[k - 1].first > widest) {
+        widest = by_angle[k].first - by_angle[k - 1].first;
+        start = k;
+      }
+    const double first = by_angle[start].first, span = 2 * M_PI - widest;
+    std::vector<std::uint8_t> steps(cluster_->size(), 0);  // 0: not reached; else pixels on + 1
+    for (std::uint32_t k : inliers) steps[k] = 1;
+    for (int end = 0; end < 2; ++end) {
+      std::vector<std::uint32_t> queue, face;
+      std::vector<std::uint8_t> reached(steps);
+      for (const auto& [angle, k] : by_angle) {
+        const double along = std::fmod(angle - first + 2 * M_PI, 2 * M_PI);
+        if (end == 0 ? along <= kEndSpan : along >= span - kEndSpan) queue.push_back(k);
+      }
+      for (std::size_t q = 0; q < queue.size(); ++q) {
+        const std::uint32_t k = queue[q];
+        if (reached[k] > kPixelsOn) continue;
+        for_each_touching(k, [&](std::uint32_t j) {
+          if (reached[j]) return;
+          reached[j] = std::uint8_t(reached[k] + 1);
+          queue.push_back(j);
+          if (normals_[global(j)].allFinite()) face.push_back(j);
+        });
+      }
+      if (face.size() < kLeastFace) continue;
+      Vec3d normal = Vec3d::Zero(), centre = Vec3d::Zero();
+      for (std::uint32_t k : face) {
+        normal += normals_[global(k)].cast<double>();
+        centre += point(k);
+      }
+      centre /= double(face.size());
+      if (!(normal.norm() > 0)) continue;
+      normal.normalize();
+      std::size_t flat = 0, leaving = 0;
+      for (std::uint32_t k : face) {
+        flat += std::abs(normal.dot(point(k) - centre)) <= band_;
+        leaving += cylinder.in_front(point(k)) > band_;
+      }
+      const double axis_behind = normal.dot(centre - cylinder.axis_point);
+      if (double(flat) >= kFlatShare * double(face.size()) &&
+          double(leaving) >= kLeavingShare * double(face.size()) &&
+          std::abs(normal.dot(cylinder.axis)) <= std::sin(options_.normal_angle_deg * kDegree) &&
+          axis_behind > 0 &&
+          std::abs(axis_behind - cylinder.radius) <=
+              std::max(2 * band_, kRadiusTolerance * cylinder.radius))
+        return true;
+    }
+    return false;
   }
 
   // A can's side is seen as one unbroken arc around its axis. A cylinder through strips of two

@@ -3,11 +3,11 @@
 // one cluster), so that later steps do not join them again: the occlusion merge links a can to
 // the box it stands in front of exactly as it links the two halves of one object.
 //
-// The shape split also hands on the balls it fitted: a ball's surface bounds its solid all round,
-// so what lies outside it is another object, whichever cluster it came in. Two balls in contact
-// arrive in two clusters (the crease split cuts at their contact), which the merge would join
-// again: they have one height and colour and no table between them. (Solid holds a can's too,
-// but the shape split hands on none: see shape_split.hpp.)
+// The shape split also hands on the balls and cans it fitted: their surfaces bound their solids
+// all round, so what lies outside one is another object, whichever cluster it came in. Two balls
+// in contact arrive in two clusters (the crease split cuts at their contact), which the merge
+// would join again: they have one height and colour and no table between them. (A box's rounded
+// edge fitted as a can is not handed on: see shape_split.hpp.)
 
 #include <cstddef>
 #include <cstdint>

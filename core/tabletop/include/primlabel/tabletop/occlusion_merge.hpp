@@ -56,7 +56,7 @@ struct OcclusionMergeOptions {
 // are. `height` holds the signed distance above the table of every point the clusters name;
 // `table` bins the points of the table's band (the table and what touches it) in the table plane.
 // Clusters holding points `kept_apart` says are other objects are never joined, nor a cluster
-// holding a ball's solid (KeptApart::solids) and one lying outside it.
+// holding a ball's or can's solid (KeptApart::solids) and one lying outside it.
 std::vector<std::vector<std::uint32_t>> merge_occluded(
     const PointCloud& cloud, const std::vector<float>& height, const PlaneGrid& table,
     std::vector<std::vector<std::uint32_t>> clusters, const OcclusionMergeOptions& options,

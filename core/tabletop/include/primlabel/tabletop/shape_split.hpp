@@ -47,11 +47,14 @@
 //
 // Two balls in contact usually arrive in two clusters (the crease split cuts at their contact),
 // which the occlusion merge would join again (one height and colour, no table seen between
-// them). So every object-sized ball fitted in a cluster of at least min_object_points (one too
-// small to cut is fitted for this alone) goes to `kept_apart` (KeptApart::solids), and the merge
-// never joins a cluster to one lying outside the ball. Cans are not handed on: a box seen left
-// and right of a nearer one may have a cylinder fitted to its edge (mOSD learn18's), which
-// would keep its two halves apart.
+// them); so may a can and a neighbour of its colour. So every object-sized ball and can fitted
+// in a cluster of at least min_object_points (one too small to cut is fitted for this alone)
+// goes to `kept_apart` (KeptApart::solids), and the merge never joins a cluster to one lying
+// outside the solid. A box's rounded edge can fit a can (mOSD learn18's box, seen left and right
+// of a nearer one, would be kept in two halves): a can whose arc runs on at either end into a
+// flat face tangent to it (its plane at the radius with the axis behind it, its normal across
+// the axis) that then leaves the cylinder is a box edge and is not handed on. A can's arc ends
+// at its silhouette, its lid or another object, and its rim stays on its cylinder.
 
 #include <cstddef>
 #include <cstdint>
