@@ -136,30 +136,19 @@ inline PointCloud scan(const std::vector<Box>& boxes, const std::vector<Can>& ca
           rgb = box.rgb;
         }
       }
-      for (const Can& can : cans) {
-        const float t = hit_can(can, eye, ray);
-        if (t < nearest) {
-          nearest = t;
-          label = can.label;
-          rgb = can.rgb;
+      const auto take_nearest = [&](const auto& shapes, const auto& hit_shape) {
+        for (const auto& shape : shapes) {
+          const float t = hit_shape(shape, eye, ray);
+          if (t < nearest) {
+            nearest = t;
+            label = shape.label;
+            rgb = shape.rgb;
+          }
         }
-      }
-      for (const Ball& ball : balls) {
-        const float t = hit_ball(ball, eye, ray);
-        if (t < nearest) {
-          nearest = t;
-          label = ball.label;
-          rgb = ball.rgb;
-        }
-      }
-      for (const RoundedBox& box : rounded) {
-        const float t = hit_rounded_box(box, eye, ray);
-        if (t < nearest) {
-          nearest = t;
-          label = box.label;
-          rgb = box.rgb;
-        }
-      }
+      };
+      take_nearest(cans, hit_can);
+      take_nearest(balls, hit_ball);
+      take_nearest(rounded, hit_rounded_box);
       const bool hit = std::isfinite(nearest);
       const Vec3f p = hit ? Vec3f(eye + nearest * ray + Vec3f(noise(rng), noise(rng), noise(rng)))
                           : Vec3f(nan, nan, nan);

@@ -346,6 +346,33 @@ class ShapeSplitter {
     }
   }
 
+  // The inliers around a cylinder's axis: each one's angle (sorted, with its cluster-local id) and
+  // the arc they cover, from `first` over `span`: the complement of the widest empty gap.
+  struct Arc {
+    std::vector<std::pair<double, std::uint32_t>> by_angle;
+    double first = 0, span = 0;
+  };
+  Arc arc_around(const Instance& cylinder, const std::vector<std::uint32_t>& inliers) const {
+    Arc arc;
+    const Vec3d u = cylinder.axis.unitOrthogonal(), v = cylinder.axis.cross(u);
+    arc.by_angle.reserve(inliers.size());
+    for (std::uint32_t k : inliers) {
+      const Vec3d q = point(k) - cylinder.axis_point;
+      arc.by_angle.emplace_back(std::atan2(q.dot(v), q.dot(u)), k);
+    }
+    std::sort(arc.by_angle.begin(), arc.by_angle.end());
+    const auto& a = arc.by_angle;
+    std::size_t start = 0;
+    double widest = a.front().first + 2 * M_PI - a.back().first;
+    for (std::size_t k = 1; k < a.size(); ++k)
+      if (a[k].first - a[k - 1].first > widest) {
+        widest = a[k].first - a[k - 1].first;
+        start = k;
+      }
+    arc.first = a[start].first, arc.span = 2 * M_PI - widest;
+    return arc;
+  }
+
   // A box's rounded edge fitted as a can: beyond one end of its arc the surface runs on as a flat
   // face tangent to the cylinder (its plane at the radius, the axis behind it, its normal across
   // the axis) that then leaves the cylinder. A can's arc ends at its silhouette (nothing of the
@@ -358,23 +385,7 @@ class ShapeSplitter {
     constexpr double kFlatShare = 0.7, kLeavingShare = 0.3, kRadiusTolerance = 0.25;
     const std::vector<std::uint32_t>& inliers = cylinder.inliers;
     if (inliers.empty()) return false;
-    const Vec3d u = cylinder.axis.unitOrthogonal(), v = cylinder.axis.cross(u);
-    std::vector<std::pair<double, std::uint32_t>> by_angle;
-    by_angle.reserve(inliers.size());
-    for (std::uint32_t k : inliers) {
-      const Vec3d q = point(k) - cylinder.axis_point;
-      by_angle.emplace_back(std::atan2(q.dot(v), q.dot(u)), k);
-    }
-    std::sort(by_angle.begin(), by_angle.end());
-    // The arc runs from `first` over `span`: the complement of the widest empty gap.
-    std::size_t start = 0;
-    double widest = by_angle.front().first + 2 * M_PI - by_angle.back().first;
-    for (std::size_t k = 1; k < by_angle.size(); ++k)
-      if (by_angle[k].first - by_angle[k - 1].first > widest) {
-        widest = by_angle[k].first - by_angle[k - 1].first;
-        start = k;
-      }
-    const double first = by_angle[start].first, span = 2 * M_PI - widest;
+    const auto [by_angle, first, span] = arc_around(cylinder, inliers);
     std::vector<std::uint8_t> steps(cluster_->size(), 0);  // 0: not reached; else pixels on + 1
     for (std::uint32_t k : inliers) steps[k] = 1;
     for (int end = 0; end < 2; ++end) {
@@ -425,32 +436,16 @@ class ShapeSplitter {
   bool covers_an_arc(const Instance& cylinder, const std::vector<std::uint32_t>& inliers) const {
     constexpr double kBin = 10.0 * kDegree, kMinSpan = 90.0 * kDegree;
     if (inliers.empty()) return false;
-    const Vec3d u = cylinder.axis.unitOrthogonal(), v = cylinder.axis.cross(u);
-    std::vector<double> angle;
-    angle.reserve(inliers.size());
-    for (std::uint32_t k : inliers) {
-      const Vec3d q = point(k) - cylinder.axis_point;
-      angle.push_back(std::atan2(q.dot(v), q.dot(u)));
-    }
-    std::sort(angle.begin(), angle.end());
-    // The arc starts after the widest empty gap around the circle.
-    std::size_t start = 0;
-    double widest = angle.front() + 2 * M_PI - angle.back();
-    for (std::size_t k = 1; k < angle.size(); ++k)
-      if (angle[k] - angle[k - 1] > widest) {
-        widest = angle[k] - angle[k - 1];
-        start = k;
-      }
-    const double span = 2 * M_PI - widest;
+    const auto [by_angle, first, span] = arc_around(cylinder, inliers);
     if (span < kMinSpan) return false;
     const std::size_t bins = std::size_t(std::ceil(span / kBin));
     std::vector<std::size_t> count(bins, 0);
-    for (double a : angle) {
-      double offset = a - angle[start];
+    for (const auto& [a, k] : by_angle) {
+      double offset = a - first;
       if (offset < 0) offset += 2 * M_PI;
       ++count[std::min(bins - 1, std::size_t(offset / kBin))];
     }
-    const double expected = double(angle.size()) / double(bins);
+    const double expected = double(by_angle.size()) / double(bins);
     const auto filled = std::count_if(count.begin(), count.end(),
                                       [&](std::size_t c) { return double(c) >= 0.25 * expected; });
     return double(filled) >= 0.8 * double(bins);
